@@ -1,0 +1,122 @@
+//! Machine geometry in integer steps: lattice points, single steps and travel directions.
+//!
+//! Everything inside the machine is counted in steps (`i32`); millimetres appear only at the
+//! edges (protocol, menu, display) and are converted there with the per-axis steps/mm settings.
+
+/// One of the two axes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Axis {
+    X,
+    Y,
+}
+
+impl Axis {
+    pub const ALL: [Axis; 2] = [Axis::X, Axis::Y];
+
+    pub const fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+        }
+    }
+}
+
+/// A lattice point, in steps.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Point {
+    pub x: i32,
+    pub y: i32,
+}
+
+impl Point {
+    pub const ORIGIN: Point = Point { x: 0, y: 0 };
+
+    pub const fn new(x: i32, y: i32) -> Self {
+        Point { x, y }
+    }
+
+    /// The point moved by one step.
+    pub const fn stepped(self, step: Step) -> Self {
+        Point { x: self.x + step.x as i32, y: self.y + step.y as i32 }
+    }
+
+    /// `self - origin`, saturating (points inside the machine never come near the limits).
+    pub const fn offset_from(self, origin: Point) -> Point {
+        Point { x: self.x.saturating_sub(origin.x), y: self.y.saturating_sub(origin.y) }
+    }
+}
+
+/// One interpolation step: each axis moves by -1, 0 or +1.
+///
+/// `classic` interpolation moves one axis per step; `diagonal` may move both.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Step {
+    pub x: i8,
+    pub y: i8,
+}
+
+impl Step {
+    pub const NONE: Step = Step { x: 0, y: 0 };
+    pub const XP: Step = Step { x: 1, y: 0 };
+    pub const XN: Step = Step { x: -1, y: 0 };
+    pub const YP: Step = Step { x: 0, y: 1 };
+    pub const YN: Step = Step { x: 0, y: -1 };
+
+    pub const fn new(x: i8, y: i8) -> Self {
+        Step { x, y }
+    }
+
+    /// The direction of `v` on one axis: -1, 0 or +1.
+    pub const fn sign(v: i32) -> i8 {
+        if v > 0 {
+            1
+        } else if v < 0 {
+            -1
+        } else {
+            0
+        }
+    }
+
+    /// The component on `axis`.
+    pub const fn on(self, axis: Axis) -> i8 {
+        match axis {
+            Axis::X => self.x,
+            Axis::Y => self.y,
+        }
+    }
+
+    /// True when both axes move.
+    pub const fn is_diagonal(self) -> bool {
+        self.x != 0 && self.y != 0
+    }
+
+    /// True when the step goes to a lattice neighbour (8-neighbourhood, not standing still).
+    pub const fn is_neighbour(self) -> bool {
+        (self.x >= -1 && self.x <= 1 && self.y >= -1 && self.y <= 1) && !(self.x == 0 && self.y == 0)
+    }
+}
+
+/// Direction of rotation of an arc, seen with X to the right and Y up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Rotation {
+    Clockwise,
+    CounterClockwise,
+}
+
+/// Pulse timer ticks per second: `StepCmd` intervals count these. The firmware's time base
+/// (embassy-time's tick rate) is the same.
+pub const TICK_HZ: u32 = 1_000_000;
+
+/// One command for the pulse task: which axes step in which direction, and how long after the
+/// previous pulse this one is due.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct StepCmd {
+    pub step: Step,
+    /// Time from the previous pulse to this one, in [`TICK_HZ`] ticks.
+    pub interval_ticks: u32,
+}
