@@ -1,0 +1,291 @@
+//! Bytes from the host into lines, and the realtime bytes that never belong to a line.
+//!
+//! GRBL senders stream lines ended by LF, CR or CRLF, and at any moment (even in the middle of a
+//! line) send single realtime bytes: `?` status, `!` hold, `~` resume, Ctrl-X reset and GRBL's
+//! extended commands in 0x80–0xFF. The serial task routes every byte through [`realtime`] first
+//! and acts on the realtime ones at once; [`LineAssembler`] skips them too, so a line is the same
+//! whether or not the sender slipped a `?` into it.
+//!
+//! A line is kept exactly as sent (comments and spaces included, since the `$F` expression needs
+//! its own parentheses); the G-code parser strips comments itself. The assembler owns only
+//! framing: line length, line ends and which bytes may stand in a line. It must not interpret
+//! the line's contents.
+
+use super::GrblError;
+
+/// Longest line kept, in bytes, comments and spaces included. GRBL keeps 80 bytes after
+/// stripping spaces and comments; a few more leave room for spaces in the plotter's `$`
+/// commands while a sender's character counting (128-byte receive buffer) still holds a line.
+pub const LINE_MAX_BYTES: usize = 96;
+
+/// A byte that acts at once instead of being part of a line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Realtime {
+    /// `?`: send a status report.
+    StatusQuery,
+    /// `!`: feed hold.
+    FeedHold,
+    /// `~`: cycle start / resume.
+    CycleStart,
+    /// 0x18 (Ctrl-X): soft reset.
+    Reset,
+    /// 0x85: cancel the jog in progress.
+    JogCancel,
+    /// One of GRBL's other extended realtime bytes (safety door 0x84, feed, rapid and spindle
+    /// overrides 0x90–0x9E, coolant toggles 0xA0/0xA1): the plotter has no use for it and
+    /// ignores it, as GRBL would on a machine without that feature.
+    Unsupported(u8),
+}
+
+/// The realtime command `byte` stands for, if any.
+pub const fn realtime(byte: u8) -> Option<Realtime> {
+    Some(match byte {
+        b'?' => Realtime::StatusQuery,
+        b'!' => Realtime::FeedHold,
+        b'~' => Realtime::CycleStart,
+        0x18 => Realtime::Reset,
+        0x85 => Realtime::JogCancel,
+        0x84 | 0x90..=0x97 | 0x99..=0x9E | 0xA0 | 0xA1 => Realtime::Unsupported(byte),
+        _ => return None,
+    })
+}
+
+/// What a finished line turned out to be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum LineEvent<'a> {
+    /// A complete line, without its line end; may be empty (answer `ok`, as GRBL does).
+    Line(&'a str),
+    /// The line was longer than [`LINE_MAX_BYTES`]; all of it was dropped (`error:11`).
+    Overflow,
+    /// The line held this control or non-ASCII byte (the first one); all of it was dropped
+    /// (`error:1`).
+    BadByte(u8),
+}
+
+impl LineEvent<'_> {
+    /// The error to answer for a refused line; `None` for a line to execute.
+    pub const fn error(&self) -> Option<GrblError> {
+        match self {
+            LineEvent::Line(_) => None,
+            LineEvent::Overflow => Some(GrblError::LineOverflow),
+            LineEvent::BadByte(_) => Some(GrblError::ExpectedCommandLetter),
+        }
+    }
+}
+
+/// Collects bytes into lines; see the module documentation.
+///
+/// A line ends at LF or CR; an LF right after a CR only completes the CRLF pair and makes no
+/// second (empty) line. Every other byte that is not realtime belongs to the line: printable
+/// ASCII and tab are kept; any other byte marks the whole line as refused. A line that grows past
+/// [`LINE_MAX_BYTES`] is dropped up to its end and reported once, as [`LineEvent::Overflow`],
+/// when that end arrives. A soft reset byte (0x18) drops the partial line, as GRBL's reset
+/// flushes its receive buffer.
+#[derive(Clone, Debug)]
+pub struct LineAssembler {
+    buf: [u8; LINE_MAX_BYTES],
+    len: usize,
+    overflow: bool,
+    bad_byte: Option<u8>,
+    /// The previous line-ending byte was a CR: a following LF belongs to it.
+    after_cr: bool,
+    /// A line was handed out by the previous `push`; the buffer starts over at the next byte.
+    handed_out: bool,
+}
+
+impl Default for LineAssembler {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl LineAssembler {
+    pub const fn new() -> Self {
+        LineAssembler {
+            buf: [0; LINE_MAX_BYTES],
+            len: 0,
+            overflow: false,
+            bad_byte: None,
+            after_cr: false,
+            handed_out: false,
+        }
+    }
+
+    /// Drops the partial line (after a soft reset, or when the link reconnects).
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.overflow = false;
+        self.bad_byte = None;
+        self.after_cr = false;
+        self.handed_out = false;
+    }
+
+    /// Takes one byte; returns an event when it ended a line. The returned line borrows the
+    /// assembler's buffer and is valid until the next `push`.
+    pub fn push(&mut self, byte: u8) -> Option<LineEvent<'_>> {
+        if self.handed_out {
+            self.len = 0;
+            self.overflow = false;
+            self.bad_byte = None;
+            self.handed_out = false;
+        }
+        if let Some(rt) = realtime(byte) {
+            if rt == Realtime::Reset {
+                self.clear();
+            }
+            return None;
+        }
+        match byte {
+            b'\n' if self.after_cr => {
+                self.after_cr = false;
+                None
+            }
+            b'\r' | b'\n' => {
+                self.after_cr = byte == b'\r';
+                self.handed_out = true;
+                Some(self.finish())
+            }
+            _ => {
+                self.after_cr = false;
+                let allowed = byte == b'\t' || (0x20..=0x7E).contains(&byte);
+                if !allowed {
+                    if self.bad_byte.is_none() {
+                        self.bad_byte = Some(byte);
+                    }
+                } else if self.len < LINE_MAX_BYTES {
+                    self.buf[self.len] = byte;
+                    self.len += 1;
+                } else {
+                    self.overflow = true;
+                }
+                None
+            }
+        }
+    }
+
+    fn finish(&self) -> LineEvent<'_> {
+        if self.overflow {
+            LineEvent::Overflow
+        } else if let Some(b) = self.bad_byte {
+            LineEvent::BadByte(b)
+        } else {
+            // Only printable ASCII and tab are ever stored, so this is always valid UTF-8.
+            match core::str::from_utf8(&self.buf[..self.len]) {
+                Ok(line) => LineEvent::Line(line),
+                Err(_) => LineEvent::BadByte(0),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::string::{String, ToString};
+    use std::vec::Vec;
+
+    /// Feeds `bytes` and collects every event, lines as owned strings.
+    fn feed(asm: &mut LineAssembler, bytes: &[u8]) -> Vec<Result<String, LineEvent<'static>>> {
+        let mut out = Vec::new();
+        for &b in bytes {
+            match asm.push(b) {
+                Some(LineEvent::Line(l)) => out.push(Ok(l.to_string())),
+                Some(LineEvent::Overflow) => out.push(Err(LineEvent::Overflow)),
+                Some(LineEvent::BadByte(b)) => out.push(Err(LineEvent::BadByte(b))),
+                None => {}
+            }
+        }
+        out
+    }
+
+    fn lines(v: &[&str]) -> Vec<Result<String, LineEvent<'static>>> {
+        v.iter().map(|s| Ok(s.to_string())).collect()
+    }
+
+    #[test]
+    fn lf_cr_and_crlf_each_end_one_line() {
+        let mut a = LineAssembler::new();
+        assert_eq!(feed(&mut a, b"G0 X1\nG0 X2\rG0 X3\r\nG0 X4\n"), lines(&["G0 X1", "G0 X2", "G0 X3", "G0 X4"]));
+    }
+
+    #[test]
+    fn crlf_split_across_pushes_makes_no_empty_line_but_blank_lines_still_count() {
+        let mut a = LineAssembler::new();
+        assert_eq!(feed(&mut a, b"$$\r"), lines(&["$$"]));
+        assert_eq!(feed(&mut a, b"\n"), lines(&[]));
+        // A blank line is a line: GRBL answers it with `ok`, and senders count on that.
+        assert_eq!(feed(&mut a, b"\n\r\n"), lines(&["", ""]));
+        // LF CR is two line ends, not a pair.
+        assert_eq!(feed(&mut a, b"A\n\rB\n"), lines(&["A", "", "B"]));
+    }
+
+    #[test]
+    fn realtime_bytes_mid_line_are_not_part_of_it() {
+        let mut a = LineAssembler::new();
+        assert_eq!(feed(&mut a, b"G1 X?1!0~ Y\x855\x91\n"), lines(&["G1 X10 Y5"]));
+        assert_eq!(realtime(b'?'), Some(Realtime::StatusQuery));
+        assert_eq!(realtime(b'!'), Some(Realtime::FeedHold));
+        assert_eq!(realtime(b'~'), Some(Realtime::CycleStart));
+        assert_eq!(realtime(0x18), Some(Realtime::Reset));
+        assert_eq!(realtime(0x85), Some(Realtime::JogCancel));
+        assert_eq!(realtime(0x91), Some(Realtime::Unsupported(0x91)));
+        assert_eq!(realtime(b'G'), None);
+        assert_eq!(realtime(b'\n'), None);
+    }
+
+    #[test]
+    fn reset_drops_the_partial_line() {
+        let mut a = LineAssembler::new();
+        assert_eq!(feed(&mut a, b"G1 X100\x18G0 X0\n"), lines(&["G0 X0"]));
+    }
+
+    #[test]
+    fn an_overlong_line_is_reported_once_and_the_next_line_is_intact() {
+        let mut a = LineAssembler::new();
+        let mut input = std::vec![b'X'; LINE_MAX_BYTES * 3];
+        input.extend_from_slice(b"\r\nG0 X1\n");
+        assert_eq!(feed(&mut a, &input), std::vec![Err(LineEvent::Overflow), Ok("G0 X1".to_string())]);
+    }
+
+    #[test]
+    fn a_line_of_exactly_the_maximum_length_is_kept() {
+        let mut a = LineAssembler::new();
+        let mut input = std::vec![b'9'; LINE_MAX_BYTES];
+        input.push(b'\n');
+        let got = feed(&mut a, &input);
+        assert_eq!(got, std::vec![Ok("9".repeat(LINE_MAX_BYTES))]);
+        input.insert(0, b'9');
+        assert_eq!(feed(&mut a, &input), std::vec![Err(LineEvent::Overflow)]);
+    }
+
+    #[test]
+    fn control_and_non_ascii_bytes_refuse_the_line_without_eating_the_next() {
+        let mut a = LineAssembler::new();
+        // "°" in UTF-8 is C2 B0; neither byte is a GRBL realtime command.
+        let got = feed(&mut a, "G0 X1 (10°)\nG0 X2\n".as_bytes());
+        assert_eq!(got, std::vec![Err(LineEvent::BadByte(0xC2)), Ok("G0 X2".to_string())]);
+        let got = feed(&mut a, b"G0\x07X1\n\tG0\tX3\n");
+        assert_eq!(got, std::vec![Err(LineEvent::BadByte(0x07)), Ok("\tG0\tX3".to_string())]);
+        assert_eq!(LineEvent::BadByte(7).error(), Some(GrblError::ExpectedCommandLetter));
+        assert_eq!(LineEvent::Overflow.error().map(GrblError::code), Some(11));
+        assert_eq!(LineEvent::Line("").error(), None);
+    }
+
+    #[test]
+    fn lines_never_exceed_the_buffer_whatever_the_bytes() {
+        use proptest::prelude::*;
+        proptest!(|(bytes in proptest::collection::vec(any::<u8>(), 0..400))| {
+            let mut a = LineAssembler::new();
+            for b in bytes {
+                if let Some(LineEvent::Line(l)) = a.push(b) {
+                    prop_assert!(l.len() <= LINE_MAX_BYTES);
+                    prop_assert!(l.bytes().all(|c| c == b'\t' || (0x20..=0x7E).contains(&c)));
+                    prop_assert!(l.bytes().all(|c| realtime(c).is_none()));
+                }
+            }
+        });
+    }
+}

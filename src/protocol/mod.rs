@@ -1,0 +1,145 @@
+//! The host link's GRBL 1.1 line protocol: the pure, synchronous core of the serial link.
+//!
+//! Existing G-code senders (UGS, CNCjs, bCNC) and a plain terminal talk to the plotter as if it
+//! were GRBL 1.1. This module owns the three pure parts of that conversation:
+//!
+//! - [`line`](mod@line): bytes in, lines out ([`LineAssembler`]), and the realtime bytes
+//!   that bypass lines ([`realtime`]);
+//! - [`gcode`]: one line in, machine [`Command`]s out ([`GcodeState::execute`]), with GRBL's
+//!   modal state, planned position and error rules, plus the plotter's own curve commands;
+//! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...).
+//!
+//! It owns no pins, queues or clocks: the serial task feeds it bytes, hands the resulting
+//! commands to the machine and writes the answers. Every line gets exactly one `ok` or
+//! `error:N`, and a line answered with an error changes nothing (neither the modal state nor the
+//! planned position, nor the settings).
+//!
+//! # Error numbers
+//!
+//! Every error is a GRBL 1.1 error number, so senders show their usual text for it:
+//!
+//! | N  | [`GrblError`]             | when |
+//! |----|---------------------------|------|
+//! | 1  | `ExpectedCommandLetter`   | a word does not start with a letter; a line holds a control or non-ASCII byte |
+//! | 2  | `BadNumberFormat`         | a word's number is missing or malformed (`X`, `X1.2.3`, `X--1`) |
+//! | 2  | `Expression`              | the `Y=` expression of `$F` does not parse (an info line gives the column) |
+//! | 3  | `InvalidStatement`        | unknown `$` command, unknown setting number, bad setting value |
+//! | 4  | `NegativeValue`           | negative F, N, P, S, T, or negative size in a curve command |
+//! | 5  | `SettingDisabled`         | `$H`: the plotter has no homing switches |
+//! | 8  | `NotIdle`                 | `$N=`/`$RST=` while moving; `$J=` while drawing, held or in alarm |
+//! | 9  | `Locked`                  | G-code or a curve command while in alarm (unlock with `$X`) or jogging |
+//! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`] |
+//! | 15 | `TravelExceeded`          | any point of a move or curve outside ±max travel (`$130`, `$131`) |
+//! | 16 | `InvalidJog`              | a `$J=` line with a word or command jogging does not allow |
+//! | 20 | `Unsupported`             | a G/M code or word letter the plotter does not support (G18, G28, M8, ...) |
+//! | 21 | `ModalGroupViolation`     | two commands of one modal group in a line (`G0 G1`, `G20 G21`) |
+//! | 22 | `UndefinedFeedRate`       | a feed move or jog with a zero or missing feed rate |
+//! | 23 | `ValueNotInteger`         | `G1.5`, `M3.1` |
+//! | 24 | `AxisCommandConflict`     | G92 and a motion command in one line |
+//! | 25 | `RepeatedWord`            | a word letter twice in a line (`X1 X2`) |
+//! | 26 | `NoAxisWords`             | G92, an arc or a jog without axis words |
+//! | 27 | `InvalidLineNumber`       | N above 9 999 999 |
+//! | 28 | `ValueWordMissing`        | G4 without P; a curve command without a required word |
+//! | 30 | `G53InvalidMotionMode`    | G53 while G2/G3/G80 is the motion mode |
+//! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode |
+//! | 32 | `NoAxisWordsInPlane`      | G2/G3 with only a Z word |
+//! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, a curve of less than one step radius, sweep above 360° |
+//! | 33 | `FunctionUndefined`       | the `$F` function cannot be evaluated on its range (an info line gives x) |
+//! | 34 | `ArcRadius`               | R arc whose radius is shorter than half the chord |
+//! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |
+//! | 36 | `UnusedWords`             | a word no command in the line uses (`G0 X1 P2`, `I5` without an arc) |
+//! | 38 | `MaxValueExceeded`        | T above 255, dwell above [`gcode::DWELL_MAX_MS`] |
+//!
+//! GRBL's soft limits raise an alarm; the plotter answers `error:15` instead and moves nothing,
+//! which is safer and tells the sender which line was refused.
+//!
+//! # Plotter commands
+//!
+//! Beyond GRBL, one `$` command per curve the machine draws; all draw from the pen, take
+//! millimetres and degrees whatever G20/G21 says, and accept an F word (mm/min) that becomes the
+//! modal feed rate like G1's. See [`gcode`] for their exact syntax and geometry.
+
+pub mod gcode;
+pub mod line;
+pub mod report;
+
+pub use gcode::{Command, Commands, CurveShape, GcodeState, Report};
+pub use line::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
+
+/// Why a line was refused; [`GrblError::code`] is the number sent as `error:N`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum GrblError {
+    ExpectedCommandLetter,
+    BadNumberFormat,
+    InvalidStatement,
+    NegativeValue,
+    SettingDisabled,
+    NotIdle,
+    Locked,
+    LineOverflow,
+    TravelExceeded,
+    InvalidJog,
+    Unsupported,
+    ModalGroupViolation,
+    UndefinedFeedRate,
+    ValueNotInteger,
+    AxisCommandConflict,
+    RepeatedWord,
+    NoAxisWords,
+    InvalidLineNumber,
+    ValueWordMissing,
+    G53InvalidMotionMode,
+    AxisWordsExist,
+    NoAxisWordsInPlane,
+    InvalidTarget,
+    ArcRadius,
+    NoOffsetsInPlane,
+    UnusedWords,
+    MaxValueExceeded,
+    /// The expression of `$F` does not parse; `column` is 1-based within the line.
+    Expression {
+        column: u16,
+        kind: crate::expr::ParseErrorKind,
+    },
+    /// The function of `$F` cannot be evaluated at `x_mm` (a domain error or an overflow).
+    FunctionUndefined {
+        x_mm: f32,
+        error: crate::expr::EvalError,
+    },
+}
+
+impl GrblError {
+    /// The GRBL 1.1 error number.
+    pub const fn code(self) -> u8 {
+        match self {
+            GrblError::ExpectedCommandLetter => 1,
+            GrblError::BadNumberFormat | GrblError::Expression { .. } => 2,
+            GrblError::InvalidStatement => 3,
+            GrblError::NegativeValue => 4,
+            GrblError::SettingDisabled => 5,
+            GrblError::NotIdle => 8,
+            GrblError::Locked => 9,
+            GrblError::LineOverflow => 11,
+            GrblError::TravelExceeded => 15,
+            GrblError::InvalidJog => 16,
+            GrblError::Unsupported => 20,
+            GrblError::ModalGroupViolation => 21,
+            GrblError::UndefinedFeedRate => 22,
+            GrblError::ValueNotInteger => 23,
+            GrblError::AxisCommandConflict => 24,
+            GrblError::RepeatedWord => 25,
+            GrblError::NoAxisWords => 26,
+            GrblError::InvalidLineNumber => 27,
+            GrblError::ValueWordMissing => 28,
+            GrblError::G53InvalidMotionMode => 30,
+            GrblError::AxisWordsExist => 31,
+            GrblError::NoAxisWordsInPlane => 32,
+            GrblError::InvalidTarget | GrblError::FunctionUndefined { .. } => 33,
+            GrblError::ArcRadius => 34,
+            GrblError::NoOffsetsInPlane => 35,
+            GrblError::UnusedWords => 36,
+            GrblError::MaxValueExceeded => 38,
+        }
+    }
+}

@@ -1,0 +1,315 @@
+//! Every answer the plotter writes to the host, formatted as GRBL 1.1 does.
+//!
+//! Each function writes complete lines, each ended by CR LF as GRBL ends them, into any
+//! `core::fmt::Write` (a `heapless::String`, or a writer over the UART's transmit buffer); none
+//! allocates. A single line is at most [`REPORT_LINE_MAX_BYTES`] long, so a
+//! `heapless::String<REPORT_LINE_MAX_BYTES>` holds any one of them; `$$` writes one line per
+//! setting ([`setting`] writes one at a time). Positions are millimetres with three decimals,
+//! from steps and the steps/mm settings; Z is always `0.000`, for senders that expect three axes.
+//! This module only formats: it decides nothing and reads no machine state it is not given.
+
+use core::fmt::{self, Write};
+
+use super::GrblError;
+use super::gcode::{Distance, GcodeState, MotionMode, Spindle, Units};
+use crate::geom::Axis;
+use crate::settings::{SETTING_INFO, Settings};
+use crate::status::{RunState, Status};
+
+/// The GRBL version the plotter speaks; senders look for "Grbl 1.1".
+pub const GRBL_VERSION: &str = "1.1h";
+
+/// The build name reported by `$I`.
+pub const BUILD_NAME: &str = "servoplot";
+
+/// Longest single line written here (a status report with a work offset at ±500 mm is 81).
+pub const REPORT_LINE_MAX_BYTES: usize = 128;
+
+/// Settings whose values are whole numbers (a bit mask, a choice), listed without decimals.
+const INTEGER_SETTINGS: &[u16] = &[3, 202];
+
+/// `ok`: the line was executed.
+pub fn ok(out: &mut impl Write) -> fmt::Result {
+    out.write_str("ok\r\n")
+}
+
+/// `error:N`, preceded by an info line where the number alone would not say what is wrong
+/// (the column of an expression error, the x where a function is undefined).
+pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
+    match error {
+        GrblError::Expression { column, kind } => {
+            write!(out, "[MSG:Expression error at column {column}: {}]\r\n", kind.message())?;
+        }
+        GrblError::FunctionUndefined { x_mm, error } => {
+            out.write_str("[MSG:Function undefined at x=")?;
+            mm(out, x_mm as f64)?;
+            write!(out, ": {}]\r\n", error.message())?;
+        }
+        _ => {}
+    }
+    write!(out, "error:{}\r\n", error.code())
+}
+
+/// The banner after power-up and every soft reset.
+pub fn welcome(out: &mut impl Write) -> fmt::Result {
+    write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")
+}
+
+/// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
+pub fn message(out: &mut impl Write, text: &str) -> fmt::Result {
+    write!(out, "[MSG:{text}]\r\n")
+}
+
+/// `ALARM:N` with GRBL's alarm numbers (1 hard limit, 2 soft limit, 3 reset while moving).
+pub fn alarm(out: &mut impl Write, code: u8) -> fmt::Result {
+    write!(out, "ALARM:{code}\r\n")
+}
+
+/// The status report for `?`: `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `feed_mm_per_min` is the
+/// speed now (0 when stopped); `work_offset_mm`, when given, adds GRBL's `|WCO:x,y,0.000` field
+/// (GRBL sends it every 10 to 30 reports and after the offset changes).
+pub fn status(
+    out: &mut impl Write,
+    status: &Status,
+    settings: &Settings,
+    feed_mm_per_min: f32,
+    work_offset_mm: Option<[f32; 2]>,
+) -> fmt::Result {
+    let state = match status.state {
+        RunState::Idle => "Idle",
+        RunState::Run => "Run",
+        RunState::Hold => "Hold:0",
+        RunState::Jog => "Jog",
+        RunState::Alarm => "Alarm",
+    };
+    write!(out, "<{state}|MPos:")?;
+    let x = status.position.x as f64 / settings.steps_per_mm(Axis::X) as f64;
+    let y = status.position.y as f64 / settings.steps_per_mm(Axis::Y) as f64;
+    xyz(out, x, y)?;
+    let feed = if feed_mm_per_min.is_finite() { libm::roundf(feed_mm_per_min.abs()) as u32 } else { 0 };
+    write!(out, "|FS:{feed},0")?;
+    if let Some([x, y]) = work_offset_mm {
+        out.write_str("|WCO:")?;
+        xyz(out, x as f64, y as f64)?;
+    }
+    out.write_str(">\r\n")
+}
+
+/// `$$`: every setting, `$N=value` per line, in `SETTING_INFO` order.
+pub fn settings(out: &mut impl Write, settings: &Settings) -> fmt::Result {
+    for info in SETTING_INFO {
+        setting(out, info.id, settings)?;
+    }
+    Ok(())
+}
+
+/// One `$N=value` line; nothing for an unknown id.
+pub fn setting(out: &mut impl Write, id: u16, settings: &Settings) -> fmt::Result {
+    let Ok(value) = settings.get(id) else { return Ok(()) };
+    write!(out, "${id}=")?;
+    if INTEGER_SETTINGS.contains(&id) {
+        write!(out, "{}", value as i64)?;
+    } else {
+        decimal(out, value)?;
+    }
+    out.write_str("\r\n")
+}
+
+/// `$G`: `[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]`, F the feed rate G1 would use now.
+pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Settings) -> fmt::Result {
+    let motion = match gcode.motion_mode() {
+        MotionMode::Rapid => "G0",
+        MotionMode::Linear => "G1",
+        MotionMode::ArcCw => "G2",
+        MotionMode::ArcCcw => "G3",
+        MotionMode::Off => "G80",
+    };
+    let units = match gcode.units() {
+        Units::Mm => "G21",
+        Units::Inch => "G20",
+    };
+    let distance = match gcode.distance() {
+        Distance::Absolute => "G90",
+        Distance::Incremental => "G91",
+    };
+    let spindle = match gcode.spindle() {
+        Spindle::Cw => "M3",
+        Spindle::Ccw => "M4",
+        Spindle::Off => "M5",
+    };
+    let feed = libm::roundf(gcode.feed_mm_per_min(settings)) as u32;
+    let speed = libm::roundf(gcode.spindle_speed()) as u32;
+    write!(out, "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} M9 T{} F{feed} S{speed}]\r\n", gcode.tool())
+}
+
+/// `$#`: GRBL's coordinate offsets. Only G92 can be set; the others are always zero.
+pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
+    for name in ["G54", "G55", "G56", "G57", "G58", "G59", "G28", "G30"] {
+        write!(out, "[{name}:0.000,0.000,0.000]\r\n")?;
+    }
+    let [x, y] = gcode.work_offset_mm();
+    out.write_str("[G92:")?;
+    xyz(out, x as f64, y as f64)?;
+    out.write_str("]\r\n[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
+}
+
+/// `$I`: version and GRBL's `[OPT:codes,blocks,rx]` line. Senders size their character-counting
+/// window from `rx_buffer_bytes`, so it must be the serial task's real receive buffer.
+pub fn build_info(out: &mut impl Write, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
+    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:]\r\n[OPT:,{planner_blocks},{rx_buffer_bytes}]\r\n")
+}
+
+/// `$`: the commands the plotter understands.
+pub fn help(out: &mut impl Write) -> fmt::Result {
+    out.write_str("[HLP:$$ $# $G $I $x=val $J=line $RST=$ $X $E $O $S $F ~ ! ? ctrl-x]\r\n")
+}
+
+/// `x,y,0.000` in millimetres.
+fn xyz(out: &mut impl Write, x: f64, y: f64) -> fmt::Result {
+    mm(out, x)?;
+    out.write_char(',')?;
+    mm(out, y)?;
+    out.write_str(",0.000")
+}
+
+/// Millimetres with exactly three decimals, rounded to the micrometre; never `-0.000`.
+fn mm(out: &mut impl Write, value: f64) -> fmt::Result {
+    let um = if value.is_finite() { libm::round(value * 1000.0) as i64 } else { 0 };
+    let sign = if um < 0 { "-" } else { "" };
+    let um = um.unsigned_abs();
+    write!(out, "{sign}{}.{:03}", um / 1000, um % 1000)
+}
+
+/// A setting's value: at least three decimals like GRBL, more (up to six) when it has them.
+fn decimal(out: &mut impl Write, value: f32) -> fmt::Result {
+    let mut text: heapless::String<48> = heapless::String::new();
+    if write!(text, "{value:.6}").is_err() {
+        return write!(out, "{value:.3}");
+    }
+    let keep = match text.find('.') {
+        Some(point) => {
+            let digits = text.trim_end_matches('0').len();
+            digits.max(point + 4)
+        }
+        None => text.len(),
+    };
+    out.write_str(&text[..keep])
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::geom::Point;
+    use crate::protocol::GrblError;
+    use crate::settings::Settings;
+    use std::string::String;
+
+    fn text(f: impl FnOnce(&mut String) -> fmt::Result) -> String {
+        let mut s = String::new();
+        f(&mut s).unwrap();
+        s
+    }
+
+    fn st(state: RunState, x: i32, y: i32) -> Status {
+        Status { state, position: Point::new(x, y), queued_jobs: 0 }
+    }
+
+    #[test]
+    fn status_reports_match_grbl_exactly() {
+        let s = Settings::default(); // 100 steps/mm
+        assert_eq!(
+            text(|o| status(o, &st(RunState::Idle, 1000, 500), &s, 0.0, None)),
+            "<Idle|MPos:10.000,5.000,0.000|FS:0,0>\r\n"
+        );
+        assert_eq!(
+            text(|o| status(o, &st(RunState::Run, -1, -123_456), &s, 1499.6, None)),
+            "<Run|MPos:-0.010,-1234.560,0.000|FS:1500,0>\r\n"
+        );
+        assert_eq!(
+            text(|o| status(o, &st(RunState::Hold, 0, 0), &s, 0.0, Some([-2.5, 0.0]))),
+            "<Hold:0|MPos:0.000,0.000,0.000|FS:0,0|WCO:-2.500,0.000,0.000>\r\n"
+        );
+        assert!(text(|o| status(o, &st(RunState::Jog, 0, 0), &s, 600.0, None)).starts_with("<Jog|"));
+        assert!(text(|o| status(o, &st(RunState::Alarm, 0, 0), &s, 0.0, None)).starts_with("<Alarm|"));
+    }
+
+    #[test]
+    fn positions_use_each_axis_steps_per_mm_and_never_show_minus_zero() {
+        let mut s = Settings::default();
+        s.set(100, 80.0).unwrap();
+        s.set(101, 200.0).unwrap();
+        assert_eq!(
+            text(|o| status(o, &st(RunState::Idle, -1, -1), &s, 0.0, None)),
+            "<Idle|MPos:-0.013,-0.005,0.000|FS:0,0>\r\n"
+        );
+        // -0.0004 mm rounds to zero and shows as zero.
+        assert_eq!(text(|o| mm(o, -0.0004)), "0.000");
+        assert_eq!(text(|o| mm(o, 499.9996)), "500.000");
+    }
+
+    #[test]
+    fn the_longest_status_line_fits_the_stated_maximum() {
+        let s = Settings::default();
+        let line = text(|o| status(o, &st(RunState::Hold, -50_000, -50_000), &s, 60_000.0, Some([-500.0, -500.0])));
+        assert!(line.len() <= REPORT_LINE_MAX_BYTES, "{} bytes", line.len());
+        let mut fixed: heapless::String<REPORT_LINE_MAX_BYTES> = heapless::String::new();
+        status(&mut fixed, &st(RunState::Hold, -50_000, -50_000), &s, 60_000.0, Some([-500.0, -500.0])).unwrap();
+        assert_eq!(fixed.as_str(), line);
+    }
+
+    #[test]
+    fn short_answers() {
+        assert_eq!(text(ok), "ok\r\n");
+        assert_eq!(text(|o| error(o, GrblError::TravelExceeded)), "error:15\r\n");
+        assert_eq!(text(|o| error(o, GrblError::ModalGroupViolation)), "error:21\r\n");
+        assert_eq!(text(welcome), "\r\nGrbl 1.1h ['$' for help]\r\n");
+        assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
+        assert_eq!(text(|o| alarm(o, 1)), "ALARM:1\r\n");
+        assert_eq!(text(|o| build_info(o, 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
+        assert!(text(help).starts_with("[HLP:$$ $# $G $I"));
+    }
+
+    #[test]
+    fn expression_errors_say_where() {
+        let e = GrblError::Expression { column: 19, kind: crate::expr::ParseErrorKind::UnknownName };
+        assert_eq!(text(|o| error(o, e)), "[MSG:Expression error at column 19: unknown name]\r\nerror:2\r\n");
+        let e = GrblError::FunctionUndefined { x_mm: -1.5, error: crate::expr::EvalError::SqrtOfNegative };
+        assert_eq!(
+            text(|o| error(o, e)),
+            "[MSG:Function undefined at x=-1.500: sqrt of a negative number]\r\nerror:33\r\n"
+        );
+    }
+
+    #[test]
+    fn settings_list_like_grbl() {
+        let mut s = Settings::default();
+        s.set(12, 0.0005).unwrap();
+        let list = text(|o| settings(o, &s));
+        let lines: std::vec::Vec<&str> = list.split("\r\n").filter(|l| !l.is_empty()).collect();
+        assert_eq!(lines.len(), SETTING_INFO.len());
+        assert_eq!(lines[0], "$0=5.000");
+        assert!(lines.contains(&"$3=0"));
+        assert!(lines.contains(&"$11=0.020"));
+        assert!(lines.contains(&"$12=0.0005"));
+        assert!(lines.contains(&"$100=100.000"));
+        assert!(lines.contains(&"$202=1"));
+        assert!(lines.contains(&"$205=20000.000"));
+        assert_eq!(text(|o| setting(o, 999, &s)), "");
+    }
+
+    #[test]
+    fn parser_state_and_offsets() {
+        let s = Settings::default();
+        let mut g = GcodeState::new();
+        assert_eq!(text(|o| parser_state(o, &g, &s)), "[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]\r\n");
+        g.execute("G91 G20 G1 F10 M3 S1000 T2", &s, RunState::Idle).unwrap();
+        assert_eq!(text(|o| parser_state(o, &g, &s)), "[GC:G1 G54 G17 G20 G91 G94 M3 M9 T2 F254 S1000]\r\n");
+        g.execute("G90 G21 G0 X10 Y-5", &s, RunState::Idle).unwrap();
+        g.execute("G92 X0 Y0", &s, RunState::Idle).unwrap();
+        let p = text(|o| parameters(o, &g));
+        assert!(p.starts_with("[G54:0.000,0.000,0.000]\r\n"));
+        assert!(p.contains("[G92:10.000,-5.000,0.000]\r\n"));
+        assert!(p.ends_with("[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n"));
+    }
+}
