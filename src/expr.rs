@@ -202,6 +202,14 @@ pub struct Expr {
     ops: Vec<Op, EXPR_MAX_OPS>,
 }
 
+/// Logs show an expression's size; its text is the host's, not the firmware's.
+#[cfg(target_os = "none")]
+impl defmt::Format for Expr {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "Expr({=usize} ops)", self.op_count())
+    }
+}
+
 /// Parses `src` into an [`Expr`]; see the module documentation for the language.
 pub fn parse(src: &str) -> Result<Expr, ParseError> {
     if let Some((pos, _)) = src.char_indices().nth(MAX_EXPR_LEN_CHARS) {
@@ -423,7 +431,8 @@ impl Parser<'_> {
                 end += 1 + sign + exp;
             }
         }
-        let text = core::str::from_utf8(&s[start..end]).map_err(|_| ParseError { kind: ParseErrorKind::UnexpectedChar, pos: start })?;
+        let text = core::str::from_utf8(&s[start..end])
+            .map_err(|_| ParseError { kind: ParseErrorKind::UnexpectedChar, pos: start })?;
         match text.parse::<f64>() {
             Ok(v) if v.is_finite() && v <= EXPR_MAX_MAGNITUDE => Ok((Tok::Num(v), start, end)),
             Ok(_) => Self::error(ParseErrorKind::NumberOutOfRange, start),
@@ -824,7 +833,10 @@ mod tests {
     #[test]
     fn a_realistic_curve_parses_once_and_evaluates_everywhere() {
         let e = parse("2.5*sin(2*pi*x/40) * exp(-x/100) + 0.1*x - abs(x - 50)^1.5/100").unwrap();
-        let f = |x: f64| 2.5 * libm::sin(2.0 * PI * x / 40.0) * libm::exp(-x / 100.0) + 0.1 * x - libm::pow(libm::fabs(x - 50.0), 1.5) / 100.0;
+        let f = |x: f64| {
+            2.5 * libm::sin(2.0 * PI * x / 40.0) * libm::exp(-x / 100.0) + 0.1 * x
+                - libm::pow(libm::fabs(x - 50.0), 1.5) / 100.0
+        };
         for i in 0..=100 {
             let x = i as f64;
             let got = e.eval(x).unwrap();

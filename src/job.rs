@@ -4,7 +4,12 @@
 //! (steps), so everything the keypad can draw the host can draw too. A job starts where the pen
 //! is when the job begins; positions in it are absolute.
 
-use crate::geom::{Point, Rotation};
+use crate::expr::Expr;
+use crate::geom::{Axis, Point, Rotation, Step};
+use crate::settings::Settings;
+
+/// Feed of a jog from the keypad.
+pub const JOG_FEED_MM_PER_MIN: f32 = 1_200.0;
 
 /// How fast a job moves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,12 +21,23 @@ pub enum Feed {
     MmPerMin(f32),
 }
 
-/// The path of one job.
+/// The path of one job, in steps. Curves that start "at the pen" (sine, function) are
+/// translated so their first point is wherever the pen is when the job begins.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Shape {
     /// Straight line to `to`.
     Line { to: Point },
+    /// Circular arc around `center` to `to`; `to` equal to the start point is a full circle.
+    Arc { center: Point, to: Point, rotation: Rotation },
+    /// Elliptic arc with semi-axes `a_steps` (along X) and `b_steps` (along Y) around `center`
+    /// to `to`; `to` equal to the start point is the full ellipse.
+    Ellipse { center: Point, a_steps: i32, b_steps: i32, to: Point, rotation: Rotation },
+    /// y = A·sin(ω·x + φ) − A·sin φ, for x from 0 to `length_steps` (negative: towards −X).
+    Sine { amplitude_steps: f32, omega_rad_per_step: f32, phase_rad: f32, length_steps: i32 },
+    /// y = f(x) with x and y in millimetres, for x from `x0_mm` to `x1_mm`, translated so that
+    /// (x0, f(x0)) is the start point.
+    Function { expr: Expr, x0_mm: f32, x1_mm: f32 },
 }
 
 /// One drawing job.
@@ -42,4 +58,41 @@ pub enum Control {
     Resume,
     /// Decelerate to a stop and drop the rest of the job and every queued one.
     Abort,
+}
+
+impl Job {
+    /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a
+    /// straight 0°, 45° or 90° line; releasing the key aborts it, which decelerates to a stop.
+    pub fn jog(direction: Step, from: Point, settings: &Settings) -> Job {
+        let room = |axis: Axis| -> i32 {
+            let limit = settings.mm_to_steps(axis, settings.max_travel_mm[axis.index()]);
+            let at = match axis {
+                Axis::X => from.x,
+                Axis::Y => from.y,
+            };
+            match direction.on(axis) {
+                1 => (limit - at).max(0),
+                -1 => (at + limit).max(0),
+                _ => i32::MAX,
+            }
+        };
+        let distance = room(Axis::X).min(room(Axis::Y));
+        let distance = if distance == i32::MAX { 0 } else { distance };
+        let to = Point::new(from.x + direction.x as i32 * distance, from.y + direction.y as i32 * distance);
+        Job { shape: Shape::Line { to }, feed: Feed::MmPerMin(JOG_FEED_MM_PER_MIN) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_diagonal_jog_stays_at_45_degrees_and_inside_the_travel() {
+        let s = Settings::default(); // ±200 mm at 100 steps/mm
+        let job = Job::jog(Step::new(1, -1), Point::new(19_000, 5_000), &s);
+        assert_eq!(job.shape, Shape::Line { to: Point::new(20_000, 4_000) });
+        let job = Job::jog(Step::XN, Point::new(19_000, 5_000), &s);
+        assert_eq!(job.shape, Shape::Line { to: Point::new(-20_000, 5_000) });
+    }
 }

@@ -78,9 +78,7 @@ impl Key {
 
     /// Where the key sits in the matrix; `None` for a digit above 9.
     pub fn row_col(self) -> Option<(usize, usize)> {
-        (0..KEYPAD_ROWS)
-            .flat_map(|r| (0..KEYPAD_COLS).map(move |c| (r, c)))
-            .find(|&(r, c)| KEY_MAP[r][c] == self)
+        (0..KEYPAD_ROWS).flat_map(|r| (0..KEYPAD_COLS).map(move |c| (r, c))).find(|&(r, c)| KEY_MAP[r][c] == self)
     }
 
     /// The key's bit in a raw scan.
@@ -228,9 +226,9 @@ impl KeypadDecoder {
 
 /// The keys whose bits are set in `bits`, in matrix order.
 fn keys_in(bits: u16) -> impl Iterator<Item = (u16, Key)> {
-    (0..KEYPAD_ROWS * KEYPAD_COLS).filter(move |i| bits & (1 << i) != 0).filter_map(|i| {
-        Key::from_row_col(i / KEYPAD_COLS, i % KEYPAD_COLS).map(|k| (1u16 << i, k))
-    })
+    (0..KEYPAD_ROWS * KEYPAD_COLS)
+        .filter(move |i| bits & (1 << i) != 0)
+        .filter_map(|i| Key::from_row_col(i / KEYPAD_COLS, i % KEYPAD_COLS).map(|k| (1u16 << i, k)))
 }
 
 fn push(events: &mut KeyEvents, event: KeyEvent) {
@@ -287,7 +285,10 @@ mod tests {
         hold(&mut d, &mut now, 0, 100, &mut ev);
         assert_eq!(
             ev,
-            [(20 + KEYPAD_DEBOUNCE_MS, KeyEvent::Press(Key::Digit(5))), (120 + KEYPAD_DEBOUNCE_MS, KeyEvent::Release(Key::Digit(5)))]
+            [
+                (20 + KEYPAD_DEBOUNCE_MS, KeyEvent::Press(Key::Digit(5))),
+                (120 + KEYPAD_DEBOUNCE_MS, KeyEvent::Release(Key::Digit(5)))
+            ]
         );
         assert_eq!(d.held(), 0);
     }
@@ -404,7 +405,8 @@ mod tests {
         let (mut d, mut now, mut ev) = (KeypadDecoder::new(), 0, Vec::new());
         hold(&mut d, &mut now, a, 300, &mut ev);
         hold(&mut d, &mut now, a | b, 600, &mut ev);
-        let repeats: Vec<KeyEvent> = events_only(&ev).into_iter().filter(|e| matches!(e, KeyEvent::Repeat(_))).collect();
+        let repeats: Vec<KeyEvent> =
+            events_only(&ev).into_iter().filter(|e| matches!(e, KeyEvent::Repeat(_))).collect();
         assert_eq!(repeats, [KeyEvent::Repeat(Key::B)], "B repeats once (at 815 ms), A no more");
         ev.clear();
         // A stays down but B's release ends all repeating.

@@ -1,15 +1,31 @@
 //! servoplot: the portable core of a two-axis servo pen plotter.
 //!
 //! Everything that decides lives here and is `no_std`, free of any HAL, and unit-tested on the
-//! host: geometry, interpolators, settings and jobs. The async loops in [`tasks`] only wait and
-//! move values between the core and the pins; boards (in the firmware binary) wire them up.
+//! host: geometry, interpolators, the expression language, the speed planner, the serial
+//! protocol, keypad decoding, the menu and its screen, settings and machine state. The async
+//! loops in [`tasks`] only wait and move values between the core and the pins. The STM32 board
+//! lives in the firmware binary; the simulated board ([`sim`], host only) lives here so tests
+//! and benchmarks can drive it.
 #![no_std]
+
+#[cfg(not(target_os = "none"))]
+extern crate std;
 
 #[macro_use]
 mod fmt;
 
+pub mod expr;
 pub mod geom;
 pub mod interp;
 pub mod job;
+pub mod keypad;
+pub mod machine;
+pub mod planner;
+pub mod protocol;
 pub mod settings;
 pub mod status;
+pub mod tasks;
+pub mod ui;
+
+#[cfg(not(target_os = "none"))]
+pub mod sim;

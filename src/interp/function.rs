@@ -62,9 +62,10 @@ pub enum CurveSetupError {
 impl From<EvalError> for CurveError {
     fn from(e: EvalError) -> Self {
         match e {
-            EvalError::SqrtOfNegative | EvalError::LogOfNonPositive | EvalError::ArcOutOfRange | EvalError::PowerOfNegative => {
-                CurveError::Domain
-            }
+            EvalError::SqrtOfNegative
+            | EvalError::LogOfNonPositive
+            | EvalError::ArcOutOfRange
+            | EvalError::PowerOfNegative => CurveError::Domain,
             EvalError::TanPole | EvalError::DivisionByZero => CurveError::DivisionByZero,
             EvalError::Overflow => CurveError::Overflow,
         }
@@ -252,7 +253,8 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
         let step = if self.method == Method::Classic && sx != 0 && sy != 0 {
             // Through the corner nearer to the chord.
             let x_first = self.chord_distance2(self.col + 1, self.y) <= self.chord_distance2(self.col, self.y + dy);
-            let (first, second) = if x_first { (Step::new(sx, 0), Step::new(0, sy)) } else { (Step::new(0, sy), Step::new(sx, 0)) };
+            let (first, second) =
+                if x_first { (Step::new(sx, 0), Step::new(0, sy)) } else { (Step::new(0, sy), Step::new(sx, 0)) };
             self.pending = Some(second);
             first
         } else {
@@ -484,12 +486,7 @@ mod tests {
     /// Curve values at columns 0..=n: a random walk mixing flat, steep and exactly-half rises,
     /// from an arbitrary origin.
     fn sampled_curve() -> impl Strategy<Value = Vec<f64>> {
-        let rise = prop_oneof![
-            -1.2f64..1.2,
-            -60.0f64..60.0,
-            (-40i32..40).prop_map(|k| k as f64 + 0.5),
-            Just(0.0),
-        ];
+        let rise = prop_oneof![-1.2f64..1.2, -60.0f64..60.0, (-40i32..40).prop_map(|k| k as f64 + 0.5), Just(0.0),];
         (proptest::collection::vec(rise, 0..80), -5_000.0f64..5_000.0).prop_map(|(rises, origin)| {
             let mut g = Vec::from([origin]);
             for r in rises {
@@ -605,10 +602,16 @@ mod tests {
             assert_eq!((w.end, w.last()), (Err(CurveError::Overflow), Point::new(1, 10)));
             let f = |_| Ok(0.0);
             assert_eq!(ExplicitCurve::new(f, 10, -1, method).err(), Some(CurveSetupError::BadParameter));
-            assert_eq!(ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, method).err(), Some(CurveSetupError::OutOfRange));
+            assert_eq!(
+                ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, method).err(),
+                Some(CurveSetupError::OutOfRange)
+            );
             assert_eq!(ExplicitCurve::new(f, i32::MIN, 0, method).err(), Some(CurveSetupError::OutOfRange));
             let nan = |_| Ok(f64::NAN);
-            assert_eq!(ExplicitCurve::new(nan, 10, 0, method).err(), Some(CurveSetupError::Start(CurveError::Overflow)));
+            assert_eq!(
+                ExplicitCurve::new(nan, 10, 0, method).err(),
+                Some(CurveSetupError::Start(CurveError::Overflow))
+            );
         }
     }
 
@@ -616,7 +619,15 @@ mod tests {
 
     /// Runs `src` over [x0, x1] mm at `spm` steps/mm; returns the walk and the ideal values
     /// (steps, relative) at its columns computed by `f`.
-    fn draw(src: &str, x0: f64, x1: f64, spm: f64, max_jump: i32, method: Method, f: impl Fn(f64) -> f64) -> (Walk, Vec<f64>, i32) {
+    fn draw(
+        src: &str,
+        x0: f64,
+        x1: f64,
+        spm: f64,
+        max_jump: i32,
+        method: Method,
+        f: impl Fn(f64) -> f64,
+    ) -> (Walk, Vec<f64>, i32) {
         let mut interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], max_jump, method).unwrap();
         let n = ((x1 - x0) * spm).round() as i32;
         let dir = if n < 0 { -1 } else { 1 };
@@ -697,7 +708,8 @@ mod tests {
         for method in METHODS {
             // tan(x) on [1, 2] mm at 100 steps/mm: x = 1.57 gives 1255.8 mm, x = 1.58 gives
             // -108.6 mm; a 1000-step jump limit stops it before the pole.
-            let mut interp = FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, method).unwrap();
+            let mut interp =
+                FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, method).unwrap();
             let w = walk(&mut interp, method, 1_000_000);
             assert_eq!(w.end, Err(CurveError::Jump));
             let last = w.last();
@@ -707,10 +719,19 @@ mod tests {
             assert!((last.y as f64 - ideal).abs() <= 0.5 + FLOAT_SLACK_STEPS);
             // Without a jump limit a pole between two columns goes unseen: over [0, π] at one
             // step/mm the columns are 0, π/3, 2π/3 and π, drawn as their polyline. Hence the limit.
-            let mut interp = FunctionInterp::new(parse("tan(x)").unwrap(), 0.0, core::f64::consts::PI, [1.0, 1.0], i32::MAX, method).unwrap();
+            let mut interp =
+                FunctionInterp::new(parse("tan(x)").unwrap(), 0.0, core::f64::consts::PI, [1.0, 1.0], i32::MAX, method)
+                    .unwrap();
             assert_eq!(walk(&mut interp, method, 100_000).end, Ok(()));
             // Started exactly at π/2, the pole is an error and nothing moves.
-            let at_pole = FunctionInterp::new(parse("tan(x)").unwrap(), core::f64::consts::FRAC_PI_2, 3.0, [1.0, 1.0], 10, method);
+            let at_pole = FunctionInterp::new(
+                parse("tan(x)").unwrap(),
+                core::f64::consts::FRAC_PI_2,
+                3.0,
+                [1.0, 1.0],
+                10,
+                method,
+            );
             assert_eq!(at_pole.err(), Some(CurveSetupError::Start(CurveError::DivisionByZero)));
         }
     }
@@ -720,7 +741,8 @@ mod tests {
         for method in METHODS {
             // sqrt(-1-x) is defined for x <= -1: from x = -3 mm it climbs down to x = -1 mm
             // (column 20 at 10 steps/mm) and fails at the next column.
-            let mut interp = FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, method).unwrap();
+            let mut interp =
+                FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, method).unwrap();
             let w = walk(&mut interp, method, 10_000);
             assert_eq!(w.end, Err(CurveError::Domain));
             assert_eq!(w.last(), Point::new(20, (-libm::sqrt(2.0) * 10.0).round() as i32));
@@ -747,7 +769,8 @@ mod tests {
     #[test]
     fn steps_per_mm_differ_per_axis() {
         // y = x/2 on [0, 10] mm at 40 X steps/mm and 100 Y steps/mm: 400 columns, 500 rows.
-        let mut interp = FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, Method::Diagonal).unwrap();
+        let mut interp =
+            FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, Method::Diagonal).unwrap();
         let w = walk(&mut interp, Method::Diagonal, 10_000);
         assert_eq!(w.last(), Point::new(400, 500));
         assert_eq!(w.steps(), 500);
@@ -775,7 +798,9 @@ mod tests {
     #[test]
     fn bad_parameters_are_refused_and_an_empty_range_takes_no_step() {
         let e = parse("x").unwrap();
-        let new = |x0: f64, x1: f64, spm: [f64; 2], jump: i32| FunctionInterp::new(e.clone(), x0, x1, spm, jump, Method::Diagonal).err();
+        let new = |x0: f64, x1: f64, spm: [f64; 2], jump: i32| {
+            FunctionInterp::new(e.clone(), x0, x1, spm, jump, Method::Diagonal).err()
+        };
         assert_eq!(new(f64::NAN, 1.0, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(0.0, f64::INFINITY, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(0.0, 1.0, [0.0, 10.0], 10), Some(CurveSetupError::BadParameter));

@@ -142,7 +142,8 @@ mod tests {
 
     #[test]
     fn classic_reaches_every_quadrant_with_dx_plus_dy_steps() {
-        for (dx, dy) in [(7, 3), (-7, 3), (-7, -3), (7, -3), (3, 7), (-3, -7), (0, 5), (0, -5), (5, 0), (-5, 0), (4, 4)] {
+        for (dx, dy) in [(7, 3), (-7, 3), (-7, -3), (7, -3), (3, 7), (-3, -7), (0, 5), (0, -5), (5, 0), (-5, 0), (4, 4)]
+        {
             let path = walk(dx, dy, Method::Classic);
             assert_eq!(*path.last().unwrap(), Point::new(dx, dy));
             assert_eq!(path.len() - 1, (dx.abs() + dy.abs()) as usize, "steps for ({dx}, {dy})");
@@ -166,7 +167,9 @@ mod tests {
 
     #[test]
     fn diagonal_takes_the_major_axis_count_and_stays_within_half_a_step() {
-        for (dx, dy) in [(7, 3), (-7, 3), (-7, -3), (7, -3), (3, 7), (-3, -7), (0, 5), (5, 0), (4, 4), (-4, 4), (1000, 999)] {
+        for (dx, dy) in
+            [(7, 3), (-7, 3), (-7, -3), (7, -3), (3, 7), (-3, -7), (0, 5), (5, 0), (4, 4), (-4, 4), (1000, 999)]
+        {
             let path = walk(dx, dy, Method::Diagonal);
             assert_eq!(*path.last().unwrap(), Point::new(dx, dy));
             assert_eq!(path.len() - 1, dx.abs().max(dy.abs()) as usize);

@@ -5,11 +5,17 @@
 //! comparison (error <= 1 step), and `diagonal`, which may move both axes at once (error <= 0.5
 //! step, fewer steps). Interpolators never read a clock and never allocate.
 
+pub mod function;
 pub mod line;
+pub mod sine;
 
+pub use function::{CurveSetupError, FunctionInterp};
 pub use line::LineInterp;
+pub use sine::SineInterp;
 
-use crate::geom::Step;
+use crate::geom::{Point, Step};
+use crate::job::{Job, Shape};
+use crate::settings::Settings;
 
 /// How an interpolator chooses its steps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -48,11 +54,7 @@ impl Tangent {
     /// The unit vector along `(x, y)`; `(1, 0)` for a zero vector.
     pub fn along(x: f32, y: f32) -> Self {
         let len = libm::sqrtf(x * x + y * y);
-        if len > 0.0 && len.is_finite() {
-            Tangent { x: x / len, y: y / len }
-        } else {
-            Tangent { x: 1.0, y: 0.0 }
-        }
+        if len > 0.0 && len.is_finite() { Tangent { x: x / len, y: y / len } } else { Tangent { x: 1.0, y: 0.0 } }
     }
 }
 
@@ -64,4 +66,87 @@ pub trait Interpolator {
 
     /// The unit tangent of the ideal curve at the current point, in the direction of travel.
     fn tangent(&self) -> Tangent;
+}
+
+/// Any curve the machine draws, starting at a known point: what the planner queues.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    kind: CurveKind,
+    end: Point,
+}
+
+#[derive(Clone, Debug)]
+enum CurveKind {
+    Line(LineInterp),
+    Sine(SineInterp),
+    Function(FunctionInterp),
+}
+
+impl Curve {
+    /// The curve a job draws when the pen starts at `start`. A job that cannot be drawn from
+    /// there (a bad parameter, a function undefined at its first point) is an error and nothing
+    /// moves.
+    pub fn for_job(job: &Job, start: Point, settings: &Settings) -> Result<Curve, CurveSetupError> {
+        let method = settings.method;
+        let spm = settings.steps_per_mm.map(f64::from);
+        Ok(match &job.shape {
+            Shape::Line { to } => {
+                let d = to.offset_from(start);
+                Curve { kind: CurveKind::Line(LineInterp::new(d.x, d.y, method)), end: *to }
+            }
+            Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps } => {
+                let sine = SineInterp::new(
+                    f64::from(*amplitude_steps),
+                    f64::from(*omega_rad_per_step),
+                    f64::from(*phase_rad),
+                    *length_steps,
+                    method,
+                )?;
+                let d = sine.end();
+                Curve { kind: CurveKind::Sine(sine), end: Point::new(start.x + d.x, start.y + d.y) }
+            }
+            Shape::Function { expr, x0_mm, x1_mm } => {
+                // At least one row between columns, or any slope at all would be a "jump".
+                let max_jump_steps = (settings.max_jump_mm * settings.steps_per_mm[1]).max(1.0) as i32;
+                let f = FunctionInterp::new(
+                    expr.clone(),
+                    f64::from(*x0_mm),
+                    f64::from(*x1_mm),
+                    spm,
+                    max_jump_steps,
+                    method,
+                )?;
+                // The end is where the curve really stops, found by drawing it once on paper
+                // that does not exist: an error part way makes the job end there.
+                let mut probe = f.clone();
+                while let Ok(Some(_)) = probe.next_step() {}
+                let d = probe.position();
+                Curve { kind: CurveKind::Function(f), end: Point::new(start.x + d.x, start.y + d.y) }
+            }
+            Shape::Arc { .. } | Shape::Ellipse { .. } => return Err(CurveSetupError::BadParameter),
+        })
+    }
+
+    /// Where the pen is once the whole curve is drawn.
+    pub fn end(&self) -> Point {
+        self.end
+    }
+}
+
+impl Interpolator for Curve {
+    fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
+        match &mut self.kind {
+            CurveKind::Line(c) => c.next_step(),
+            CurveKind::Sine(c) => c.next_step(),
+            CurveKind::Function(c) => c.next_step(),
+        }
+    }
+
+    fn tangent(&self) -> Tangent {
+        match &self.kind {
+            CurveKind::Line(c) => c.tangent(),
+            CurveKind::Sine(c) => c.tangent(),
+            CurveKind::Function(c) => c.tangent(),
+        }
+    }
 }

@@ -57,13 +57,18 @@ impl SineInterp {
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let span_rad = omega_rad_per_step * f64::from(length_steps);
-        if !(amplitude_steps.is_finite() && omega_rad_per_step.is_finite() && phase_rad.is_finite() && span_rad.is_finite()) {
+        if !(amplitude_steps.is_finite()
+            && omega_rad_per_step.is_finite()
+            && phase_rad.is_finite()
+            && span_rad.is_finite())
+        {
             return Err(CurveSetupError::BadParameter);
         }
         if libm::fabs(amplitude_steps) > MAX_SINE_AMPLITUDE_STEPS {
             return Err(CurveSetupError::OutOfRange);
         }
-        let f = SineFn { amplitude_steps, omega_rad_per_step, phase_rad, dir: if length_steps < 0 { -1.0 } else { 1.0 } };
+        let f =
+            SineFn { amplitude_steps, omega_rad_per_step, phase_rad, dir: if length_steps < 0 { -1.0 } else { 1.0 } };
         let end = Point::new(length_steps, nearest_step(f.at(f64::from(length_steps)) - f.at(0.0)));
         // Continuous: no jump limit.
         let curve = ExplicitCurve::new(f, length_steps, i32::MAX, method)?;
@@ -129,7 +134,12 @@ mod tests {
             prop_assert_eq!(w.end, Ok(()));
             prop_assert_eq!(w.last(), end);
             prop_assert_eq!(end.x, length);
-            prop_assert!((end.y as f64 - h[n as usize]).abs() <= 0.5 + FLOAT_SLACK_STEPS, "{:?} vs {}", end, h[n as usize]);
+            prop_assert!(
+                (end.y as f64 - h[n as usize]).abs() <= 0.5 + FLOAT_SLACK_STEPS,
+                "{:?} vs {}",
+                end,
+                h[n as usize]
+            );
             prop_assert_eq!(w.steps(), expected_steps as usize);
             let dev = max_deviation(&w.path, dir, &h);
             prop_assert!(dev <= max_deviation_for(method) + FLOAT_SLACK_STEPS, "{:?} deviates {}", method, dev);

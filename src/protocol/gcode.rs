@@ -70,7 +70,6 @@ use core::f32::consts::{FRAC_PI_2, PI, TAU};
 
 use super::GrblError;
 use super::line::LINE_MAX_BYTES;
-use crate::expr::Expr;
 use crate::geom::{Axis, Point, Rotation};
 use crate::job::{Feed, Job, Shape};
 use crate::settings::{SettingError, Settings};
@@ -215,38 +214,16 @@ pub enum Report {
     BuildInfo,
 }
 
-/// A curve, in steps, that starts where the pen is when it begins (the planned position when it
-/// was parsed). Each variant is meant to become the `crate::job::Shape` variant of the same name
-/// and fields; [`Command::Curve`] also carries the end point the parser planned.
-// No heap: a function curve carries its parsed expression by value.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug, PartialEq)]
-pub enum CurveShape {
-    /// Circular arc around `center` from the pen to `to` in `rotation`; `to` equal to the start
-    /// is a full circle. Made only when both axes have the same steps/mm.
-    Arc { center: Point, to: Point, rotation: Rotation },
-    /// Axis-aligned elliptic arc around `center` with semi-axes `a_steps` (X) and `b_steps` (Y),
-    /// from the pen to `to` in `rotation`; `to` equal to the start is the full ellipse. Also made
-    /// for circles when the axes' steps/mm differ (a circle is then an ellipse in steps).
-    Ellipse { center: Point, a_steps: i32, b_steps: i32, to: Point, rotation: Rotation },
-    /// Sine from the pen (xs, ys): for u from 0 to `length_steps` (negative: towards -X), the
-    /// point (xs + u, ys + round(amplitude_steps·(sin(omega_rad_per_step·u + phase_rad) − sin phase_rad))).
-    Sine { amplitude_steps: f32, omega_rad_per_step: f32, phase_rad: f32, length_steps: i32 },
-    /// y = f(x) in millimetres for x from `x0_mm` to `x1_mm`, moved so that (x0, f(x0)) is the
-    /// pen (xs, ys): with n = round((x1 − x0)·(X steps/mm)), for u from 0 to n (negative: towards
-    /// −X) and x = x0 + u / (X steps/mm), the point (xs + u, ys + round((f(x) − f(x0))·(Y steps/mm))).
-    Function { expr: Expr, x0_mm: f32, x1_mm: f32 },
-}
-
 /// What one line asks the machine to do.
-#[allow(clippy::large_enum_variant)] // see `CurveShape`
+// A function curve carries its parsed expression by value (no heap).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// A straight move (G0, G1): a `Shape::Line` job.
     Job(Job),
     /// A curve (G2/G3, `$E`, `$O`, `$S`, `$F`) at a feed rate; it ends at `end`, where the parser
     /// planned it (the interpolator must end there too).
-    Curve { shape: CurveShape, feed: Feed, end: Point },
+    Curve { shape: Shape, feed: Feed, end: Point },
     /// A `$J=` jog: a straight line; a jog cancel (0x85) aborts it, then
     /// [`GcodeState::sync_position`].
     Jog(Job),
@@ -653,9 +630,9 @@ impl GcodeState {
         let center = to_steps(settings, c.center);
         let rotation = if c.sweep_rad > 0.0 { Rotation::CounterClockwise } else { Rotation::Clockwise };
         let shape = if c.semi_axes_mm[0] == c.semi_axes_mm[1] && spm[0] == spm[1] {
-            CurveShape::Arc { center, to, rotation }
+            Shape::Arc { center, to, rotation }
         } else {
-            CurveShape::Ellipse { center, a_steps: semi[0] as i32, b_steps: semi[1] as i32, to, rotation }
+            Shape::Ellipse { center, a_steps: semi[0] as i32, b_steps: semi[1] as i32, to, rotation }
         };
         self.position_mm = c.end;
         self.position = to;
@@ -884,7 +861,7 @@ impl GcodeState {
         self.conic(Conic { center, semi_axes_mm, start_rad: t0, sweep_rad: sweep, end }, feed, settings)
     }
 
-    /// `$S`: see [`CurveShape::Sine`].
+    /// `$S`: see [`Shape::Sine`].
     fn sine(
         &mut self,
         amplitude_mm: f32,
@@ -914,7 +891,7 @@ impl GcodeState {
         // Both are within the travel checked above (±500 mm at 200 steps/mm at most).
         let to = Point::new(self.position.x + dx as i32, self.position.y + dy as i32);
         self.land_on(to, settings);
-        let shape = CurveShape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps: dx as i32 };
+        let shape = Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps: dx as i32 };
         Ok(Some(Command::Curve { shape, feed, end: to }))
     }
 
@@ -973,7 +950,7 @@ impl GcodeState {
         let dy = libm::round((y_end - y0) * spm[1] as f64);
         let to = Point::new(self.position.x + dx as i32, self.position.y + dy as i32);
         self.land_on(to, settings);
-        let shape = CurveShape::Function { expr, x0_mm, x1_mm };
+        let shape = Shape::Function { expr, x0_mm, x1_mm };
         Ok(Commands::one(Command::Curve { shape, feed, end: to }))
     }
 

@@ -63,7 +63,7 @@ pub mod gcode;
 pub mod line;
 pub mod report;
 
-pub use gcode::{Command, Commands, CurveShape, GcodeState, Report};
+pub use gcode::{Command, Commands, GcodeState, Report};
 pub use line::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
 
 /// Why a line was refused; [`GrblError::code`] is the number sent as `error:N`.

@@ -17,8 +17,10 @@
 
 use core::f32::consts::{FRAC_PI_2, PI, TAU};
 
-use crate::geom::{Point, Rotation};
-use crate::job::Feed;
+use crate::expr::ParseError;
+use crate::geom::{Axis, Point, Rotation};
+use crate::job::{Feed, Job, Shape};
+use crate::settings::Settings;
 
 /// The box a curve covers, relative to its start point, in millimetres.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,7 +58,12 @@ pub struct CircleParams {
 impl CircleParams {
     /// The same arc as an ellipse with equal axes.
     pub const fn as_ellipse(&self) -> EllipseParams {
-        EllipseParams { a_mm: self.radius_mm, b_mm: self.radius_mm, start_deg: self.start_deg, sweep_deg: self.sweep_deg }
+        EllipseParams {
+            a_mm: self.radius_mm,
+            b_mm: self.radius_mm,
+            start_deg: self.start_deg,
+            sweep_deg: self.sweep_deg,
+        }
     }
 }
 
@@ -173,8 +180,13 @@ pub enum FunctionPreset {
 
 impl FunctionPreset {
     /// Every preset, in the order the keypad numbers them (1-based).
-    pub const ALL: [FunctionPreset; 5] =
-        [FunctionPreset::Parabola, FunctionPreset::Wave, FunctionPreset::Root, FunctionPreset::Cubic, FunctionPreset::Bell];
+    pub const ALL: [FunctionPreset; 5] = [
+        FunctionPreset::Parabola,
+        FunctionPreset::Wave,
+        FunctionPreset::Root,
+        FunctionPreset::Cubic,
+        FunctionPreset::Bell,
+    ];
 
     /// The expression, in the host link's expression language.
     pub const fn expression(self) -> &'static str {
@@ -243,7 +255,12 @@ impl FunctionParams {
         let (lo, hi) = (self.x0_mm.min(self.x1_mm), self.x0_mm.max(self.x1_mm));
         let (y_min, y_max) = self.preset.range(lo, hi)?;
         let y0 = self.preset.eval(self.x0_mm)?;
-        Some(Extent { x_min_mm: lo - self.x0_mm, x_max_mm: hi - self.x0_mm, y_min_mm: y_min - y0, y_max_mm: y_max - y0 })
+        Some(Extent {
+            x_min_mm: lo - self.x0_mm,
+            x_max_mm: hi - self.x0_mm,
+            y_min_mm: y_min - y0,
+            y_max_mm: y_max - y0,
+        })
     }
 }
 
@@ -277,6 +294,41 @@ pub struct CurveJob {
     pub start: Point,
     pub curve: CurveParams,
     pub feed: Feed,
+}
+
+impl CurveJob {
+    /// The job in machine units (steps). A circle becomes an `Arc` when both axes have the same
+    /// steps/mm and an `Ellipse` in steps otherwise, as the host link's commands do.
+    pub fn to_job(&self, settings: &Settings) -> Result<Job, ParseError> {
+        let at = |(x, y): (f32, f32)| {
+            Point::new(self.start.x + settings.mm_to_steps(Axis::X, x), self.start.y + settings.mm_to_steps(Axis::Y, y))
+        };
+        let elliptic = |e: &EllipseParams| {
+            let center = at(e.center_offset_mm());
+            let to = if e.is_full() { self.start } else { at(e.end_offset_mm()) };
+            let (a_steps, b_steps) = (settings.mm_to_steps(Axis::X, e.a_mm), settings.mm_to_steps(Axis::Y, e.b_mm));
+            let rotation = e.rotation();
+            if a_steps == b_steps {
+                Shape::Arc { center, to, rotation }
+            } else {
+                Shape::Ellipse { center, a_steps, b_steps, to, rotation }
+            }
+        };
+        let shape = match &self.curve {
+            CurveParams::Circle(c) => elliptic(&c.as_ellipse()),
+            CurveParams::Ellipse(e) => elliptic(e),
+            CurveParams::Sine(s) => Shape::Sine {
+                amplitude_steps: s.amplitude_mm * settings.steps_per_mm(Axis::Y),
+                omega_rad_per_step: s.omega_rad_per_mm() / settings.steps_per_mm(Axis::X),
+                phase_rad: s.phase_deg.to_radians(),
+                length_steps: settings.mm_to_steps(Axis::X, s.length_mm),
+            },
+            CurveParams::Function(f) => {
+                Shape::Function { expr: crate::expr::parse(f.preset.expression())?, x0_mm: f.x0_mm, x1_mm: f.x1_mm }
+            }
+        };
+        Ok(Job { shape, feed: self.feed })
+    }
 }
 
 /// sin and cos of an angle in degrees, exact at multiples of 90.

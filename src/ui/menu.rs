@@ -29,7 +29,9 @@ use crate::job::{Control, Feed, Job, Shape};
 use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::ui::curves::{CircleParams, CurveJob, CurveParams, EllipseParams, Extent, FunctionParams, FunctionPreset, SineParams};
+use crate::ui::curves::{
+    CircleParams, CurveJob, CurveParams, EllipseParams, Extent, FunctionParams, FunctionPreset, SineParams,
+};
 use crate::ui::entry::{EntryError, NumberEntry};
 
 /// Line: offset of the end point from the pen, per axis.
@@ -56,17 +58,17 @@ pub const FUNCTION_X_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
 /// Most fields one form has.
 pub const FORM_MAX_FIELDS: usize = 4;
 
-/// The eight jog keys, around `5` as on a numeric keypad: `8` is +Y, `2` −Y, `4` −X, `6` +X,
-/// and `7`, `9`, `1`, `3` the diagonals.
+/// The eight jog keys, around `5` as they sit on the keypad (`2` is above `5`): `2` is +Y, `8`
+/// −Y, `4` −X, `6` +X, and `1`, `3`, `7`, `9` the diagonals.
 pub const JOG_KEYS: [(u8, Step); 8] = [
-    (8, Step::YP),
-    (2, Step::YN),
+    (2, Step::YP),
+    (8, Step::YN),
     (4, Step::XN),
     (6, Step::XP),
-    (7, Step::new(-1, 1)),
-    (9, Step::new(1, 1)),
-    (1, Step::new(-1, -1)),
-    (3, Step::new(1, -1)),
+    (1, Step::new(-1, 1)),
+    (3, Step::new(1, 1)),
+    (7, Step::new(-1, -1)),
+    (9, Step::new(1, -1)),
 ];
 
 /// The jog direction of a key; `None` for keys that do not jog.
@@ -108,7 +110,8 @@ pub enum Mode {
 
 impl Mode {
     /// Every mode, in menu order: `1` picks the first.
-    pub const ALL: [Mode; 7] = [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings];
+    pub const ALL: [Mode; 7] =
+        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings];
 
     /// Screen title.
     pub const fn title(self) -> &'static str {
@@ -253,7 +256,11 @@ pub enum UiError {
     Entry(EntryError),
     /// `#` on an empty field that has no default.
     Empty,
-    OutOfRange { min: f32, max: f32, unit: Unit },
+    OutOfRange {
+        min: f32,
+        max: f32,
+        unit: Unit,
+    },
     /// Zero where the field needs a length.
     Zero,
     /// A function's x1 equals its x0.
@@ -287,7 +294,12 @@ pub struct Form {
 
 impl Form {
     fn new(mode: Mode) -> Self {
-        Form { mode, field: 0, entries: [const { NumberEntry::new() }; FORM_MAX_FIELDS], preset: FunctionPreset::Parabola }
+        Form {
+            mode,
+            field: 0,
+            entries: [const { NumberEntry::new() }; FORM_MAX_FIELDS],
+            preset: FunctionPreset::Parabola,
+        }
     }
 
     pub fn mode(&self) -> Mode {
@@ -375,9 +387,11 @@ impl Form {
     /// The typed curve (every mode but line).
     pub fn curve(&self) -> Result<CurveParams, UiError> {
         Ok(match self.mode {
-            Mode::Circle => {
-                CurveParams::Circle(CircleParams { radius_mm: self.number(0)?, start_deg: self.number(1)?, sweep_deg: self.sweep(2)? })
-            }
+            Mode::Circle => CurveParams::Circle(CircleParams {
+                radius_mm: self.number(0)?,
+                start_deg: self.number(1)?,
+                sweep_deg: self.sweep(2)?,
+            }),
             Mode::Ellipse => CurveParams::Ellipse(EllipseParams {
                 a_mm: self.number(0)?,
                 b_mm: self.number(1)?,
@@ -461,7 +475,9 @@ pub enum Screen {
     Jog,
     Form(Form),
     /// Read-only list of the main settings, scrolled to `first_line`.
-    Settings { first_line: usize },
+    Settings {
+        first_line: usize,
+    },
 }
 
 /// The keypad menu; see the module documentation.
@@ -505,9 +521,10 @@ impl Menu {
         self.jog
     }
 
-    /// Shows that a job could not be queued (the caller found the job queue full).
-    pub fn refuse_busy(&mut self) {
-        self.message = Some(UiError::Busy);
+    /// Shows why the job just confirmed could not start (the job queue was full, the curve
+    /// could not be built).
+    pub fn refuse(&mut self, why: UiError) {
+        self.message = Some(why);
     }
 
     /// True while the machine's motion takes the keypad: only `C` and `D` act. A jog counts
@@ -581,7 +598,8 @@ impl Menu {
                 Ok(MenuAction::None)
             }
             Screen::Settings { first_line } => {
-                let last = crate::ui::screen::SETTINGS_VIEW_LINES.saturating_sub(crate::ui::screen::SETTINGS_VISIBLE_LINES);
+                let last =
+                    crate::ui::screen::SETTINGS_VIEW_LINES.saturating_sub(crate::ui::screen::SETTINGS_VISIBLE_LINES);
                 match key {
                     Key::A => *first_line = first_line.saturating_sub(1),
                     Key::B => *first_line = (*first_line + 1).min(last),
@@ -790,13 +808,15 @@ mod tests {
         type_keys(&mut m, "1", &idle());
         assert_eq!(*m.screen(), Screen::Jog);
         let jogging = Status { state: RunState::Jog, ..Status::default() };
-        for (k, step) in [(8, Step::YP), (2, Step::YN), (4, Step::XN), (6, Step::XP), (9, Step::new(1, 1)), (1, Step::new(-1, -1))] {
+        for (k, step) in
+            [(2, Step::YP), (8, Step::YN), (4, Step::XN), (6, Step::XP), (3, Step::new(1, 1)), (7, Step::new(-1, -1))]
+        {
             assert_eq!(m.handle(KeyEvent::Press(Key::Digit(k)), &idle(), &s), MenuAction::JogStart(step));
             assert_eq!(m.handle(KeyEvent::Release(Key::Digit(k)), &jogging, &s), MenuAction::JogStop);
         }
         assert_eq!(m.handle(KeyEvent::Press(Key::Digit(5)), &idle(), &s), MenuAction::None);
         // Releasing a key other than the jogging one does not stop it.
-        assert_eq!(m.handle(KeyEvent::Press(Key::Digit(7)), &idle(), &s), MenuAction::JogStart(Step::new(-1, 1)));
+        assert_eq!(m.handle(KeyEvent::Press(Key::Digit(1)), &idle(), &s), MenuAction::JogStart(Step::new(-1, 1)));
         assert_eq!(m.handle(KeyEvent::Release(Key::Digit(5)), &jogging, &s), MenuAction::None);
         // D while the key is held stops the jog; the late release then does nothing.
         assert_eq!(m.handle(KeyEvent::Press(Key::D), &jogging, &s), MenuAction::JogStop);
@@ -842,12 +862,18 @@ mod tests {
         let status = Status { position: Point::new(1000, 0), ..Status::default() };
         let actions = type_keys(&mut m, "3 10# # #", &status);
         assert_eq!(actions.len(), 1);
-        assert_eq!(curve(&actions[0]), CurveParams::Circle(CircleParams { radius_mm: 10.0, start_deg: 0.0, sweep_deg: 360.0 }));
+        assert_eq!(
+            curve(&actions[0]),
+            CurveParams::Circle(CircleParams { radius_mm: 10.0, start_deg: 0.0, sweep_deg: 360.0 })
+        );
         let MenuAction::StartCurve(job) = &actions[0] else { unreachable!() };
         assert_eq!(job.start, Point::new(1000, 0));
         // A half turn clockwise from the top.
         let actions = type_keys(&mut m, "3# 90# A180#", &status);
-        assert_eq!(curve(&actions[0]), CurveParams::Circle(CircleParams { radius_mm: 3.0, start_deg: 90.0, sweep_deg: -180.0 }));
+        assert_eq!(
+            curve(&actions[0]),
+            CurveParams::Circle(CircleParams { radius_mm: 3.0, start_deg: 90.0, sweep_deg: -180.0 })
+        );
         // Radius 0 is refused; a circle leaving the travel area too.
         assert_eq!(type_keys(&mut m, "0#", &status), []);
         assert_eq!(m.message(), Some(UiError::OutOfRange { min: 0.1, max: 500.0, unit: Unit::Mm }));
@@ -859,7 +885,10 @@ mod tests {
     fn ellipse_and_sine_forms() {
         let mut m = Menu::new();
         let a = type_keys(&mut m, "4 20# 10# 45# 90#", &idle());
-        assert_eq!(curve(&a[0]), CurveParams::Ellipse(EllipseParams { a_mm: 20.0, b_mm: 10.0, start_deg: 45.0, sweep_deg: 90.0 }));
+        assert_eq!(
+            curve(&a[0]),
+            CurveParams::Ellipse(EllipseParams { a_mm: 20.0, b_mm: 10.0, start_deg: 45.0, sweep_deg: 90.0 })
+        );
         type_keys(&mut m, "D", &idle());
         let a = type_keys(&mut m, "5 A5# 20# # 40#", &idle());
         assert_eq!(
@@ -874,11 +903,17 @@ mod tests {
     fn function_presets_and_their_domains() {
         let mut m = Menu::new();
         let a = type_keys(&mut m, "6 2# 0# 20#", &idle());
-        assert_eq!(curve(&a[0]), CurveParams::Function(FunctionParams { preset: FunctionPreset::Wave, x0_mm: 0.0, x1_mm: 20.0 }));
+        assert_eq!(
+            curve(&a[0]),
+            CurveParams::Function(FunctionParams { preset: FunctionPreset::Wave, x0_mm: 0.0, x1_mm: 20.0 })
+        );
         // The preset choice is kept for the next drawing; B steps to the next one.
         assert_eq!(form(&m).preset(), FunctionPreset::Wave);
         let a = type_keys(&mut m, "B# 0# 9#", &idle());
-        assert_eq!(curve(&a[0]), CurveParams::Function(FunctionParams { preset: FunctionPreset::Root, x0_mm: 0.0, x1_mm: 9.0 }));
+        assert_eq!(
+            curve(&a[0]),
+            CurveParams::Function(FunctionParams { preset: FunctionPreset::Root, x0_mm: 0.0, x1_mm: 9.0 })
+        );
         // sqrt of negative x, and an empty interval, are refused.
         assert_eq!(type_keys(&mut m, "# A4# 9#", &idle()), []);
         assert_eq!(m.message(), Some(UiError::Domain));

@@ -11,4 +11,4 @@ pub mod screen;
 
 pub use curves::{CircleParams, CurveJob, CurveParams, EllipseParams, FunctionParams, FunctionPreset, SineParams};
 pub use menu::{Menu, MenuAction};
-pub use screen::{ScreenView, SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+pub use screen::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX, ScreenView};

@@ -18,6 +18,7 @@
 
 use core::fmt::{self, Write};
 
+use embedded_graphics::Drawable;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::mono_font::MonoTextStyle;
@@ -25,15 +26,14 @@ use embedded_graphics::mono_font::ascii::FONT_5X8;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::primitives::Rectangle;
 use embedded_graphics::text::{Baseline, Text};
-use embedded_graphics::Drawable;
 use heapless::String;
 
 use crate::geom::{Axis, Step};
 use crate::interp::Method;
+use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
-use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
 
 /// Visible width of the LCD.
@@ -102,7 +102,13 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
         Screen::Modes => Cut(&mut title_text).write_str("SERVOPLOT"),
         Screen::Jog | Screen::Settings { .. } => Cut(&mut title_text).write_str(menu.selected().title()),
         Screen::Form(form) => {
-            write!(Cut(&mut title_text), "{} {}/{}", form.mode().title(), form.field_index() + 1, form.mode().fields().len())
+            write!(
+                Cut(&mut title_text),
+                "{} {}/{}",
+                form.mode().title(),
+                form.field_index() + 1,
+                form.mode().fields().len()
+            )
         }
     };
     let state = state_name(status.state);
@@ -125,7 +131,7 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
                 *l3 = TextLine::new(format_args!("Release to stop"), false);
             }
             None => {
-                *l2 = TextLine::new(format_args!("8 +Y 2 -Y 4 -X 6 +X"), false);
+                *l2 = TextLine::new(format_args!("2 +Y 8 -Y 4 -X 6 +X"), false);
                 *l3 = TextLine::new(format_args!("7 9 1 3 diagonal D back"), false);
             }
         },
@@ -133,7 +139,10 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
             Some(Field::Number(spec)) => {
                 let entry = form.entry();
                 let sign = if entry.is_negative() { "-" } else { "" };
-                *l2 = TextLine::new(format_args!("{} {}: {sign}{}_", spec.label, spec.unit.symbol(), entry.digits()), false);
+                *l2 = TextLine::new(
+                    format_args!("{} {}: {sign}{}_", spec.label, spec.unit.symbol(), entry.digits()),
+                    false,
+                );
                 *l3 = TextLine::new(format_args!("{}", spec.hint), false);
             }
             Some(Field::Preset) => {
@@ -174,7 +183,8 @@ where
     D: DrawTarget<Color = BinaryColor>,
 {
     for (i, line) in view.lines.iter().enumerate() {
-        let (fg, bg) = if line.inverted { (BinaryColor::Off, BinaryColor::On) } else { (BinaryColor::On, BinaryColor::Off) };
+        let (fg, bg) =
+            if line.inverted { (BinaryColor::Off, BinaryColor::On) } else { (BinaryColor::On, BinaryColor::Off) };
         let top = (i as u32 * SCREEN_LINE_HEIGHT_PX) as i32;
         let area = Rectangle::new(Point::new(0, top), Size::new(SCREEN_WIDTH_PX, SCREEN_LINE_HEIGHT_PX));
         target.fill_solid(&area, bg)?;
@@ -412,7 +422,7 @@ mod tests {
         press(&mut m, "BBBBBBBB", &idle);
         assert_eq!(texts(&view(&m, &idle, &s))[3], "Interpolation diagonal");
         press(&mut m, "D1", &idle);
-        m.handle(KeyEvent::Press(Key::Digit(9)), &idle, &s);
+        m.handle(KeyEvent::Press(Key::Digit(3)), &idle, &s);
         let jog = Status { state: RunState::Jog, ..Status::default() };
         assert_eq!(texts(&view(&m, &jog, &s))[2..], ["Moving +X+Y", "Release to stop"]);
     }
@@ -476,7 +486,8 @@ mod tests {
     #[test]
     fn nothing_is_drawn_outside_the_screen() {
         let s = Settings::default();
-        let busy = Status { state: RunState::Run, queued_jobs: 255, position: crate::geom::Point::new(-50_000, -50_000) };
+        let busy =
+            Status { state: RunState::Run, queued_jobs: 255, position: crate::geom::Point::new(-50_000, -50_000) };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
             let mut m = Menu::new();
             press(&mut m, keys, &Status::default());

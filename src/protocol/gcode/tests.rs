@@ -60,7 +60,7 @@ fn feed(f: f32) -> Feed {
 }
 
 /// The single curve a line produced.
-fn curve(g: &mut GcodeState, l: &str) -> (CurveShape, Feed, Point) {
+fn curve(g: &mut GcodeState, l: &str) -> (Shape, Feed, Point) {
     match run(g, l) {
         Ok(mut c) if c.len() == 1 => match c.remove(0) {
             Command::Curve { shape, feed, end } => (shape, feed, end),
@@ -205,7 +205,7 @@ fn g20_converts_inches_for_axes_offsets_and_feed() {
     assert_eq!(run(&mut g, "G20 G1 X1 Y-0.5 F10"), Ok(std::vec![line(2540, -1270, feed(254.0))]));
     assert_eq!(g.units(), Units::Inch);
     let (shape, _, end) = curve(&mut g, "G2 X1.5 Y-0.5 I0.25");
-    assert_eq!(shape, CurveShape::Arc { center: Point::new(3175, -1270), to: end, rotation: Rotation::Clockwise });
+    assert_eq!(shape, Shape::Arc { center: Point::new(3175, -1270), to: end, rotation: Rotation::Clockwise });
     assert_eq!(end, Point::new(3810, -1270));
     // Back to millimetres: the planned position is where the inches left it.
     assert_eq!(run(&mut g, "G21 G91 G0 X1"), Ok(std::vec![line(3910, -1270, Feed::Rapid)]));
@@ -241,21 +241,18 @@ fn arcs_with_centre_offsets() {
     let (shape, f, end) = curve(&mut g, "G2 X20 Y0 I10 J0 F500");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(1000, 0), to: Point::new(2000, 0), rotation: Rotation::Clockwise }
+        Shape::Arc { center: Point::new(1000, 0), to: Point::new(2000, 0), rotation: Rotation::Clockwise }
     );
     assert_eq!((f, end), (feed(500.0), Point::new(2000, 0)));
     let (shape, ..) = curve(&mut g, "G3 X0 I-10");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
+        Shape::Arc { center: Point::new(1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
     );
     assert_eq!(g.motion_mode(), MotionMode::ArcCcw);
     // A full circle: the end is the start.
     let (shape, _, end) = curve(&mut g, "G91 G2 X0 Y0 I0 J-5");
-    assert_eq!(
-        shape,
-        CurveShape::Arc { center: Point::new(0, -500), to: Point::ORIGIN, rotation: Rotation::Clockwise }
-    );
+    assert_eq!(shape, Shape::Arc { center: Point::new(0, -500), to: Point::ORIGIN, rotation: Rotation::Clockwise });
     assert_eq!(end, Point::ORIGIN);
     // The end 0.05 mm off a 10 mm circle: more than 0.1 % of the radius.
     refused(&mut g, "G90 G2 X20 Y1 I10", 33);
@@ -273,20 +270,20 @@ fn arcs_with_a_radius() {
     let (shape, ..) = curve(&mut g, "G2 X10 Y10 R10");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(1000, 0), to: Point::new(1000, 1000), rotation: Rotation::Clockwise }
+        Shape::Arc { center: Point::new(1000, 0), to: Point::new(1000, 1000), rotation: Rotation::Clockwise }
     );
     // ...a negative R takes the long way, about (0,10) when starting back from (0,0).
     ok_all(&mut g, &["G0 X0 Y0"]);
     let (shape, ..) = curve(&mut g, "G2 X10 Y10 R-10");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(0, 1000), to: Point::new(1000, 1000), rotation: Rotation::Clockwise }
+        Shape::Arc { center: Point::new(0, 1000), to: Point::new(1000, 1000), rotation: Rotation::Clockwise }
     );
     // Back from (10,10) to (0,0) counter-clockwise, the short way: about (10,0).
     let (shape, ..) = curve(&mut g, "G3 X0 Y0 R10");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
+        Shape::Arc { center: Point::new(1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
     );
     refused(&mut g, "G2 X10 Y0 R4.9", 34);
     refused(&mut g, "G2 X0 Y0 R5", 33);
@@ -303,11 +300,7 @@ fn arcs_are_checked_against_the_travel_along_their_whole_sweep() {
     let (shape, ..) = curve(&mut g, "G2 X195 Y12 I0 J6");
     assert_eq!(
         shape,
-        CurveShape::Arc {
-            center: Point::new(19_500, 600),
-            to: Point::new(19_500, 1200),
-            rotation: Rotation::Clockwise
-        }
+        Shape::Arc { center: Point::new(19_500, 600), to: Point::new(19_500, 1200), rotation: Rotation::Clockwise }
     );
     refused(&mut g, "G91 G2 X0 Y0 I0 J-150", 15);
 }
@@ -318,7 +311,7 @@ fn circles_become_ellipses_in_steps_when_the_axes_differ() {
     s.set(101, 50.0).unwrap();
     let mut g = GcodeState::new();
     let cmds = g.execute("G2 X20 Y0 I10 F500", &s, RunState::Idle).unwrap();
-    let expected = CurveShape::Ellipse {
+    let expected = Shape::Ellipse {
         center: Point::new(1000, 0),
         a_steps: 1000,
         b_steps: 500,
@@ -480,14 +473,14 @@ fn circle_command_draws_from_the_pen() {
     let (shape, f, end) = curve(&mut g, "$O R10");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(-1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
+        Shape::Arc { center: Point::new(-1000, 0), to: Point::ORIGIN, rotation: Rotation::CounterClockwise }
     );
     assert_eq!((f, end), (feed(3000.0), Point::ORIGIN));
     // Pen at 90° on the circle, a quarter clockwise: ends at 0°.
     let (shape, f, end) = curve(&mut g, "$o r10 s90 w-90 f600");
     assert_eq!(
         shape,
-        CurveShape::Arc { center: Point::new(0, -1000), to: Point::new(1000, -1000), rotation: Rotation::Clockwise }
+        Shape::Arc { center: Point::new(0, -1000), to: Point::new(1000, -1000), rotation: Rotation::Clockwise }
     );
     assert_eq!((f, end), (feed(600.0), Point::new(1000, -1000)));
     assert_eq!(g.planned_position(), end);
@@ -497,11 +490,7 @@ fn circle_command_draws_from_the_pen() {
     let (shape, ..) = curve(&mut g, "$O R1 W180");
     assert_eq!(
         shape,
-        CurveShape::Arc {
-            center: Point::new(900, -1000),
-            to: Point::new(800, -1000),
-            rotation: Rotation::CounterClockwise
-        }
+        Shape::Arc { center: Point::new(900, -1000), to: Point::new(800, -1000), rotation: Rotation::CounterClockwise }
     );
     refused(&mut g, "$O", 28);
     refused(&mut g, "$O R-1", 4);
@@ -518,7 +507,7 @@ fn circle_command_draws_from_the_pen() {
 fn ellipse_command() {
     let mut g = GcodeState::new();
     let (shape, _, end) = curve(&mut g, "$E A20 B10");
-    let full = CurveShape::Ellipse {
+    let full = Shape::Ellipse {
         center: Point::new(-2000, 0),
         a_steps: 2000,
         b_steps: 1000,
@@ -530,7 +519,7 @@ fn ellipse_command() {
     assert_eq!(end, Point::new(-2000, 1000));
     assert_eq!(
         shape,
-        CurveShape::Ellipse {
+        Shape::Ellipse {
             center: Point::new(-2000, 0),
             a_steps: 2000,
             b_steps: 1000,
@@ -556,7 +545,7 @@ fn sine_command() {
     // A quarter period (ω = π/10 rad/mm, 5 mm): ends at the crest, A above the pen.
     let (shape, _, end) = curve(&mut g, "$S A5 W0.31415927 L5");
     match shape {
-        CurveShape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps } => {
+        Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps } => {
             assert_eq!((amplitude_steps, phase_rad, length_steps), (500.0, 0.0, 500));
             assert!((omega_rad_per_step - 0.0031415927).abs() < 1e-9);
         }
@@ -581,7 +570,7 @@ fn function_command() {
     ok_all(&mut g, &["G0 X10 Y10"]);
     let (shape, f, end) = curve(&mut g, "$F X-2 U2 F600 Y=x^2");
     match &shape {
-        CurveShape::Function { expr, x0_mm, x1_mm } => {
+        Shape::Function { expr, x0_mm, x1_mm } => {
             assert_eq!((*x0_mm, *x1_mm), (-2.0, 2.0));
             assert_eq!(expr.eval(3.0), Ok(9.0));
         }
@@ -712,7 +701,7 @@ fn random_gcode_blocks_keep_the_plan_consistent() {
                             prop_assert!(end.x.abs() <= 20_000 && end.y.abs() <= 20_000, "{} -> {:?}", text, end);
                             prop_assert_eq!(end, g.planned_position(), "{}", text);
                         }
-                        if let Command::Curve { shape: CurveShape::Arc { to, .. }, end, .. } = &c {
+                        if let Command::Curve { shape: Shape::Arc { to, .. }, end, .. } = &c {
                             prop_assert_eq!(to, end);
                         }
                     }

@@ -1,0 +1,42 @@
+#!/usr/bin/env python3
+"""Prints the flash and static RAM a firmware ELF image uses, from its section headers."""
+import struct
+import sys
+
+FLASH = (0x08000000, 1024 * 1024)
+RAM = (0x20000000, 128 * 1024)
+
+
+def sections(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] != b"\x7fELF" or data[4] != 1:
+        sys.exit(f"{path}: not a 32-bit ELF file")
+    shoff, = struct.unpack_from("<I", data, 0x20)
+    shentsize, shnum, shstrndx = struct.unpack_from("<HHH", data, 0x2E)
+    headers = [struct.unpack_from("<IIIIIIIIII", data, shoff + i * shentsize) for i in range(shnum)]
+    strtab = headers[shstrndx]
+    for name, typ, flags, addr, off, size, *_ in headers:
+        end = data.index(b"\0", strtab[4] + name)
+        yield data[strtab[4] + name:end].decode(), typ, flags, addr, size
+
+
+def main():
+    flash = ram = 0
+    for name, typ, flags, addr, size in sections(sys.argv[1]):
+        if not flags & 0x2:  # SHF_ALLOC
+            continue
+        in_flash = FLASH[0] <= addr < FLASH[0] + FLASH[1]
+        in_ram = RAM[0] <= addr < RAM[0] + RAM[1]
+        if in_flash:
+            flash += size
+        if in_ram:
+            ram += size
+            if typ != 8:  # not NOBITS: .data's initial values are stored in flash too
+                flash += size
+    print(f"flash: {flash} bytes ({flash / FLASH[1]:.1%} of {FLASH[1] // 1024} KiB)")
+    print(f"static RAM: {ram} bytes ({ram / RAM[1]:.1%} of {RAM[1] // 1024} KiB)")
+
+
+if __name__ == "__main__":
+    main()

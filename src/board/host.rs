@@ -1,0 +1,159 @@
+//! The simulator's command line: feeds the simulated board from files, standard input or the
+//! built-in demo, prints the serial answers, and writes the plot and the LCD frames.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use servoplot::sim::{self, KeysStart, SimConfig, keys::KeyScript, picture, serial::SimSerial};
+
+/// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
+const DEMO_GCODE: &str = include_str!("../../demo/demo.gcode");
+const DEMO_KEYS: &str = include_str!("../../demo/demo.keys");
+
+/// At most this many LCD frames are written as PNG files (the last frame always is).
+const LCD_PNG_MAX_FRAMES: usize = 300;
+
+const USAGE: &str = "\
+usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--out DIR]
+
+Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
+built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
+pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults to `out`).
+
+  --serial FILE   host-link input, as a GRBL sender would send it (`-` = standard input)
+  --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
+                  with --serial it starts once the serial drawing is done
+  --keys-text S   the keypad script given inline
+  --out DIR       where the pictures go";
+
+struct Args {
+    serial: Option<String>,
+    keys: Option<String>,
+    out: PathBuf,
+}
+
+fn parse_args() -> Result<Args, String> {
+    let mut args = Args { serial: None, keys: None, out: PathBuf::from("out") };
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
+        match a.as_str() {
+            "--serial" => args.serial = Some(value()?),
+            "--keys" => {
+                let path = value()?;
+                args.keys = Some(std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?);
+            }
+            "--keys-text" => args.keys = Some(value()?),
+            "--out" => args.out = PathBuf::from(value()?),
+            "-h" | "--help" => return Err(String::new()),
+            other => return Err(format!("unknown argument `{other}`")),
+        }
+    }
+    Ok(args)
+}
+
+pub fn main() -> ExitCode {
+    let args = match parse_args() {
+        Ok(a) => a,
+        Err(e) => {
+            if !e.is_empty() {
+                eprintln!("error: {e}");
+            }
+            eprintln!("{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let demo = args.serial.is_none() && args.keys.is_none();
+    let has_serial = demo || args.serial.is_some();
+    let serial = match args.serial.as_deref() {
+        Some("-") => SimSerial::from_stdin(),
+        Some(path) => match std::fs::read(path) {
+            Ok(bytes) => SimSerial::with_input(&bytes),
+            Err(e) => {
+                eprintln!("error: {path}: {e}");
+                return ExitCode::from(2);
+            }
+        },
+        None if demo => SimSerial::with_input(DEMO_GCODE.as_bytes()),
+        None => SimSerial::default(),
+    };
+    let key_text = if demo { Some(DEMO_KEYS.to_string()) } else { args.keys };
+    let keys = match key_text.as_deref().map(KeyScript::parse).transpose() {
+        Ok(k) => k.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("error: keypad script: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    if demo {
+        eprintln!("servoplot simulator: no input given, drawing the built-in demo");
+    }
+    // A keypad script given with serial input starts once the serial drawing is done.
+    let keys_start = if has_serial { KeysStart::AfterSerial } else { KeysStart::AtOnce };
+    let report = sim::run(SimConfig { serial: serial.echo_to_stdout(), keys, keys_start, ..SimConfig::default() });
+    match write_pictures(&report, &args.out) {
+        Ok(()) => {}
+        Err(e) => {
+            eprintln!("error: writing pictures to {}: {e}", args.out.display());
+            return ExitCode::FAILURE;
+        }
+    }
+    if report.timed_out {
+        eprintln!(
+            "error: the machine did not come to rest within {} s of virtual time",
+            sim::SIM_MAX_VIRTUAL_US / 1_000_000
+        );
+        return ExitCode::FAILURE;
+    }
+    ExitCode::SUCCESS
+}
+
+fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
+    let lcd_dir = out.join("lcd");
+    std::fs::create_dir_all(&lcd_dir)?;
+    for old in std::fs::read_dir(&lcd_dir)? {
+        let old = old?.path();
+        if old.extension().is_some_and(|e| e == "png") {
+            std::fs::remove_file(old)?;
+        }
+    }
+    let svg_path = out.join("plot.svg");
+    let mut svg = std::io::BufWriter::new(std::fs::File::create(&svg_path)?);
+    let path = report.path();
+    picture::write_plot_svg(&path, report.settings.steps_per_mm, &mut svg)?;
+
+    // Consecutive identical frames are one picture.
+    let mut distinct: Vec<&(u64, sim::lcd::Frame)> = Vec::new();
+    for f in &report.frames {
+        if distinct.last().is_none_or(|last| last.1 != f.1) {
+            distinct.push(f);
+        }
+    }
+    let written = distinct.len().min(LCD_PNG_MAX_FRAMES);
+    for (i, (t_us, frame)) in distinct.iter().take(written).enumerate() {
+        picture::write_frame_png(frame, &lcd_dir.join(format!("frame-{:04}-{:08}ms.png", i + 1, t_us / 1000)))?;
+    }
+    if let Some((_, last)) = distinct.last() {
+        picture::write_frame_png(last, &out.join("lcd-final.png"))?;
+    }
+    let [xf, xb, yf, yb] = report.trace.counts();
+    let mm = |axis: usize, steps: i32| steps as f32 / report.settings.steps_per_mm[axis];
+    eprintln!();
+    eprintln!("pulses: X {xf} forward, {xb} back; Y {yf} forward, {yb} back");
+    eprintln!(
+        "final position: X {:.3} mm, Y {:.3} mm; last pulse at {:.3} s of virtual time",
+        mm(0, report.position.x),
+        mm(1, report.position.y),
+        report.last_pulse_us() as f64 / 1e6
+    );
+    eprintln!("plot (rebuilt from the pulses): {}", svg_path.display());
+    eprintln!(
+        "LCD frames: {} sent, {} distinct, {written} written to {}{}",
+        report.frames.len(),
+        distinct.len(),
+        lcd_dir.display(),
+        if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
+    );
+    eprintln!("final LCD frame: {}", out.join("lcd-final.png").display());
+    Ok(())
+}

@@ -1,0 +1,189 @@
+//! The STM32F407VG board: clocks, the whole pin map, peripherals and executors.
+//!
+//! Nothing else in the firmware names a pin or a peripheral instance. The pulse task runs on an
+//! interrupt executor (UART4's vector, unused as a UART) above everything else; keypad, serial,
+//! motion and LCD share the thread-mode executor, so a blocking LCD flush never delays a pulse.
+//!
+//! | signal              | pin  | notes                                              |
+//! |---------------------|------|----------------------------------------------------|
+//! | X PULS / X SIGN     | PE9 / PE10  | to the X driver's PULS+/SIGN+ inputs        |
+//! | Y PULS / Y SIGN     | PE11 / PE12 | to the Y driver's PULS+/SIGN+ inputs        |
+//! | servo on (SON)      | PE13 | high once the firmware runs, both drivers          |
+//! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
+//! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
+//! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
+//! | LCD SID (R/W)       | PB15 | SPI2 MOSI                                          |
+//! | LCD CS (RS)         | PB12 | active high, driven by the st7920 driver           |
+//! | LCD RST             | PB11 | PSB tied to GND selects serial mode                |
+//! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
+
+use core::convert::Infallible;
+
+use defmt::{info, unwrap};
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
+use embassy_stm32::interrupt::{InterruptExt, Priority};
+use embassy_stm32::mode::Blocking;
+use embassy_stm32::peripherals::USART2;
+use embassy_stm32::spi::{self, Spi};
+use embassy_stm32::time::Hertz;
+use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
+use embassy_stm32::{Config, bind_interrupts, interrupt};
+use embassy_time::Delay;
+use embedded_hal_bus::spi::ExclusiveDevice;
+use servoplot::machine::Machine;
+use servoplot::settings::Settings;
+use servoplot::tasks::{self, lcd::St7920Lcd, pulse::AxisPins};
+use static_cell::StaticCell;
+use {defmt_rtt as _, panic_probe as _};
+
+/// Serial host link speed.
+const HOST_BAUD: u32 = 115_200;
+/// UART ring buffers. GRBL senders keep at most 128 unanswered bytes in flight (character
+/// counting), so 256 never overflows; answers are short, status reports the longest.
+const HOST_RX_BUFFER_BYTES: usize = 256;
+const HOST_TX_BUFFER_BYTES: usize = 256;
+/// ST7920 serial clock: the controller takes at most ~1 MHz at 5 V (datasheet t_scyc).
+const LCD_SPI_HZ: u32 = 600_000;
+
+bind_interrupts!(struct Irqs {
+    USART2 => usart::BufferedInterruptHandler<USART2>;
+});
+
+static EXECUTOR_PULSE: InterruptExecutor = InterruptExecutor::new();
+static MACHINE: StaticCell<Machine> = StaticCell::new();
+
+#[interrupt]
+unsafe fn UART4() {
+    // SAFETY: UART4 serves only as the pulse executor's software interrupt.
+    unsafe { EXECUTOR_PULSE.on_interrupt() }
+}
+
+type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, Delay>, Output<'static>, Delay>;
+
+#[embassy_executor::task]
+async fn pulse(machine: &'static Machine, axes: [AxisPins<Output<'static>>; 2]) -> ! {
+    tasks::pulse::run(machine, axes, Delay).await
+}
+
+#[embassy_executor::task]
+async fn motion(machine: &'static Machine) -> ! {
+    tasks::motion::run(machine).await
+}
+
+#[embassy_executor::task]
+async fn keypad(machine: &'static Machine, columns: [Output<'static>; 4], rows: [Input<'static>; 4]) -> ! {
+    tasks::keypad::run(machine, columns, rows).await
+}
+
+#[embassy_executor::task]
+async fn serial(machine: &'static Machine, rx: BufferedUartRx<'static>, tx: BufferedUartTx<'static>) -> ! {
+    tasks::serial::run(machine, rx, tx).await
+}
+
+#[embassy_executor::task]
+async fn lcd(machine: &'static Machine, lcd: Lcd) -> ! {
+    tasks::lcd::run(machine, lcd).await
+}
+
+/// The ST7920 driver drives CS itself (active high); the SPI device's own CS is this no-op.
+struct NoCs;
+
+impl embedded_hal::digital::ErrorType for NoCs {
+    type Error = Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for NoCs {
+    fn set_low(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+    fn set_high(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// 168 MHz from the 8 MHz crystal: 8 / 4 * 168 / 2; 48 MHz for USB from Q; APB1 42 MHz, APB2 84 MHz.
+fn clocks() -> Config {
+    use embassy_stm32::rcc::*;
+    let mut config = embassy_stm32::Config::default();
+    config.rcc.hse = Some(Hse { freq: Hertz(8_000_000), mode: HseMode::Oscillator });
+    config.rcc.pll_src = PllSource::HSE;
+    config.rcc.pll = Some(Pll {
+        prediv: PllPreDiv::DIV4,
+        mul: PllMul::MUL168,
+        divp: Some(PllPDiv::DIV2),
+        divq: Some(PllQDiv::DIV7),
+        divr: None,
+    });
+    config.rcc.ahb_pre = AHBPrescaler::DIV1;
+    config.rcc.apb1_pre = APBPrescaler::DIV4;
+    config.rcc.apb2_pre = APBPrescaler::DIV2;
+    config.rcc.sys = Sysclk::PLL1_P;
+    config
+}
+
+#[embassy_executor::main]
+async fn main(spawner: Spawner) {
+    let p = embassy_stm32::init(clocks());
+    info!("servoplot {} on STM32F407VG at 168 MHz", env!("CARGO_PKG_VERSION"));
+    let machine: &'static Machine = MACHINE.init(Machine::new(Settings::default()));
+
+    // Step/direction outputs, low (no pulse) until the pulse task drives them.
+    let axes = [
+        AxisPins {
+            puls: Output::new(p.PE9, Level::Low, Speed::VeryHigh),
+            sign: Output::new(p.PE10, Level::Low, Speed::VeryHigh),
+        },
+        AxisPins {
+            puls: Output::new(p.PE11, Level::Low, Speed::VeryHigh),
+            sign: Output::new(p.PE12, Level::Low, Speed::VeryHigh),
+        },
+    ];
+    // Servo on: the drivers hold position from here on. Kept for the program's whole life.
+    core::mem::forget(Output::new(p.PE13, Level::High, Speed::Low));
+
+    interrupt::UART4.set_priority(Priority::P6);
+    let pulse_spawner = EXECUTOR_PULSE.start(interrupt::UART4);
+    pulse_spawner.spawn(unwrap!(pulse(machine, axes)));
+
+    let columns = [
+        Output::new(p.PD0, Level::High, Speed::Low),
+        Output::new(p.PD1, Level::High, Speed::Low),
+        Output::new(p.PD2, Level::High, Speed::Low),
+        Output::new(p.PD3, Level::High, Speed::Low),
+    ];
+    let rows = [
+        Input::new(p.PD8, Pull::Up),
+        Input::new(p.PD9, Pull::Up),
+        Input::new(p.PD10, Pull::Up),
+        Input::new(p.PD11, Pull::Up),
+    ];
+    spawner.spawn(unwrap!(keypad(machine, columns, rows)));
+
+    static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
+    static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = HOST_BAUD;
+    let uart = unwrap!(BufferedUart::new(
+        p.USART2,
+        p.PA3,
+        p.PA2,
+        TX_BUF.init([0; HOST_TX_BUFFER_BYTES]),
+        RX_BUF.init([0; HOST_RX_BUFFER_BYTES]),
+        Irqs,
+        uart_config,
+    ));
+    let (tx, rx) = uart.split();
+    spawner.spawn(unwrap!(serial(machine, rx, tx)));
+
+    let mut spi_config = spi::Config::default();
+    spi_config.frequency = Hertz(LCD_SPI_HZ);
+    spi_config.mode = spi::MODE_3;
+    let spi_bus = Spi::new_blocking_txonly(p.SPI2, p.PB13, p.PB15, spi_config);
+    let spi_dev = unwrap!(ExclusiveDevice::new(spi_bus, NoCs, Delay));
+    let lcd_cs = Output::new(p.PB12, Level::Low, Speed::Low);
+    let lcd_rst = Output::new(p.PB11, Level::High, Speed::Low);
+    spawner.spawn(unwrap!(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));
+
+    spawner.spawn(unwrap!(motion(machine)));
+}

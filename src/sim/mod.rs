@@ -1,0 +1,234 @@
+//! The simulated board: the firmware's own tasks on the host, with virtual time.
+//!
+//! The pulse, motion, keypad, serial and LCD loops are the same code as on target; only their
+//! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
+//! pressed by a script, the serial link reads a transcript or standard input, and the LCD is a
+//! model of the ST7920 fed by the real driver. A run ends when every input is used up and the
+//! machine has come to rest.
+
+pub mod clock;
+pub mod keys;
+pub mod lcd;
+pub mod picture;
+pub mod pins;
+pub mod serial;
+
+use core::future::Future;
+use core::pin::pin;
+use core::task::{Context, Poll, Waker};
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::task::Wake;
+use std::vec::Vec;
+
+use embassy_futures::join::join5;
+use embedded_graphics::draw_target::DrawTarget;
+use embedded_graphics::pixelcolor::BinaryColor;
+
+use crate::geom::{Axis, Point};
+use crate::machine::Machine;
+use crate::settings::Settings;
+use crate::tasks::{self, lcd::Lcd, lcd::St7920Lcd, pulse::AxisPins};
+use clock::{BusyDelay, FreeDelay};
+use keys::{KeyMatrix, KeyScript};
+use lcd::{Frame, SimSpi};
+use pins::{NoPin, PulseTrace, TracePin};
+use serial::SimSerial;
+
+/// After the inputs are used up and the machine rests, the run goes on this long so the LCD
+/// shows the final state.
+pub const SIM_SETTLE_US: u64 = 500_000;
+/// A run that has not come to rest after this much virtual time is cut off.
+pub const SIM_MAX_VIRTUAL_US: u64 = 3_600_000_000;
+
+/// When the keypad script begins.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum KeysStart {
+    /// At power-on, alongside the serial input.
+    #[default]
+    AtOnce,
+    /// Once the serial input is used up and the machine rests (a person steps up to the
+    /// machine after the PC's drawing is done).
+    AfterSerial,
+}
+
+/// What a simulation starts from.
+#[derive(Default)]
+pub struct SimConfig {
+    pub settings: Settings,
+    pub serial: SimSerial,
+    pub keys: KeyScript,
+    pub keys_start: KeysStart,
+}
+
+/// What a simulation produced.
+pub struct SimReport {
+    pub trace: PulseTrace,
+    /// Every frame sent to the LCD, with the virtual time it was sent.
+    pub frames: Vec<(u64, Frame)>,
+    /// Everything the firmware answered on the serial link.
+    pub serial_out: Vec<u8>,
+    /// Position counted by the pulse task.
+    pub position: Point,
+    /// Settings at the end (the host may have changed them).
+    pub settings: Settings,
+    /// Virtual time at the end, and when the last pulse went out.
+    pub end_us: u64,
+    /// True if the run hit `SIM_MAX_VIRTUAL_US` before coming to rest.
+    pub timed_out: bool,
+}
+
+impl SimReport {
+    /// The serial answers as text.
+    pub fn answers(&self) -> std::string::String {
+        std::string::String::from_utf8_lossy(&self.serial_out).into_owned()
+    }
+
+    /// The pen path rebuilt from the pulses.
+    pub fn path(&self) -> Vec<Point> {
+        self.trace.path(self.settings.dir_invert_mask)
+    }
+
+    /// Time of the last pulse.
+    pub fn last_pulse_us(&self) -> u64 {
+        self.trace.pulses.last().map_or(0, |p| p.t_us)
+    }
+}
+
+/// The simulated LCD: the real driver on a model controller, keeping a copy of every frame.
+struct SimLcd {
+    inner: St7920Lcd<SimSpi, NoPin, FreeDelay>,
+    spi: SimSpi,
+    frames: Rc<RefCell<Vec<(u64, Frame)>>>,
+}
+
+impl embedded_graphics::geometry::OriginDimensions for SimLcd {
+    fn size(&self) -> embedded_graphics::geometry::Size {
+        self.inner.size()
+    }
+}
+
+impl DrawTarget for SimLcd {
+    type Color = BinaryColor;
+    type Error = core::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<BinaryColor>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        self.inner.draw_iter(pixels)
+    }
+}
+
+impl Lcd for SimLcd {
+    fn init(&mut self) {
+        self.inner.init();
+    }
+
+    fn show(&mut self) {
+        self.inner.show();
+        let frame = self.spi.model.borrow().visible();
+        self.frames.borrow_mut().push((clock::now_ticks(), frame));
+    }
+}
+
+struct FlagWaker(AtomicBool);
+
+impl Wake for FlagWaker {
+    fn wake(self: Arc<Self>) {
+        self.0.store(true, Ordering::Release);
+    }
+}
+
+/// Runs the firmware on the simulated board until its inputs are used up and it rests.
+pub fn run(config: SimConfig) -> SimReport {
+    clock::reset();
+    let machine = Machine::new(config.settings);
+    let trace = Rc::new(RefCell::new(PulseTrace::default()));
+    let axes = Axis::ALL.map(|axis| {
+        let (puls, sign) = TracePin::pair(&trace, axis);
+        AxisPins { puls, sign }
+    });
+    let matrix = match config.keys_start {
+        KeysStart::AtOnce => KeyMatrix::new(config.keys),
+        KeysStart::AfterSerial => KeyMatrix::waiting(config.keys),
+    };
+    let columns = [0, 1, 2, 3].map(|c| matrix.column(c));
+    let rows = [0, 1, 2, 3].map(|r| matrix.row(r));
+    let serial = config.serial;
+    let frames = Rc::new(RefCell::new(Vec::new()));
+    let spi = SimSpi::default();
+    let lcd = SimLcd { inner: St7920Lcd::new(spi.clone(), NoPin, NoPin, FreeDelay), spi, frames: frames.clone() };
+
+    let firmware = join5(
+        tasks::pulse::run(&machine, axes, BusyDelay),
+        tasks::motion::run(&machine),
+        tasks::keypad::run(&machine, columns, rows),
+        tasks::serial::run(&machine, serial.clone(), serial.clone()),
+        tasks::lcd::run(&machine, lcd),
+    );
+    let mut firmware = pin!(firmware);
+    let flag = Arc::new(FlagWaker(AtomicBool::new(true)));
+    let waker = Waker::from(flag.clone());
+    let mut cx = Context::from_waker(&waker);
+    let mut rest_since: Option<u64> = None;
+    let mut timed_out = false;
+    loop {
+        if flag.0.swap(false, Ordering::AcqRel) {
+            if let Poll::Ready(never) = firmware.as_mut().poll(&mut cx) {
+                match never {}
+            }
+            continue;
+        }
+        // Every task waits: the run may end, take live input, or jump to the next deadline.
+        serial.pump_live(false);
+        if flag.0.load(Ordering::Acquire) {
+            continue;
+        }
+        let now = clock::now_ticks();
+        if !matrix.started() && serial.input_done() && machine.is_idle() {
+            matrix.start();
+        }
+        let at_rest = serial.input_done() && matrix.script_done() && machine.is_idle();
+        if at_rest {
+            let since = *rest_since.get_or_insert(now);
+            if now >= since + SIM_SETTLE_US {
+                break;
+            }
+        } else {
+            rest_since = None;
+        }
+        if serial.is_live() && machine.is_idle() && matrix.script_done() {
+            // Nothing moves: wait, in real time, for the person at the terminal.
+            serial.pump_live(true);
+            continue;
+        }
+        if now >= SIM_MAX_VIRTUAL_US {
+            timed_out = true;
+            break;
+        }
+        if !clock::jump_to_next_deadline() {
+            break;
+        }
+    }
+    let position = machine.position();
+    let settings = machine.settings();
+    let end_us = clock::now_ticks();
+    drop(firmware);
+    let trace =
+        Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
+    let frames = core::mem::take(&mut *frames.borrow_mut());
+    SimReport { trace, frames, serial_out: serial.output(), position, settings, end_us, timed_out }
+}
+
+/// Runs a serial transcript (and nothing on the keypad) with default settings.
+pub fn run_serial(input: &str) -> SimReport {
+    run(SimConfig { serial: SimSerial::with_input(input.as_bytes()), ..SimConfig::default() })
+}
+
+/// Runs a keypad script (and nothing on the serial link) with default settings.
+pub fn run_keys(script: &str) -> Result<SimReport, std::string::String> {
+    Ok(run(SimConfig { keys: KeyScript::parse(script)?, ..SimConfig::default() }))
+}

@@ -1,0 +1,80 @@
+//! Pictures the simulator writes: the pen path as SVG and LCD frames as PNG.
+
+use std::io::{self, Write};
+use std::path::Path;
+use std::vec::Vec;
+
+use crate::geom::Point;
+use crate::sim::lcd::Frame;
+
+/// Each LCD pixel becomes a square of this many image pixels.
+pub const LCD_PNG_SCALE: usize = 4;
+/// Border around the LCD picture, in LCD pixels.
+const LCD_PNG_BORDER: usize = 2;
+/// Pixel colours of a yellow-green STN panel, lit and unlit, RGB.
+const LCD_ON_RGB: [u8; 3] = [0x20, 0x30, 0x20];
+const LCD_OFF_RGB: [u8; 3] = [0x9a, 0xc8, 0x3c];
+
+/// Writes `frame` as a PNG, scaled up so a person can read it.
+pub fn write_frame_png(frame: &Frame, path: &Path) -> io::Result<()> {
+    let w = (frame.pixels[0].len() + 2 * LCD_PNG_BORDER) * LCD_PNG_SCALE;
+    let h = (frame.pixels.len() + 2 * LCD_PNG_BORDER) * LCD_PNG_SCALE;
+    let mut rgb = Vec::with_capacity(w * h * 3);
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) =
+                ((x / LCD_PNG_SCALE).wrapping_sub(LCD_PNG_BORDER), (y / LCD_PNG_SCALE).wrapping_sub(LCD_PNG_BORDER));
+            let lit = frame.pixels.get(fy).and_then(|row| row.get(fx)).copied().unwrap_or(false);
+            rgb.extend_from_slice(if lit { &LCD_ON_RGB } else { &LCD_OFF_RGB });
+        }
+    }
+    let file = std::fs::File::create(path)?;
+    let mut enc = png::Encoder::new(io::BufWriter::new(file), w as u32, h as u32);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().map_err(io::Error::other)?;
+    writer.write_image_data(&rgb).map_err(io::Error::other)?;
+    writer.finish().map_err(io::Error::other)
+}
+
+/// Writes the pen path as an SVG drawing in millimetres, Y up, with a 5 mm margin and the origin
+/// marked.
+pub fn write_plot_svg(path: &[Point], steps_per_mm: [f32; 2], out: &mut impl Write) -> io::Result<()> {
+    const MARGIN_MM: f32 = 5.0;
+    let mm = |p: &Point| (p.x as f32 / steps_per_mm[0], p.y as f32 / steps_per_mm[1]);
+    let (mut x0, mut y0, mut x1, mut y1) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
+    for p in path {
+        let (x, y) = mm(p);
+        x0 = x0.min(x);
+        y0 = y0.min(y);
+        x1 = x1.max(x);
+        y1 = y1.max(y);
+    }
+    let (w, h) = (x1 - x0 + 2.0 * MARGIN_MM, y1 - y0 + 2.0 * MARGIN_MM);
+    writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.2}mm" height="{h:.2}mm" viewBox="{:.3} {:.3} {w:.3} {h:.3}">"#,
+        x0 - MARGIN_MM,
+        -y1 - MARGIN_MM
+    )?;
+    writeln!(
+        out,
+        r#"<rect x="{:.3}" y="{:.3}" width="{w:.3}" height="{h:.3}" fill="white"/>"#,
+        x0 - MARGIN_MM,
+        -y1 - MARGIN_MM
+    )?;
+    writeln!(out, r##"<path d="M -2 0 H 2 M 0 -2 V 2" stroke="#c00" stroke-width="0.1" fill="none"/>"##)?;
+    write!(out, r#"<polyline fill="none" stroke="black" stroke-width="0.25" stroke-linejoin="round" points=""#)?;
+    // Collinear runs are merged so the file stays small; the path itself is exact.
+    let mut last_dir = None;
+    for (i, p) in path.iter().enumerate() {
+        let dir = path.get(i + 1).map(|n| (n.x - p.x, n.y - p.y));
+        if i == 0 || dir != last_dir || i + 1 == path.len() {
+            let (x, y) = mm(p);
+            write!(out, "{x:.3},{:.3} ", -y)?;
+        }
+        last_dir = dir;
+    }
+    writeln!(out, r#""/>"#)?;
+    writeln!(out, "</svg>")
+}

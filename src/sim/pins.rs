@@ -1,0 +1,162 @@
+//! Simulated step/direction outputs and the pulse trace they record.
+//!
+//! Every PULS rising edge becomes a [`Pulse`] stamped with the virtual time, with the direction
+//! read from the SIGN level at that instant, exactly as a servo driver reads it. The pen path in
+//! `plot.svg` and every count the tests check are rebuilt from this trace, not from commands.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::vec::Vec;
+
+use crate::geom::{Axis, Point, Step};
+use crate::sim::clock;
+
+/// One pulse as a servo driver sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pulse {
+    pub t_us: u64,
+    pub axis: Axis,
+    /// SIGN level at the rising edge.
+    pub sign_high: bool,
+}
+
+/// Everything the step/direction pins did.
+#[derive(Debug, Default)]
+pub struct PulseTrace {
+    pub pulses: Vec<Pulse>,
+    /// Shortest time from a SIGN change to the next PULS edge on that axis.
+    pub min_dir_setup_us: Option<u64>,
+    /// Shortest PULS high time.
+    pub min_pulse_width_us: Option<u64>,
+    sign_high: [bool; 2],
+    sign_changed_at: [Option<u64>; 2],
+    puls_high_since: [Option<u64>; 2],
+}
+
+impl PulseTrace {
+    fn edge(&mut self, axis: Axis, role: Role, high: bool) {
+        let t = clock::now_ticks();
+        let i = axis.index();
+        match role {
+            Role::Sign => {
+                if self.sign_high[i] != high {
+                    self.sign_high[i] = high;
+                    self.sign_changed_at[i] = Some(t);
+                }
+            }
+            Role::Puls => match (self.puls_high_since[i], high) {
+                (None, true) => {
+                    self.puls_high_since[i] = Some(t);
+                    self.pulses.push(Pulse { t_us: t, axis, sign_high: self.sign_high[i] });
+                    if let Some(changed) = self.sign_changed_at[i].take() {
+                        let setup = t - changed;
+                        self.min_dir_setup_us = Some(self.min_dir_setup_us.map_or(setup, |m| m.min(setup)));
+                    }
+                }
+                (Some(since), false) => {
+                    self.puls_high_since[i] = None;
+                    let width = t - since;
+                    self.min_pulse_width_us = Some(self.min_pulse_width_us.map_or(width, |m| m.min(width)));
+                }
+                _ => {}
+            },
+        }
+    }
+
+    /// Pulses per axis, counted by direction: `[x_forward, x_backward, y_forward, y_backward]`,
+    /// with SIGN high meaning forward (no inversion).
+    pub fn counts(&self) -> [u64; 4] {
+        let mut c = [0; 4];
+        for p in &self.pulses {
+            c[p.axis.index() * 2 + usize::from(!p.sign_high)] += 1;
+        }
+        c
+    }
+
+    /// The steps the drivers took, in order, with their times; pulses on both axes at the same
+    /// instant form one diagonal step. `invert_mask` is the `$3` setting in force.
+    pub fn steps(&self, invert_mask: u8) -> Vec<(u64, Step)> {
+        let mut out: Vec<(u64, Step)> = Vec::new();
+        for p in &self.pulses {
+            let inverted = invert_mask & (1 << p.axis.index()) != 0;
+            let d = if p.sign_high != inverted { 1 } else { -1 };
+            let mut step = match out.last() {
+                Some((t, s)) if *t == p.t_us && s.on(p.axis) == 0 => out.pop().map(|(_, s)| s).unwrap_or_default(),
+                _ => Step::NONE,
+            };
+            match p.axis {
+                Axis::X => step.x = d,
+                Axis::Y => step.y = d,
+            }
+            out.push((p.t_us, step));
+        }
+        out
+    }
+
+    /// The lattice points the pen passed through, starting at the origin.
+    pub fn path(&self, invert_mask: u8) -> Vec<Point> {
+        let mut p = Point::ORIGIN;
+        let mut path = std::vec![p];
+        for (_, s) in self.steps(invert_mask) {
+            p = p.stepped(s);
+            path.push(p);
+        }
+        path
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Role {
+    Puls,
+    Sign,
+}
+
+/// A PULS or SIGN output of one axis, recording into a shared trace.
+pub struct TracePin {
+    trace: Rc<RefCell<PulseTrace>>,
+    axis: Axis,
+    role: Role,
+}
+
+impl TracePin {
+    /// The PULS and SIGN pins of `axis`.
+    pub fn pair(trace: &Rc<RefCell<PulseTrace>>, axis: Axis) -> (TracePin, TracePin) {
+        (
+            TracePin { trace: trace.clone(), axis, role: Role::Puls },
+            TracePin { trace: trace.clone(), axis, role: Role::Sign },
+        )
+    }
+}
+
+impl embedded_hal::digital::ErrorType for TracePin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for TracePin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.trace.borrow_mut().edge(self.axis, self.role, false);
+        Ok(())
+    }
+
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.trace.borrow_mut().edge(self.axis, self.role, true);
+        Ok(())
+    }
+}
+
+/// An output nobody listens to (the LCD's reset line, for one).
+pub struct NoPin;
+
+impl embedded_hal::digital::ErrorType for NoPin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for NoPin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}

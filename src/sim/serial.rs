@@ -1,0 +1,188 @@
+//! The simulated host link: bytes in from a file or standard input, answers out to a buffer
+//! (and optionally standard output), through the same embedded-io traits as the UART.
+//!
+//! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next
+//! line goes out once the firmware has answered the previous one with `ok` or `error:N`. Live
+//! standard input is passed on as typed.
+
+use core::future::poll_fn;
+use core::task::{Poll, Waker};
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::io::Write as _;
+use std::rc::Rc;
+use std::sync::mpsc;
+use std::vec::Vec;
+
+#[derive(Default)]
+struct Link {
+    input: VecDeque<u8>,
+    /// Lines not yet sent, for paced input.
+    unsent: VecDeque<Vec<u8>>,
+    /// Answers (`ok` / `error:`) still owed for lines sent.
+    owed: usize,
+    /// The output seen so far that does not end in a line end yet.
+    partial: Vec<u8>,
+    /// Standard input read by a helper thread, when the simulator is driven live.
+    live: Option<mpsc::Receiver<Vec<u8>>>,
+    live_ended: bool,
+    reader: Option<Waker>,
+    output: Vec<u8>,
+    echo_stdout: bool,
+}
+
+/// Both ends of the simulated serial link.
+#[derive(Clone, Default)]
+pub struct SimSerial {
+    link: Rc<RefCell<Link>>,
+}
+
+impl SimSerial {
+    /// A link whose whole input is known in advance (a file, a test transcript), streamed a
+    /// line at a time as each previous line is answered.
+    pub fn with_input(bytes: &[u8]) -> Self {
+        let s = SimSerial::default();
+        {
+            let mut l = s.link.borrow_mut();
+            l.unsent = bytes.split_inclusive(|b| *b == b'\n').map(<[u8]>::to_vec).collect();
+            l.send_next_line();
+        }
+        s
+    }
+
+    /// A link fed live from standard input.
+    pub fn from_stdin() -> Self {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            use std::io::Read;
+            let mut buf = [0u8; 256];
+            let mut stdin = std::io::stdin().lock();
+            while let Ok(n @ 1..) = stdin.read(&mut buf) {
+                if tx.send(buf[..n].to_vec()).is_err() {
+                    break;
+                }
+            }
+        });
+        let s = SimSerial::default();
+        s.link.borrow_mut().live = Some(rx);
+        s
+    }
+
+    /// Also print every answer on standard output as it is written.
+    pub fn echo_to_stdout(self) -> Self {
+        self.link.borrow_mut().echo_stdout = true;
+        self
+    }
+
+    /// Everything the firmware wrote so far.
+    pub fn output(&self) -> Vec<u8> {
+        self.link.borrow().output.clone()
+    }
+
+    /// True when no input is waiting and none can come any more.
+    pub fn input_done(&self) -> bool {
+        let l = self.link.borrow();
+        l.input.is_empty() && l.unsent.is_empty() && (l.live.is_none() || l.live_ended)
+    }
+
+    /// Takes what standard input has sent; with `block`, waits (in real time) for it.
+    /// Returns false once standard input has ended.
+    pub fn pump_live(&self, block: bool) -> bool {
+        let mut l = self.link.borrow_mut();
+        let Some(rx) = l.live.take() else { return false };
+        let got = if block { rx.recv().map_err(|_| mpsc::TryRecvError::Disconnected) } else { rx.try_recv() };
+        match got {
+            Ok(bytes) => {
+                l.input.extend(bytes);
+                l.live = Some(rx);
+                if let Some(w) = l.reader.take() {
+                    w.wake();
+                }
+            }
+            Err(mpsc::TryRecvError::Empty) => l.live = Some(rx),
+            Err(mpsc::TryRecvError::Disconnected) => l.live_ended = true,
+        }
+        !l.live_ended
+    }
+
+    /// True while standard input may still send something.
+    pub fn is_live(&self) -> bool {
+        let l = self.link.borrow();
+        l.live.is_some() && !l.live_ended
+    }
+}
+
+impl Link {
+    /// Sends the next paced line, if no answer is owed.
+    fn send_next_line(&mut self) {
+        if self.owed > 0 {
+            return;
+        }
+        if let Some(line) = self.unsent.pop_front() {
+            // Realtime bytes get no answer; only a line end asks for one.
+            if line.ends_with(b"\n") {
+                self.owed += 1;
+            }
+            self.input.extend(line);
+            if let Some(w) = self.reader.take() {
+                w.wake();
+            }
+        }
+    }
+
+    /// Notes the answers in what the firmware wrote and releases the next line.
+    fn heard(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            if b == b'\n' {
+                let line = core::mem::take(&mut self.partial);
+                if line.starts_with(b"ok") || line.starts_with(b"error:") {
+                    self.owed = self.owed.saturating_sub(1);
+                }
+            } else {
+                self.partial.push(b);
+            }
+        }
+        self.send_next_line();
+    }
+}
+
+impl embedded_io_async::ErrorType for SimSerial {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_io_async::Read for SimSerial {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+        poll_fn(|cx| {
+            let mut l = self.link.borrow_mut();
+            if l.input.is_empty() {
+                // A UART with nothing received simply waits; it never reports an end.
+                l.reader = Some(cx.waker().clone());
+                return Poll::Pending;
+            }
+            let n = buf.len().min(l.input.len());
+            for (dst, src) in buf.iter_mut().zip(l.input.drain(..n)) {
+                *dst = src;
+            }
+            Poll::Ready(Ok(n))
+        })
+        .await
+    }
+}
+
+impl embedded_io_async::Write for SimSerial {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+        let mut l = self.link.borrow_mut();
+        l.output.extend_from_slice(buf);
+        l.heard(buf);
+        if l.echo_stdout {
+            let mut out = std::io::stdout().lock();
+            let _ = out.write_all(buf);
+            let _ = out.flush();
+        }
+        Ok(buf.len())
+    }
+
+    async fn flush(&mut self) -> Result<(), Self::Error> {
+        Ok(())
+    }
+}

@@ -1,0 +1,76 @@
+//! The keypad task: scans the 4x4 matrix every `KEYPAD_SCAN_PERIOD_MS`, decodes key events and
+//! hands them to the menu, then carries out what the menu asks for.
+
+use embassy_time::{Duration, Instant, Ticker, Timer};
+use embedded_hal::digital::{InputPin, OutputPin};
+
+use crate::job::{Control, Job};
+use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
+use crate::machine::Machine;
+use crate::ui::MenuAction;
+use crate::ui::menu::UiError;
+
+/// Time for a row input to settle after its column is driven low.
+pub const KEYPAD_SETTLE_US: u64 = 10;
+
+/// Scans the keypad forever. Columns are outputs driven low one at a time; rows are inputs with
+/// pull-ups, read low where a pressed key joins them to the driven column.
+pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 4], mut rows: [R; 4]) -> ! {
+    let mut decoder = KeypadDecoder::new();
+    let mut ticker = Ticker::every(Duration::from_millis(KEYPAD_SCAN_PERIOD_MS as u64));
+    loop {
+        ticker.next().await;
+        let raw = scan(&mut columns, &mut rows).await;
+        let now_ms = Instant::now().as_millis() as u32;
+        for event in decoder.update(raw, now_ms) {
+            let status = machine.status();
+            let settings = machine.settings();
+            let action = machine.with_menu(|menu| menu.handle(event, &status, &settings));
+            machine.changed.signal(());
+            act(machine, action);
+        }
+    }
+}
+
+/// One pass over the matrix: bit `row * 4 + column` set for every key read as pressed.
+async fn scan<C: OutputPin, R: InputPin>(columns: &mut [C; 4], rows: &mut [R; 4]) -> u16 {
+    let mut raw = 0u16;
+    for (c, column) in columns.iter_mut().enumerate() {
+        let _ = column.set_low();
+        Timer::after(Duration::from_micros(KEYPAD_SETTLE_US)).await;
+        for (r, row) in rows.iter_mut().enumerate() {
+            if row.is_low().unwrap_or(false) {
+                raw |= 1 << (r * 4 + c);
+            }
+        }
+        let _ = column.set_high();
+    }
+    raw
+}
+
+/// Carries out a menu action: queue a job, or pass a control to the motion task.
+fn act(machine: &Machine, action: MenuAction) {
+    match action {
+        MenuAction::None => {}
+        MenuAction::Start(job) => queue(machine, job),
+        MenuAction::StartCurve(curve) => match curve.to_job(&machine.settings()) {
+            Ok(job) => queue(machine, job),
+            Err(_) => machine.with_menu(|menu| menu.refuse(UiError::Domain)),
+        },
+        MenuAction::JogStart(direction) => {
+            let job = Job::jog(direction, machine.status().position, &machine.settings());
+            queue(machine, job);
+        }
+        MenuAction::JogStop => machine.control.signal(Control::Abort),
+        MenuAction::Control(control) => machine.control.signal(control),
+    }
+}
+
+fn queue(machine: &Machine, job: Job) {
+    if machine.jobs.try_send(job).is_err() {
+        // The menu starts jobs only while the machine is idle, so this is a full queue from the
+        // host link: the keypad job is refused, visibly, rather than waiting unseen.
+        machine.with_menu(|menu| menu.refuse(UiError::Busy));
+        warn!("keypad job refused: job queue full");
+    }
+}

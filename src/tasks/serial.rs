@@ -1,0 +1,244 @@
+//! The serial task: GRBL 1.1's line protocol on the host link.
+//!
+//! Two loops share the link. The receiver reads bytes as they arrive and acts on realtime bytes
+//! (`?` `!` `~` 0x18 0x85) at once, so a status query or a feed hold is never stuck behind a line
+//! waiting for room in the job queue; every other byte goes through a small pipe to the line
+//! loop, which assembles lines, runs them through the G-code parser and answers `ok` or
+//! `error:N` once their jobs are queued (back-pressure paces a streaming sender). A third loop
+//! reports curves that stopped early. Answers are whole lines, never interleaved.
+
+use core::cell::Cell;
+use core::fmt::Write as _;
+
+use embassy_futures::join::join3;
+use embassy_sync::blocking_mutex::raw::NoopRawMutex;
+use embassy_sync::mutex::Mutex;
+use embassy_sync::pipe::Pipe;
+use embassy_time::{Duration, Timer};
+use embedded_io_async::{Read, Write};
+use heapless::String;
+
+use crate::job::{Control, Job};
+use crate::machine::{Machine, MotionFault};
+use crate::planner::PLANNER_SEGMENTS;
+use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::{Command, GcodeState, GrblError, Report, report};
+use crate::settings::Settings;
+use crate::status::RunState;
+
+/// Bytes between the receiver and the line loop. GRBL senders keep at most 128 unanswered bytes
+/// in flight, so this never fills; if it did, the receiver would simply stop reading and leave
+/// the bytes in the UART's own buffer.
+pub const SERIAL_PIPE_BYTES: usize = 128;
+/// What a sender may assume it can have in flight (reported by `$I`).
+pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
+/// Longest answer to one line: `$$` lists every setting.
+pub const SERIAL_ANSWER_MAX_BYTES: usize = 1024;
+/// How often waits for the machine to come to rest (G4, M0, M2) look again.
+pub const SERIAL_IDLE_POLL_MS: u64 = 5;
+
+type Answer = String<SERIAL_ANSWER_MAX_BYTES>;
+
+/// State the three loops share; all run on one executor, so plain cells do.
+struct Link<'m, W> {
+    machine: &'m Machine,
+    tx: Mutex<NoopRawMutex, W>,
+    bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
+    /// Feed rate of the motion in progress, for status reports.
+    feed_mm_per_min: Cell<f32>,
+    /// The last motion line from the host was a `$J=` jog (a jog cancel aborts only that).
+    jogging: Cell<bool>,
+}
+
+/// Speaks GRBL on the host link forever.
+pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
+    let link = Link {
+        machine,
+        tx: Mutex::new(tx),
+        bytes: Pipe::new(),
+        feed_mm_per_min: Cell::new(0.0),
+        jogging: Cell::new(false),
+    };
+    link.send(|a| report::welcome(a)).await;
+    join3(receive(&link, rx), lines(&link), faults(&link)).await;
+    unreachable!("the serial loops never end")
+}
+
+impl<W: Write> Link<'_, W> {
+    /// Writes one answer, built by `write`, as a whole.
+    async fn send(&self, write: impl FnOnce(&mut Answer) -> core::fmt::Result) {
+        let mut answer = Answer::new();
+        if write(&mut answer).is_err() {
+            // Every answer fits by construction; should one not, say so rather than cut it.
+            answer.clear();
+            let _ = report::message(&mut answer, "answer too long");
+        }
+        let mut tx = self.tx.lock().await;
+        if tx.write_all(answer.as_bytes()).await.is_err() || tx.flush().await.is_err() {
+            warn!("host link write failed");
+        }
+    }
+
+    async fn status_report(&self) {
+        let status = self.machine.status();
+        let settings = self.machine.settings();
+        let feed = if status.state == RunState::Idle { 0.0 } else { self.feed_mm_per_min.get() };
+        self.send(|a| report::status(a, &status, &settings, feed, None)).await;
+    }
+
+    /// Waits until nothing is queued or moving.
+    async fn machine_at_rest(&self) {
+        while !self.machine.is_idle() {
+            Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
+        }
+    }
+}
+
+/// Reads the link: realtime bytes act now, the rest go to the line loop in order.
+async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
+    let mut buf = [0u8; 32];
+    loop {
+        let n = match rx.read(&mut buf).await {
+            Ok(n) => n,
+            Err(_) => {
+                warn!("host link read error");
+                continue;
+            }
+        };
+        for &byte in &buf[..n] {
+            match realtime(byte) {
+                Some(Realtime::StatusQuery) => link.status_report().await,
+                Some(Realtime::FeedHold) => link.machine.control.signal(Control::Hold),
+                Some(Realtime::CycleStart) => link.machine.control.signal(Control::Resume),
+                Some(Realtime::JogCancel) if link.jogging.get() => link.machine.control.signal(Control::Abort),
+                Some(Realtime::Reset) => {
+                    link.machine.control.signal(Control::Abort);
+                    // In order with the lines: the line loop resets the parser when it meets it.
+                    link.bytes.write_all(&[byte]).await;
+                }
+                Some(Realtime::JogCancel | Realtime::Unsupported(_)) => {}
+                None => link.bytes.write_all(&[byte]).await,
+            }
+        }
+    }
+}
+
+/// Assembles, parses and carries out lines, answering each.
+async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
+    let machine = link.machine;
+    let mut assembler = LineAssembler::new();
+    let mut gcode = GcodeState::new();
+    let mut buf = [0u8; 32];
+    loop {
+        let n = link.bytes.read(&mut buf).await;
+        for &byte in &buf[..n] {
+            if byte == 0x18 {
+                assembler.clear();
+                link.machine_at_rest().await;
+                gcode.reset(machine.position(), &machine.settings());
+                link.jogging.set(false);
+                link.send(|a| report::welcome(a)).await;
+                continue;
+            }
+            let result = match assembler.push(byte) {
+                None => continue,
+                Some(LineEvent::Line(line)) => {
+                    let settings = machine.settings();
+                    if machine.is_idle() {
+                        // The keypad, an abort or a curve that stopped early may have moved the
+                        // pen elsewhere than the parser planned.
+                        gcode.sync_position(machine.position(), &settings);
+                    }
+                    match gcode.execute(line, &settings, machine.run_state()) {
+                        Ok(commands) => {
+                            let mut r = Ok(());
+                            for command in commands {
+                                r = carry_out(link, &gcode, &settings, command).await;
+                                if r.is_err() {
+                                    break;
+                                }
+                            }
+                            r
+                        }
+                        Err(e) => Err(e),
+                    }
+                }
+                Some(other) => Err(other.error().unwrap_or(GrblError::ExpectedCommandLetter)),
+            };
+            match result {
+                Ok(()) => link.send(|a| report::ok(a)).await,
+                Err(e) => link.send(|a| report::error(a, e)).await,
+            }
+        }
+    }
+}
+
+/// Carries out one command of a parsed line.
+async fn carry_out<W: Write>(
+    link: &Link<'_, W>,
+    gcode: &GcodeState,
+    settings: &Settings,
+    command: Command,
+) -> Result<(), GrblError> {
+    let machine = link.machine;
+    match command {
+        Command::Job(job) => queue(link, job, false).await,
+        Command::Curve { shape, feed, .. } => queue(link, Job { shape, feed }, false).await,
+        Command::Jog(job) => queue(link, job, true).await,
+        Command::Dwell { ms } => {
+            link.machine_at_rest().await;
+            Timer::after(Duration::from_millis(ms as u64)).await;
+        }
+        Command::Pause => {
+            link.machine_at_rest().await;
+            machine.control.signal(Control::Hold);
+        }
+        Command::ProgramEnd => {
+            link.machine_at_rest().await;
+            link.send(|a| report::message(a, "Pgm End")).await;
+        }
+        Command::SetSetting { id, value } => {
+            machine.update_settings(|s| s.set(id, value)).map_err(|_| GrblError::InvalidStatement)?;
+        }
+        Command::RestoreSettings => machine.update_settings(|s| *s = Settings::default()),
+        Command::Report(kind) => {
+            link.send(|a| match kind {
+                Report::Help => report::help(a),
+                Report::Settings => report::settings(a, settings),
+                Report::ParserState => report::parser_state(a, gcode, settings),
+                Report::Parameters => report::parameters(a, gcode),
+                Report::BuildInfo => report::build_info(a, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES),
+            })
+            .await
+        }
+        Command::Unlock => {
+            if machine.run_state() == RunState::Alarm {
+                machine.set_run_state(RunState::Idle);
+            }
+            link.send(|a| report::message(a, "Caution: Unlocked")).await;
+        }
+    }
+    Ok(())
+}
+
+/// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued.
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job, jog: bool) {
+    link.jogging.set(jog);
+    if let crate::job::Feed::MmPerMin(f) = job.feed {
+        link.feed_mm_per_min.set(f);
+    }
+    link.machine.jobs.send(job).await;
+}
+
+/// Tells the host when a curve could not start or stopped part way.
+async fn faults<W: Write>(link: &Link<'_, W>) -> ! {
+    loop {
+        let fault = link.machine.faults.wait().await;
+        let mut text: String<64> = String::new();
+        let _ = match fault {
+            MotionFault::Setup(e) => write!(text, "Curve refused: {:?}", e),
+            MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}", e),
+        };
+        link.send(|a| report::message(a, &text)).await;
+    }
+}
