@@ -316,6 +316,35 @@ impl Gate {
     }
 }
 
+/// On an axis, inside the curve, with the curve's crossing of that axis more than half a step
+/// farther out (the tip of an ellipse narrower than a step, or a start inside the curve): the
+/// move out along the axis. Not right after moving in along the same axis (`last`), so that a
+/// trace turns at a tip instead of climbing it again.
+fn climb_move<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> Option<(i64, i64)> {
+    if f >= D::from(0) {
+        return None;
+    }
+    let (m, w, c) = if p.0 == 0 {
+        ((0, p.1.signum()), weights.1, p.1)
+    } else if p.1 == 0 {
+        ((p.0.signum(), 0), weights.0, p.0)
+    } else {
+        return None;
+    };
+    if m == (0, 0) || last == (-m.0, -m.1) {
+        return None;
+    }
+    // 4·F half a step out: 4F + w·(4·|c| + 1).
+    let mid = D::from(4) * f + D::from(w) * D::from(4 * c.abs() + 1);
+    if mid < D::from(0) { Some(m) } else { None }
+}
+
+/// See [`Tracer::progress_quadrant`].
+fn progress_quadrant<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> u8 {
+    let q = quadrant(p.0, p.1);
+    if climb_move(p, f, last, weights).is_some() { (q + 3) % 4 } else { q }
+}
+
 /// [`quadrant`] of a fractional point.
 fn quadrant_f(p: (f64, f64)) -> u8 {
     let (x, y) = p;
@@ -387,11 +416,12 @@ impl<D: Discriminant> Tracer<D> {
         let (ex, ey) = (end.0, if mirror { -end.1 } else { end.1 });
         let (wx, wy) = weights;
         let f = D::from(wx) * D::from(x) * D::from(x) + D::from(wy) * D::from(y) * D::from(y) - c;
-        let q = quadrant(x, y);
+        let q = progress_quadrant((x, y), f, (0, 0), weights);
         let frame = |p: (f64, f64)| (p.0, if mirror { -p.1 } else { p.1 });
         let (needed, crossed, gate, phase) = match plan {
             Plan::ToEnd { near } => {
-                let eq = quadrant(ex, ey);
+                let fe = D::from(wx) * D::from(ex) * D::from(ex) + D::from(wy) * D::from(ey) * D::from(ey) - c;
+                let eq = progress_quadrant((ex, ey), fe, (0, 0), weights);
                 let mut needed = (eq + 4 - q) % 4;
                 // Same quadrant: the end must lie strictly ahead, else it takes a full turn.
                 let ahead = cross((x, y), (ex, ey));
@@ -495,27 +525,15 @@ impl<D: Discriminant> Tracer<D> {
         (if m.0 != 0 { self.df_x(m.0) } else { zero }) + (if m.1 != 0 { self.df_y(m.1) } else { zero })
     }
 
-    /// On an axis, inside the curve, with the curve's crossing of that axis more than half a
-    /// step farther out (the tip of an ellipse narrower than a step, or a start inside the
-    /// curve): the move out along the axis. Not right after moving in along the same axis, so
-    /// that the trace turns at a tip instead of climbing it again.
     fn climb(&self) -> Option<(i64, i64)> {
-        if self.f >= D::from(0) {
-            return None;
-        }
-        let (m, w, c) = if self.x == 0 {
-            ((0, self.y.signum()), self.wy, self.y)
-        } else if self.y == 0 {
-            ((self.x.signum(), 0), self.wx, self.x)
-        } else {
-            return None;
-        };
-        if self.last == (-m.0, -m.1) {
-            return None;
-        }
-        // 4·F half a step out: 4F + w·(4·|c| + 1).
-        let mid = D::from(4) * self.f + D::from(w) * D::from(4 * c.abs() + 1);
-        if mid < D::from(0) { Some(m) } else { None }
+        climb_move((self.x, self.y), self.f, self.last, (self.wx, self.wy))
+    }
+
+    /// The quadrant the trace counts point `p` (with discriminant `f`, reached by move `last`)
+    /// in: its own, except while it climbs an axis toward a tip, which still belongs to the
+    /// quadrant before the tip.
+    fn progress_quadrant(&self, p: (i64, i64), f: D, last: (i64, i64)) -> u8 {
+        progress_quadrant(p, f, last, (self.wx, self.wy))
     }
 
     /// The move the curve rule chooses at the current point.
@@ -567,7 +585,7 @@ impl<D: Discriminant> Tracer<D> {
     fn curve_step(&mut self) -> Option<Step> {
         let m = self.curve_move();
         let n = (self.x + m.0, self.y + m.1);
-        let nq = quadrant(n.0, n.1);
+        let nq = self.progress_quadrant(n, self.f + self.df(m), m);
         let crossed = self.crossed.saturating_add((nq != self.quadrant) as u8);
         let end = (self.ex, self.ey);
         let reached = crossed > self.needed || (crossed == self.needed && (n == end || self.gate.passed_by(n)));

@@ -428,14 +428,18 @@ mod tests {
         // cutting 6 steps off each tip; the trace climbs to the tip and comes back.
         let (a, b) = (2, 50);
         let s = Point::new(a, 0);
-        let table: Vec<Point> = table_walk(a as i64, b as i64, (a as i64, 0), (0, b as i64), Ccw, false)
-            .iter()
-            .scan(s, |p, st| {
-                *p = p.stepped(*st);
-                Some(*p)
-            })
-            .collect();
-        assert!(!table.contains(&Point::new(0, 48)), "the tables reach the tip after all");
+        // The literal first and second quadrant tables, 60 steps from (2, 0).
+        let (mut x, mut y) = (a as i64, 0i64);
+        let mut table = Vec::new();
+        for _ in 0..60 {
+            let f = (b * b) as i64 * x * x + (a * a) as i64 * y * y - (a * a * b * b) as i64;
+            let (ge, lt) = if x > 0 { (Step::XN, Step::YP) } else { (Step::YN, Step::XN) };
+            let st = if f >= 0 { ge } else { lt };
+            (x, y) = (x + st.x as i64, y + st.y as i64);
+            table.push((x, y));
+        }
+        assert!(table.contains(&(0, 44)) && table.contains(&(-1, 44)), "{table:?}");
+        assert!(!table.contains(&(0, 47)), "the tables reach the tip after all");
         for method in [Classic, Diagonal] {
             let mut e = EllipseInterp::new(s, Point::ORIGIN, a, b, s, Ccw, method).unwrap();
             let w = trace(&mut e, s, a, b, method);

@@ -1,0 +1,45 @@
+//! The machine driven from its own keypad, on the simulated board: keys in, pulses and LCD
+//! frames out.
+
+use servoplot::geom::Point;
+use servoplot::sim;
+
+#[test]
+fn the_line_mode_draws_the_same_line_as_g1_x10_y5() {
+    // Mode 2 (line), dX 10 mm #, dY 5 mm #.
+    let keys = sim::run_keys("2 1 0 # 5 #").unwrap();
+    let serial = sim::run_serial("G1 X10 Y5\n");
+    assert_eq!(keys.trace.counts(), [1000, 0, 500, 0]);
+    assert_eq!(keys.position, Point::new(1000, 500));
+    assert_eq!(keys.path(), serial.path(), "same steps in the same order");
+}
+
+#[test]
+fn a_negative_offset_typed_with_the_sign_key_draws_back_to_the_origin() {
+    // A toggles the sign, * is the decimal point: (+12.5, +4) then, in the same form, (-12.5, -4).
+    let report = sim::run_keys("2 1 2 * 5 # 4 # wait:3000 A 1 2 * 5 # A 4 #").unwrap();
+    assert_eq!(report.trace.counts(), [1250, 1250, 400, 400]);
+    assert_eq!(report.position, Point::ORIGIN);
+}
+
+#[test]
+fn the_lcd_shows_the_position_reached_without_stale_digits() {
+    let report = sim::run_keys("2 1 0 # 5 #").unwrap();
+    let (_, last) = report.frames.last().expect("the LCD was drawn");
+    let (_, first) = report.frames.first().unwrap();
+    assert!(first.lit() > 50, "the first frame shows the menu");
+    assert_ne!(first, last, "the screen changed with the position");
+    // Redraw the final state from scratch: identical to what the glass shows.
+    let again = sim::run_keys("2 1 0 # 5 # wait:1000").unwrap();
+    assert_eq!(again.frames.last().unwrap().1, *last);
+}
+
+#[test]
+fn holding_a_jog_key_moves_until_release_and_stops_on_a_step() {
+    // Mode 1 (jog), hold 6 (+X) for 1 s.
+    let report = sim::run_keys("1 6:1000").unwrap();
+    let [xf, xb, yf, yb] = report.trace.counts();
+    assert!(xf > 100, "moved +X: {xf}");
+    assert_eq!((xb, yf, yb), (0, 0, 0));
+    assert_eq!(report.position, Point::new(xf as i32, 0), "position is the pulses emitted");
+}
