@@ -62,6 +62,11 @@ pub fn next_deadline() -> Option<u64> {
     WAKE_AT.with(|w| w.borrow().as_ref().map(|(t, _)| *t))
 }
 
+/// Jumps to `t` (never backwards) without waking anything: an input arrives then.
+pub fn jump_to(t: u64) {
+    NOW_TICKS.with(|n| n.set(n.get().max(t)));
+}
+
 /// Jumps to the earliest timer deadline (never backwards) and wakes its waiters.
 /// Every timer re-arms itself when polled, so waking all waiters at the earliest deadline is
 /// exact: those not yet due simply ask again.

@@ -209,8 +209,17 @@ pub fn run(config: SimConfig) -> SimReport {
             timed_out = true;
             break;
         }
-        if !clock::jump_to_next_deadline() {
-            break;
+        // A timed input byte due before the next timer deadline comes first.
+        match (serial.next_timed_us(), clock::next_deadline()) {
+            (Some(t), deadline) if deadline.is_none_or(|d| t < d) => {
+                clock::jump_to(t);
+                serial.deliver_due();
+            }
+            _ => {
+                if !clock::jump_to_next_deadline() {
+                    break;
+                }
+            }
         }
     }
     let position = machine.position();

@@ -19,6 +19,8 @@ struct Link {
     input: VecDeque<u8>,
     /// Lines not yet sent, for paced input.
     unsent: VecDeque<Vec<u8>>,
+    /// Bytes sent at given virtual times, in order (a person pressing `!` mid-drawing).
+    timed: VecDeque<(u64, u8)>,
     /// Answers (`ok` / `error:`) still owed for lines sent.
     owed: usize,
     /// The output seen so far that does not end in a line end yet.
@@ -68,6 +70,41 @@ impl SimSerial {
         s
     }
 
+    /// Also sends `byte` at virtual time `t_us` (a realtime command such as `!` or `~`).
+    pub fn with_byte_at(self, t_us: u64, byte: u8) -> Self {
+        {
+            let mut l = self.link.borrow_mut();
+            let i = l.timed.partition_point(|(t, _)| *t <= t_us);
+            l.timed.insert(i, (t_us, byte));
+        }
+        self
+    }
+
+    /// When the next timed byte is due.
+    pub fn next_timed_us(&self) -> Option<u64> {
+        self.link.borrow().timed.front().map(|(t, _)| *t)
+    }
+
+    /// Sends the timed bytes due by now.
+    pub fn deliver_due(&self) {
+        let now = crate::sim::clock::now_ticks();
+        let mut l = self.link.borrow_mut();
+        let mut sent = false;
+        while let Some(&(t, b)) = l.timed.front() {
+            if t > now {
+                break;
+            }
+            l.timed.pop_front();
+            l.input.push_back(b);
+            sent = true;
+        }
+        if sent {
+            if let Some(w) = l.reader.take() {
+                w.wake();
+            }
+        }
+    }
+
     /// Also print every answer on standard output as it is written.
     pub fn echo_to_stdout(self) -> Self {
         self.link.borrow_mut().echo_stdout = true;
@@ -82,7 +119,7 @@ impl SimSerial {
     /// True when no input is waiting and none can come any more.
     pub fn input_done(&self) -> bool {
         let l = self.link.borrow();
-        l.input.is_empty() && l.unsent.is_empty() && (l.live.is_none() || l.live_ended)
+        l.input.is_empty() && l.unsent.is_empty() && l.timed.is_empty() && (l.live.is_none() || l.live_ended)
     }
 
     /// Takes what standard input has sent; with `block`, waits (in real time) for it.
