@@ -24,7 +24,41 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
   --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
                   with --serial it starts once the serial drawing is done
   --keys-text S   the keypad script given inline
-  --out DIR       where the pictures go";
+  --out DIR       where the pictures go
+
+Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
+
+/// Firmware log lines on standard error, stamped with virtual time; the level comes from the
+/// `SERVOPLOT_LOG` variable (`error`, `warn`, `info`, `debug`, `trace`), off when it is unset.
+struct StderrLog;
+
+impl log::Log for StderrLog {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.level() <= log::max_level()
+    }
+
+    fn log(&self, record: &log::Record) {
+        let t_s = sim::clock::now_ticks() as f64 / 1e6;
+        eprintln!("{t_s:10.6} {:<5} {}", record.level(), record.args());
+    }
+
+    fn flush(&self) {}
+}
+
+fn init_log() {
+    let level = match std::env::var("SERVOPLOT_LOG").as_deref() {
+        Ok("error") => log::LevelFilter::Error,
+        Ok("warn") => log::LevelFilter::Warn,
+        Ok("info") => log::LevelFilter::Info,
+        Ok("debug") => log::LevelFilter::Debug,
+        Ok("trace") => log::LevelFilter::Trace,
+        _ => return,
+    };
+    static LOG: StderrLog = StderrLog;
+    if log::set_logger(&LOG).is_ok() {
+        log::set_max_level(level);
+    }
+}
 
 struct Args {
     serial: Option<String>,
@@ -53,6 +87,7 @@ fn parse_args() -> Result<Args, String> {
 }
 
 pub fn main() -> ExitCode {
+    init_log();
     let args = match parse_args() {
         Ok(a) => a,
         Err(e) => {

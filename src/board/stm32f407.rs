@@ -1,8 +1,10 @@
 //! The STM32F407VG board: clocks, the whole pin map, peripherals and executors.
 //!
-//! Nothing else in the firmware names a pin or a peripheral instance. The pulse task runs on an
-//! interrupt executor (UART4's vector, unused as a UART) above everything else; keypad, serial,
-//! motion and LCD share the thread-mode executor, so a blocking LCD flush never delays a pulse.
+//! Nothing else in the firmware names a pin or a peripheral instance. Three priorities:
+//! the pulse task runs on an interrupt executor (UART4's vector, unused as a UART) above
+//! everything else; the motion task on a second one just below it (UART5's vector), so the step
+//! queue stays full while a blocking LCD flush (~20 ms) runs; keypad, serial and LCD share the
+//! thread-mode executor.
 //!
 //! | signal              | pin  | notes                                              |
 //! |---------------------|------|----------------------------------------------------|
@@ -51,6 +53,7 @@ bind_interrupts!(struct Irqs {
 });
 
 static EXECUTOR_PULSE: InterruptExecutor = InterruptExecutor::new();
+static EXECUTOR_MOTION: InterruptExecutor = InterruptExecutor::new();
 static MACHINE: StaticCell<Machine> = StaticCell::new();
 
 #[interrupt]
@@ -59,11 +62,27 @@ unsafe fn UART4() {
     unsafe { EXECUTOR_PULSE.on_interrupt() }
 }
 
+#[interrupt]
+unsafe fn UART5() {
+    // SAFETY: UART5 serves only as the motion executor's software interrupt.
+    unsafe { EXECUTOR_MOTION.on_interrupt() }
+}
+
+/// Busy-waits with the CPU's cycle count: exact to a cycle, where a timer tick is 1 µs.
+struct CycleDelay;
+
+impl embedded_hal::delay::DelayNs for CycleDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        const CPU_MHZ: u32 = 168;
+        cortex_m::asm::delay((ns.saturating_mul(CPU_MHZ)).div_ceil(1000));
+    }
+}
+
 type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, Delay>, Output<'static>, Delay>;
 
 #[embassy_executor::task]
 async fn pulse(machine: &'static Machine, axes: [AxisPins<Output<'static>>; 2]) -> ! {
-    tasks::pulse::run(machine, axes, Delay).await
+    tasks::pulse::run(machine, axes, CycleDelay).await
 }
 
 #[embassy_executor::task]
@@ -145,6 +164,9 @@ async fn main(spawner: Spawner) {
     interrupt::UART4.set_priority(Priority::P6);
     let pulse_spawner = EXECUTOR_PULSE.start(interrupt::UART4);
     pulse_spawner.spawn(unwrap!(pulse(machine, axes)));
+    interrupt::UART5.set_priority(Priority::P7);
+    let motion_spawner = EXECUTOR_MOTION.start(interrupt::UART5);
+    motion_spawner.spawn(unwrap!(motion(machine)));
 
     let columns = [
         Output::new(p.PD0, Level::High, Speed::Low),
@@ -184,6 +206,4 @@ async fn main(spawner: Spawner) {
     let lcd_cs = Output::new(p.PB12, Level::Low, Speed::Low);
     let lcd_rst = Output::new(p.PB11, Level::High, Speed::Low);
     spawner.spawn(unwrap!(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));
-
-    spawner.spawn(unwrap!(motion(machine)));
 }

@@ -31,6 +31,7 @@ pub async fn run(machine: &Machine) -> ! {
             match Curve::for_job(&job, planned_end, &settings) {
                 Ok(curve) => {
                     planned_end = curve.end();
+                    info!("job planned to ({}, {}) steps", planned_end.x, planned_end.y);
                     machine.set_fault(None);
                     if planner.push(curve, job.feed, settings.method).is_err() {
                         // is_full() was false just now; nothing else pushes.
@@ -63,6 +64,9 @@ pub async fn run(machine: &Machine) -> ! {
                         machine.pulses_done.wait().await;
                     }
                     planned_end = machine.position();
+                    if machine.run_state() != RunState::Idle {
+                        info!("at rest at ({}, {}) steps", planned_end.x, planned_end.y);
+                    }
                     machine.set_run_state(RunState::Idle);
                 } else {
                     machine.set_run_state(RunState::Hold);
