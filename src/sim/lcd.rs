@@ -7,6 +7,7 @@
 
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::vec::Vec;
 
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 
@@ -30,6 +31,11 @@ impl Frame {
 /// The controller's state as far as graphics mode needs it.
 #[derive(Debug)]
 pub struct St7920Model {
+    /// What the glass showed each time chip select fell after new pixels were written, with the
+    /// virtual time.
+    pub frames: Vec<(u64, Frame)>,
+    /// Pixels were written since the last frame.
+    written: bool,
     gdram: [[u8; GDRAM_ROW_BYTES]; GDRAM_ROWS],
     /// Bytes of the frame in progress.
     frame: [u8; 3],
@@ -47,6 +53,8 @@ pub struct St7920Model {
 impl Default for St7920Model {
     fn default() -> Self {
         St7920Model {
+            frames: Vec::new(),
+            written: false,
             gdram: [[0; GDRAM_ROW_BYTES]; GDRAM_ROWS],
             frame: [0; 3],
             frame_len: 0,
@@ -100,6 +108,7 @@ impl St7920Model {
     }
 
     fn data(&mut self, d: u8) {
+        self.written = true;
         self.gdram[self.row][self.col_byte] = d;
         self.col_byte = (self.col_byte + 1) % GDRAM_ROW_BYTES;
         self.expect_vertical = true;
@@ -114,6 +123,35 @@ impl St7920Model {
             }
         }
         f
+    }
+}
+
+/// The controller's chip select (RS pin, active high) and reset lines.
+pub enum LcdPin {
+    /// Chip select: when it falls after pixels were written, the glass shows a new frame.
+    ChipSelect(Rc<RefCell<St7920Model>>),
+    Reset,
+}
+
+impl embedded_hal::digital::ErrorType for LcdPin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for LcdPin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        if let LcdPin::ChipSelect(model) = self {
+            let mut m = model.borrow_mut();
+            if m.written {
+                m.written = false;
+                let frame = m.visible();
+                m.frames.push((crate::sim::clock::now_ticks(), frame));
+            }
+        }
+        Ok(())
+    }
+
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        Ok(())
     }
 }
 
@@ -145,7 +183,6 @@ impl SpiDevice for SimSpi {
 mod tests {
     use super::*;
     use crate::sim::clock::FreeDelay;
-    use crate::sim::pins::NoPin;
     use embedded_graphics::pixelcolor::BinaryColor;
     use embedded_graphics::prelude::*;
     use embedded_graphics::primitives::{PrimitiveStyle, Rectangle};
@@ -153,7 +190,8 @@ mod tests {
     #[test]
     fn the_driver_region_flush_lands_on_the_visible_pixels() {
         let spi = SimSpi::default();
-        let mut lcd = st7920::ST7920::new(spi.clone(), NoPin, None::<NoPin>, false);
+        let cs = LcdPin::ChipSelect(spi.model.clone());
+        let mut lcd = st7920::ST7920::new(spi.clone(), LcdPin::Reset, Some(cs), false);
         lcd.init(&mut FreeDelay).unwrap();
         Rectangle::new(Point::new(100, 3), Size::new(22, 2))
             .into_styled(PrimitiveStyle::with_fill(BinaryColor::On))
@@ -162,6 +200,8 @@ mod tests {
         lcd.flush_region(0, 0, SCREEN_WIDTH_PX as u8, SCREEN_HEIGHT_PX as u8, &mut FreeDelay).unwrap();
         let f = spi.model.borrow().visible();
         assert_eq!(spi.model.borrow().bad_frames, 0);
+        assert_eq!(spi.model.borrow().frames.len(), 1, "one frame when chip select fell after the flush");
+        assert_eq!(spi.model.borrow().frames[0].1, f);
         assert_eq!(f.lit(), 44);
         assert!(f.pixels[3][100] && f.pixels[4][121] && !f.pixels[5][100] && !f.pixels[3][99]);
     }

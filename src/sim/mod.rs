@@ -24,17 +24,15 @@ use std::task::Wake;
 use std::vec::Vec;
 
 use embassy_futures::join::join5;
-use embedded_graphics::draw_target::DrawTarget;
-use embedded_graphics::pixelcolor::BinaryColor;
 
 use crate::geom::{Axis, Point};
 use crate::machine::Machine;
 use crate::settings::Settings;
-use crate::tasks::{self, lcd::Lcd, lcd::St7920Lcd, pulse::AxisPins};
+use crate::tasks::{self, lcd::St7920Lcd, pulse::AxisPins};
 use clock::{BusyDelay, FreeDelay};
 use keys::{KeyMatrix, KeyScript};
-use lcd::{Frame, SimSpi};
-use pins::{NoPin, PulseTrace, TracePin};
+use lcd::{Frame, LcdPin, SimSpi};
+use pins::{PulseTrace, TracePin};
 use serial::SimSerial;
 
 /// After the inputs are used up and the machine rests, the run goes on this long so the LCD
@@ -97,43 +95,6 @@ impl SimReport {
     }
 }
 
-/// The simulated LCD: the real driver on a model controller, keeping a copy of every frame.
-struct SimLcd {
-    inner: St7920Lcd<SimSpi, NoPin, FreeDelay>,
-    spi: SimSpi,
-    frames: Rc<RefCell<Vec<(u64, Frame)>>>,
-}
-
-impl embedded_graphics::geometry::OriginDimensions for SimLcd {
-    fn size(&self) -> embedded_graphics::geometry::Size {
-        self.inner.size()
-    }
-}
-
-impl DrawTarget for SimLcd {
-    type Color = BinaryColor;
-    type Error = core::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<BinaryColor>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        self.inner.draw_iter(pixels)
-    }
-}
-
-impl Lcd for SimLcd {
-    fn init(&mut self) {
-        self.inner.init();
-    }
-
-    fn show(&mut self) {
-        self.inner.show();
-        let frame = self.spi.model.borrow().visible();
-        self.frames.borrow_mut().push((clock::now_ticks(), frame));
-    }
-}
-
 struct FlagWaker(AtomicBool);
 
 impl Wake for FlagWaker {
@@ -158,9 +119,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let columns = [0, 1, 2, 3].map(|c| matrix.column(c));
     let rows = [0, 1, 2, 3].map(|r| matrix.row(r));
     let serial = config.serial;
-    let frames = Rc::new(RefCell::new(Vec::new()));
     let spi = SimSpi::default();
-    let lcd = SimLcd { inner: St7920Lcd::new(spi.clone(), NoPin, NoPin, FreeDelay), spi, frames: frames.clone() };
+    let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
 
     let firmware = join5(
         tasks::pulse::run(&machine, axes, BusyDelay),
@@ -228,7 +188,7 @@ pub fn run(config: SimConfig) -> SimReport {
     drop(firmware);
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
-    let frames = core::mem::take(&mut *frames.borrow_mut());
+    let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
     SimReport { trace, frames, serial_out: serial.output(), position, settings, end_us, timed_out }
 }
 

@@ -143,20 +143,3 @@ impl embedded_hal::digital::OutputPin for TracePin {
         Ok(())
     }
 }
-
-/// An output nobody listens to (the LCD's reset line, for one).
-pub struct NoPin;
-
-impl embedded_hal::digital::ErrorType for NoPin {
-    type Error = core::convert::Infallible;
-}
-
-impl embedded_hal::digital::OutputPin for NoPin {
-    fn set_low(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
-
-    fn set_high(&mut self) -> Result<(), Self::Error> {
-        Ok(())
-    }
-}
