@@ -3,20 +3,18 @@
 //! The ellipse with semi-axis `a` along X and `b` along Y is the zero set of
 //! `F = b²x² + a²y² − a²b²` around its centre. It is traced by the same rules as circles (see
 //! [`crate::interp::arc`]): `classic` steps one axis at a time, inward when `F >= 0` and
-//! outward otherwise (error < 1 step, a full ellipse started on an axis takes `4(a + b)`
+//! outward otherwise (error <= 1 step, a full ellipse started on an axis takes `4(a + b)`
 //! steps); `diagonal` picks between the inward, outward and diagonal moves by a midpoint test
 //! (error <= 0.5 step, about `4·√(a² + b²)` steps for a full ellipse). `F` is kept in `i128`:
-//! `a²b²` reaches 10²⁴ at [`MAX_RADIUS_STEPS`].
+//! `a²b²` reaches 10²⁴ at [`MAX_RADIUS_STEPS`]. Tips narrower than a step are climbed and
+//! come back along the axis instead of being cut off (see [`crate::interp::arc`]).
 //!
 //! Start and end points are lattice points and so lie slightly off the ideal ellipse; both may
 //! be up to [`ARC_END_TOLERANCE_STEPS`] away (measured as the true Euclidean distance, see
 //! [`distance_to_ellipse`]). The trace ends exactly on the end point.
 
 use crate::geom::{Point, Rotation, Step};
-use crate::interp::arc::{
-    offset, point_at, round, ArcError, Plan, Tracer, ARC_END_TOLERANCE_STEPS,
-    MAX_RADIUS_STEPS,
-};
+use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, MAX_RADIUS_STEPS, Plan, Tracer, offset, point_at, round};
 use crate::interp::{CurveError, Interpolator, Method, Tangent};
 
 /// Bisection rounds of [`distance_to_ellipse`]; enough to exhaust `f64` precision.
@@ -38,7 +36,15 @@ impl EllipseInterp {
     /// `start` and `end` may each lie up to [`ARC_END_TOLERANCE_STEPS`] off the ellipse; the
     /// trace still ends exactly on `end`. `end == start`, or an end on the ray from the centre
     /// through the start, means the full ellipse (one turn).
-    pub fn new(start: Point, center: Point, a: i32, b: i32, end: Point, rotation: Rotation, method: Method) -> Result<Self, ArcError> {
+    pub fn new(
+        start: Point,
+        center: Point,
+        a: i32,
+        b: i32,
+        end: Point,
+        rotation: Rotation,
+        method: Method,
+    ) -> Result<Self, ArcError> {
         if a <= 0 || b <= 0 {
             return Err(ArcError::ZeroRadius);
         }
@@ -66,12 +72,20 @@ impl EllipseInterp {
     /// `start_angle_rad` (the point `center + (a·cos t, b·sin t)`); the centre is rounded to the
     /// lattice, so `start` is within 0.71 step of the ellipse.
     ///
-    /// A positive `sweep_rad` turns counter-clockwise, a negative one clockwise; `|sweep_rad|
-    /// >= 2π` draws the full ellipse (one turn). The end is the lattice point nearest to the
-    /// ideal end at parametric angle `start_angle + sweep` ([`end`](Self::end) tells it). An arc
-    /// shorter than the rounding of its end takes no steps; one whose rounded end falls behind
-    /// its start is drawn as the short straight move it really is.
-    pub fn from_angles(start: Point, a: i32, b: i32, start_angle_rad: f32, sweep_rad: f32, method: Method) -> Result<Self, ArcError> {
+    /// A positive `sweep_rad` turns counter-clockwise, a negative one clockwise; a sweep of at
+    /// least 2π either way draws the full ellipse (one turn). The end is the lattice point
+    /// nearest to the ideal end at parametric angle `start_angle + sweep` ([`end`](Self::end)
+    /// tells it). The number of quadrants swept comes from the angles, not from the rounded
+    /// points, so rounding never turns a short arc into a full turn or back: an arc shorter
+    /// than half a turn whose end rounds onto the start takes no steps.
+    pub fn from_angles(
+        start: Point,
+        a: i32,
+        b: i32,
+        start_angle_rad: f32,
+        sweep_rad: f32,
+        method: Method,
+    ) -> Result<Self, ArcError> {
         if !start_angle_rad.is_finite() || !sweep_rad.is_finite() {
             return Err(ArcError::NotFinite);
         }
@@ -100,7 +114,8 @@ impl EllipseInterp {
             (e, Plan::between(from, to, sweep, e == s))
         };
         if e == (0, 0) {
-            // Only reachable for a tiny ellipse whose end rounds to its centre.
+            // Cannot happen with semi-axes of a step or more (one of |a·cos|, |b·sin| is at
+            // least 0.71); refused rather than traced should it ever.
             return Err(ArcError::EndOffCurve);
         }
         let end = point_at(center, e)?;
@@ -108,7 +123,17 @@ impl EllipseInterp {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn build(s: (i64, i64), e: (i64, i64), a: i32, b: i32, center: Point, end: Point, rotation: Rotation, method: Method, plan: Plan) -> Self {
+    fn build(
+        s: (i64, i64),
+        e: (i64, i64),
+        a: i32,
+        b: i32,
+        center: Point,
+        end: Point,
+        rotation: Rotation,
+        method: Method,
+        plan: Plan,
+    ) -> Self {
         let (a2, b2) = (a as i64 * a as i64, b as i64 * b as i64);
         let c = a2 as i128 * b2 as i128;
         let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a as i64, b as i64), rotation, method);
@@ -157,11 +182,8 @@ pub fn distance_to_ellipse(a: f64, b: f64, x: f64, y: f64) -> f64 {
 pub fn nearest_on_ellipse(a: f64, b: f64, x: f64, y: f64) -> (f64, f64) {
     // Work in the first quadrant with the major axis first.
     let swap = a < b;
-    let (e0, e1, y0, y1) = if swap {
-        (b, a, libm::fabs(y), libm::fabs(x))
-    } else {
-        (a, b, libm::fabs(x), libm::fabs(y))
-    };
+    let (e0, e1, y0, y1) =
+        if swap { (b, a, libm::fabs(y), libm::fabs(x)) } else { (a, b, libm::fabs(x), libm::fabs(y)) };
     let (x0, x1) = if y1 > 0.0 {
         if y0 > 0.0 {
             let (z0, z1) = (y0 / e0, y1 / e1);
@@ -217,17 +239,17 @@ fn root(r0: f64, z0: f64, z1: f64, g: f64) -> f64 {
 mod tests {
     extern crate std;
     use super::*;
-    use crate::interp::arc::test_support::*;
     use crate::interp::arc::ArcInterp;
+    use crate::interp::arc::test_support::*;
+    use Method::{Classic, Diagonal};
+    use Rotation::{Clockwise as Cw, CounterClockwise as Ccw};
     use core::f64::consts::{FRAC_PI_2, PI, TAU};
     use proptest::prelude::*;
     use std::vec::Vec;
-    use Method::{Classic, Diagonal};
-    use Rotation::{Clockwise as Cw, CounterClockwise as Ccw};
 
     impl EllipseInterp {
         fn tail_steps(&self) -> u32 {
-            self.tracer.tail_steps
+            self.tracer.tail_steps()
         }
     }
 
@@ -240,11 +262,28 @@ mod tests {
         distance_to_ellipse(a as f64, b as f64, d.0 as f64, d.1 as f64)
     }
 
-    /// Parametric angle of the point of the ellipse nearest to `p`.
-    fn param(p: Point, c: Point, a: i32, b: i32) -> f64 {
-        let d = offset(p, c);
+    /// True when `p` and `q` lie on one ray from `c`.
+    fn same_ray(p: Point, q: Point, c: Point) -> bool {
+        let (u, v) = (offset(p, c), offset(q, c));
+        u.0 * v.1 == u.1 * v.0 && u.0 * v.0 + u.1 * v.1 > 0
+    }
+
+    /// Parametric angle of the point of the ellipse nearest to `start`. A start on an axis
+    /// inside a thin tip is as near to both sides of the tip: the tip counts as behind it.
+    fn start_param(start: Point, c: Point, a: i32, b: i32, sign: f64) -> f64 {
+        let d = offset(start, c);
         let (x, y) = nearest_on_ellipse(a as f64, b as f64, d.0 as f64, d.1 as f64);
-        libm::atan2(y / b as f64, x / a as f64)
+        let at = |x: f64, y: f64| libm::atan2(y / b as f64, x / a as f64);
+        let t = at(x, y);
+        let other = if d.0 == 0 && x != 0.0 {
+            at(-x, y)
+        } else if d.1 == 0 && y != 0.0 {
+            at(x, -y)
+        } else {
+            return t;
+        };
+        // The later of the two in the direction of travel.
+        if travel(t, other, sign) < PI { other } else { t }
     }
 
     /// Travel from parametric angle `t0` to the point of the ellipse nearest to `end`. An end
@@ -280,7 +319,17 @@ mod tests {
     /// the straight finish short and within the bound plus the end's own distance; and the step
     /// count against the L1 / L∞ length of the ideal elliptic arc.
     #[allow(clippy::too_many_arguments)]
-    fn check(w: &Walk, start: Point, c: Point, a: i32, b: i32, end: Point, rotation: Rotation, method: Method, every: usize) {
+    fn check(
+        w: &Walk,
+        start: Point,
+        c: Point,
+        a: i32,
+        b: i32,
+        end: Point,
+        rotation: Rotation,
+        method: Method,
+        every: usize,
+    ) {
         assert_eq!(w.last(), end, "did not end on the end point");
         let bnd = bound(method);
         let end_off = off(end, c, a, b);
@@ -303,10 +352,8 @@ mod tests {
             assert!(w.tail_len() <= ARC_END_TOLERANCE_STEPS as usize + 2, "finish of {} steps", w.tail_len());
         }
         let sign = if rotation == Ccw { 1.0 } else { -1.0 };
-        let t0 = param(start, c, a, b);
-        let (sd, ed) = (offset(start, c), offset(end, c));
-        let same_ray = sd.0 * ed.1 == sd.1 * ed.0 && sd.0 * ed.0 + sd.1 * ed.1 > 0;
-        let sweep = if same_ray { TAU } else { end_travel(t0, end, c, a, b, sign) };
+        let t0 = start_param(start, c, a, b, sign);
+        let sweep = if same_ray(start, end, c) { TAU } else { end_travel(t0, end, c, a, b, sign) };
         let (af, bf) = (a as f64, b as f64);
         let (l1, linf) = ideal_lengths(
             |t| (af * libm::cos(t0 + sign * t), bf * libm::sin(t0 + sign * t)),
@@ -323,10 +370,22 @@ mod tests {
             slack += 4.0 * (tip + 1.0) * (axes + 1.0);
         }
         assert!((w.len() as f64 - analytic).abs() <= slack, "{} steps, analytic {analytic} ± {slack}", w.len());
+        if w.len() > STRAY_CHECK_MAX_STEPS {
+            return;
+        }
         let (cx, cy) = (c.x as f64, c.y as f64);
-        let h = curve_to_path(&w.points, |t| (cx + af * libm::cos(t0 + sign * t), cy + bf * libm::sin(t0 + sign * t)), 0.0, sweep, (8 * l1 as usize + 64).min(CURVE_SAMPLES_MAX));
+        let h = curve_to_path(
+            &w.points,
+            |t| (cx + af * libm::cos(t0 + sign * t), cy + bf * libm::sin(t0 + sign * t)),
+            0.0,
+            sweep,
+            (4 * l1 as usize + 64).min(CURVE_SAMPLES_MAX),
+        );
         let start_off = off(start, c, a, b);
-        assert!(h <= path_bound(method) + end_off.max(start_off) + MEASURE_TOLERANCE_STEPS, "the curve strays {h} from the path ({method:?}, a {a}, b {b})");
+        assert!(
+            h <= path_bound(method) + end_off.max(start_off) + MEASURE_TOLERANCE_STEPS,
+            "the curve strays {h} from the path ({method:?}, a {a}, b {b})"
+        );
     }
 
     #[test]
@@ -335,7 +394,8 @@ mod tests {
         let brute = |a: f64, b: f64, x: f64, y: f64| {
             let d = |t: f64| libm::hypot(a * libm::cos(t) - x, b * libm::sin(t) - y);
             let n = 20_000;
-            let k = (0..n).min_by(|i, j| d(TAU * *i as f64 / n as f64).total_cmp(&d(TAU * *j as f64 / n as f64))).unwrap();
+            let k =
+                (0..n).min_by(|i, j| d(TAU * *i as f64 / n as f64).total_cmp(&d(TAU * *j as f64 / n as f64))).unwrap();
             let (mut lo, mut hi) = (TAU * (k as f64 - 1.0) / n as f64, TAU * (k as f64 + 1.0) / n as f64);
             for _ in 0..200 {
                 let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
@@ -344,9 +404,17 @@ mod tests {
             d(0.5 * (lo + hi))
         };
         let cases = [
-            (5.0, 3.0, 6.0, 1.0), (5.0, 3.0, 0.0, 0.0), (5.0, 3.0, 4.0, 0.0), (5.0, 3.0, 0.0, -2.5),
-            (3.0, 5.0, 1.0, 4.0), (100.0, 1.0, 99.0, 1.0), (100.0, 1.0, -50.0, 0.3), (1.0, 100.0, 0.2, -99.0),
-            (7.0, 7.0, 3.0, 4.0), (200_000.0, 100_000.0, 150_001.0, 66_143.0), (2.0, 1.0, 1.0, 0.0),
+            (5.0, 3.0, 6.0, 1.0),
+            (5.0, 3.0, 0.0, 0.0),
+            (5.0, 3.0, 4.0, 0.0),
+            (5.0, 3.0, 0.0, -2.5),
+            (3.0, 5.0, 1.0, 4.0),
+            (100.0, 1.0, 99.0, 1.0),
+            (100.0, 1.0, -50.0, 0.3),
+            (1.0, 100.0, 0.2, -99.0),
+            (7.0, 7.0, 3.0, 4.0),
+            (200_000.0, 100_000.0, 150_001.0, 66_143.0),
+            (2.0, 1.0, 1.0, 0.0),
         ];
         for (a, b, x, y) in cases {
             let (got, want) = (distance_to_ellipse(a, b, x, y), brute(a, b, x, y));
@@ -411,9 +479,15 @@ mod tests {
                         for k in 1..=4 {
                             let e = if rotation == Ccw { axes[(i + k) % 4] } else { axes[(i + 4 - k) % 4] };
                             let (start, end) = (Point::new(s.0 as i32, s.1 as i32), Point::new(e.0 as i32, e.1 as i32));
-                            let mut el = EllipseInterp::new(start, Point::ORIGIN, a as i32, b as i32, end, rotation, Classic).unwrap();
+                            let mut el =
+                                EllipseInterp::new(start, Point::ORIGIN, a as i32, b as i32, end, rotation, Classic)
+                                    .unwrap();
                             let w = trace(&mut el, start, a as i32, b as i32, Classic);
-                            assert_eq!(w.steps, table_walk(a, b, *s, e, rotation, k == 4), "a {a} b {b} from {s:?}, {k} quarters {rotation:?}");
+                            assert_eq!(
+                                w.steps,
+                                table_walk(a, b, *s, e, rotation, k == 4),
+                                "a {a} b {b} from {s:?}, {k} quarters {rotation:?}"
+                            );
                             assert_eq!(w.len() as i64, (a + b) * k as i64, "a + b per quarter");
                         }
                     }
@@ -443,7 +517,10 @@ mod tests {
         for method in [Classic, Diagonal] {
             let mut e = EllipseInterp::new(s, Point::ORIGIN, a, b, s, Ccw, method).unwrap();
             let w = trace(&mut e, s, a, b, method);
-            assert!(w.points.contains(&Point::new(0, b)) && w.points.contains(&Point::new(0, -b)), "{method:?} cut a tip");
+            assert!(
+                w.points.contains(&Point::new(0, b)) && w.points.contains(&Point::new(0, -b)),
+                "{method:?} cut a tip"
+            );
             check(&w, s, Point::ORIGIN, a, b, s, Ccw, method, 1);
         }
     }
@@ -501,20 +578,35 @@ mod tests {
         assert_eq!(EllipseInterp::new(s, c, 0, 5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
         assert_eq!(EllipseInterp::new(s, c, 10, -5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
         assert_eq!(EllipseInterp::new(c, c, 10, 5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(EllipseInterp::new(Point::new(13, 0), c, 10, 5, s, Ccw, Classic).err(), Some(ArcError::StartOffCurve));
+        assert_eq!(
+            EllipseInterp::new(Point::new(13, 0), c, 10, 5, s, Ccw, Classic).err(),
+            Some(ArcError::StartOffCurve)
+        );
         assert!(EllipseInterp::new(Point::new(12, 0), c, 10, 5, s, Ccw, Classic).is_ok());
         assert_eq!(EllipseInterp::new(s, c, 10, 5, Point::new(0, 8), Ccw, Classic).err(), Some(ArcError::EndOffCurve));
-        assert_eq!(EllipseInterp::new(s, c, 10, 5, Point::new(0, 7), Cw, Diagonal).map(|e| e.end()), Ok(Point::new(0, 7)));
+        assert_eq!(
+            EllipseInterp::new(s, c, 10, 5, Point::new(0, 7), Cw, Diagonal).map(|e| e.end()),
+            Ok(Point::new(0, 7))
+        );
         assert_eq!(EllipseInterp::new(Point::new(2, 0), c, 2, 1, c, Ccw, Classic).err(), Some(ArcError::EndOffCurve));
         let far = MAX_RADIUS_STEPS + 1;
         assert_eq!(EllipseInterp::new(Point::new(far, 0), c, far, 5, s, Ccw, Classic).err(), Some(ArcError::TooLarge));
         let corner = Point::new(i32::MIN, i32::MAX);
-        assert_eq!(EllipseInterp::new(corner, Point::new(i32::MAX, 0), 100, 100, corner, Ccw, Classic).err(), Some(ArcError::StartOffCurve));
+        assert_eq!(
+            EllipseInterp::new(corner, Point::new(i32::MAX, 0), 100, 100, corner, Ccw, Classic).err(),
+            Some(ArcError::StartOffCurve)
+        );
         assert_eq!(EllipseInterp::from_angles(s, 0, 5, 0.0, 1.0, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(EllipseInterp::from_angles(s, 5, 5, f32::NEG_INFINITY, 1.0, Classic).err(), Some(ArcError::NotFinite));
+        assert_eq!(
+            EllipseInterp::from_angles(s, 5, 5, f32::NEG_INFINITY, 1.0, Classic).err(),
+            Some(ArcError::NotFinite)
+        );
         assert_eq!(EllipseInterp::from_angles(s, 5, 5, 0.0, f32::NAN, Classic).err(), Some(ArcError::NotFinite));
         assert_eq!(EllipseInterp::from_angles(s, 5, far, 0.0, 1.0, Classic).err(), Some(ArcError::TooLarge));
-        assert_eq!(EllipseInterp::from_angles(Point::new(i32::MIN + 3, 0), 100, 50, 0.0, 1.0, Classic).err(), Some(ArcError::TooLarge));
+        assert_eq!(
+            EllipseInterp::from_angles(Point::new(i32::MIN + 3, 0), 100, 50, 0.0, 1.0, Classic).err(),
+            Some(ArcError::TooLarge)
+        );
     }
 
     #[test]
@@ -560,7 +652,10 @@ mod tests {
                     let n = (wx * wx + wy * wy).sqrt();
                     assert!((t.x - wx / n).abs() < 1e-5 && (t.y - wy / n).abs() < 1e-5, "{t:?} at {p:?}");
                     let Some(step) = e.next_step().unwrap() else { break };
-                    assert!(t.x * step.x as f32 + t.y * step.y as f32 >= 0.0, "step {step:?} against the tangent at {p:?}");
+                    assert!(
+                        t.x * step.x as f32 + t.y * step.y as f32 >= 0.0,
+                        "step {step:?} against the tangent at {p:?}"
+                    );
                     p = p.stepped(step);
                 }
             }
@@ -574,13 +669,26 @@ mod tests {
             (200_000, 100_000, Point::new(100_000, 100_000), Point::new(100_000, 100_000), Ccw),
             (100_000, 200_000, Point::new(-100_000, -100_000), Point::new(-100_000, -100_000), Cw),
             (200_000, 1, Point::new(100_000, 100_000), Point::new(-300_000, 100_000), Cw),
-            (MAX_RADIUS_STEPS, MAX_RADIUS_STEPS / 2, Point::new(c.x + MAX_RADIUS_STEPS, c.y), Point::new(c.x, c.y + MAX_RADIUS_STEPS / 2), Ccw),
+            (
+                MAX_RADIUS_STEPS,
+                MAX_RADIUS_STEPS / 2,
+                Point::new(c.x + MAX_RADIUS_STEPS, c.y),
+                Point::new(c.x, c.y + MAX_RADIUS_STEPS / 2),
+                Ccw,
+            ),
         ];
         for (a, b, start, end, rotation) in cases {
             for method in [Classic, Diagonal] {
                 let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
                 let w = trace(&mut e, start, a, b, method);
                 check(&w, start, c, a, b, end, rotation, method, 17);
+                if (a, b) == (200_000, 100_000) {
+                    // The full ellipse from an axis: exactly 4(a + b) classic steps,
+                    // 4·√(a² + b²) ± 4 diagonal ones.
+                    let analytic = if method == Classic { 1_200_000.0 } else { 4.0 * libm::hypot(2e5, 1e5) };
+                    let slack = if method == Classic { 0.0 } else { 4.0 };
+                    assert!((w.len() as f64 - analytic).abs() <= slack, "{method:?}: {} steps", w.len());
+                }
             }
         }
     }
@@ -601,6 +709,7 @@ mod tests {
             let (c, method, rotation) = (Point::new(cx, cy), if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
             let (start, end) = (rounded(c, a, b, t0), rounded(c, a, b, t1));
             prop_assume!(start != c && end != c);
+            prop_assume!(end == start || !same_ray(start, end, c), "distinct ends on one ray mean a full turn");
             let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
             let w = trace(&mut e, start, a, b, method);
             check(&w, start, c, a, b, end, rotation, method, 1);
@@ -609,7 +718,7 @@ mod tests {
         /// Very flat ellipses, where one region of the curve is shorter than a step.
         #[test]
         fn flat_ellipses_stay_on_the_ellipse(
-            long in 50i32..2000, short in 1i32..4, along_x: bool, t0 in 0.0f64..TAU, full: bool, t1 in 0.0f64..TAU,
+            long in 20i32..600, short in 1i32..4, along_x: bool, t0 in 0.0f64..TAU, full: bool, t1 in 0.0f64..TAU,
             ccw: bool, classic: bool,
         ) {
             let (a, b) = if along_x { (long, short) } else { (short, long) };
@@ -618,6 +727,7 @@ mod tests {
             let start = rounded(c, a, b, t0);
             let end = if full { start } else { rounded(c, a, b, t1) };
             prop_assume!(start != c && end != c);
+            prop_assume!(end == start || !same_ray(start, end, c), "distinct ends on one ray mean a full turn");
             let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
             let w = trace(&mut e, start, a, b, method);
             check(&w, start, c, a, b, end, rotation, method, 1);
@@ -661,10 +771,11 @@ mod tests {
         ) {
             let (method, rotation) = (if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
             let (s, c, e) = (Point::new(s.0, s.1), Point::new(c.0, c.1), Point::new(e.0, e.1));
-            if let Ok(mut el) = EllipseInterp::new(s, c, a, b, e, rotation, method) {
-                if a < 5000 && b < 5000 {
-                    trace(&mut el, s, a, b, method);
-                }
+            if let Ok(mut el) = EllipseInterp::new(s, c, a, b, e, rotation, method)
+                && a < 5000
+                && b < 5000
+            {
+                trace(&mut el, s, a, b, method);
             }
             let (a, b) = (a.rem_euclid(3000) + 1, b.rem_euclid(3000) + 1);
             if let Ok(mut el) = EllipseInterp::from_angles(s, a, b, t, sweep, method) {
@@ -672,25 +783,5 @@ mod tests {
                 prop_assert_eq!(trace(&mut el, s, a, b, method).last(), end);
             }
         }
-    }
-}
-#[cfg(test)]
-mod debug_tmp {
-    extern crate std;
-    use super::*;
-    use crate::interp::arc::test_support::*;
-    #[test]
-    fn dbg_path() {
-        let (a, b) = (183, 17);
-        let c = Point::new(0, 0);
-        let t1 = 2.209450053949262f64;
-        let s = Point::new(183, 0);
-        let end = Point::new(libm::round(a as f64 * libm::cos(t1)) as i32, libm::round(b as f64 * libm::sin(t1)) as i32);
-        let mut e = EllipseInterp::new(s, c, a, b, end, Rotation::CounterClockwise, Method::Classic).unwrap();
-        std::println!("end {end:?} needed {} budget {} near {:?}", e.tracer.needed, e.tracer.budget, nearest_on_ellipse(a as f64, b as f64, end.x as f64, end.y as f64));
-        let w = walk(&mut e, s, true, |e: &EllipseInterp| e.tracer.tail_steps, 10000);
-        std::println!("len {} tail {}", w.len(), w.tail_len());
-        for (p, t) in w.points.iter().zip(&w.tail).skip(w.len() - 20) { std::print!("({},{}){} ", p.x, p.y, if *t {"T"} else {""}); }
-        std::println!();
     }
 }
