@@ -5,10 +5,14 @@
 //! comparison (error <= 1 step), and `diagonal`, which may move both axes at once (error <= 0.5
 //! step, fewer steps). Interpolators never read a clock and never allocate.
 
+pub mod arc;
+pub mod ellipse;
 pub mod function;
 pub mod line;
 pub mod sine;
 
+pub use arc::{ArcError, ArcInterp};
+pub use ellipse::EllipseInterp;
 pub use function::{CurveSetupError, FunctionInterp};
 pub use line::LineInterp;
 pub use sine::SineInterp;
@@ -68,6 +72,17 @@ pub trait Interpolator {
     fn tangent(&self) -> Tangent;
 }
 
+impl From<ArcError> for CurveSetupError {
+    fn from(e: ArcError) -> Self {
+        match e {
+            ArcError::TooLarge => CurveSetupError::OutOfRange,
+            ArcError::ZeroRadius | ArcError::StartOffCurve | ArcError::EndOffCurve | ArcError::NotFinite => {
+                CurveSetupError::BadParameter
+            }
+        }
+    }
+}
+
 /// Any curve the machine draws, starting at a known point: what the planner queues.
 #[derive(Clone, Debug)]
 pub struct Curve {
@@ -78,6 +93,8 @@ pub struct Curve {
 #[derive(Clone, Debug)]
 enum CurveKind {
     Line(LineInterp),
+    Arc(ArcInterp),
+    Ellipse(EllipseInterp),
     Sine(SineInterp),
     Function(FunctionInterp),
 }
@@ -123,7 +140,14 @@ impl Curve {
                 let d = probe.position();
                 Curve { kind: CurveKind::Function(f), end: Point::new(start.x + d.x, start.y + d.y) }
             }
-            Shape::Arc { .. } | Shape::Ellipse { .. } => return Err(CurveSetupError::BadParameter),
+            Shape::Arc { center, to, rotation } => {
+                let arc = ArcInterp::new(start, *center, *to, *rotation, method)?;
+                Curve { kind: CurveKind::Arc(arc), end: *to }
+            }
+            Shape::Ellipse { center, a_steps, b_steps, to, rotation } => {
+                let ellipse = EllipseInterp::new(start, *center, *a_steps, *b_steps, *to, *rotation, method)?;
+                Curve { kind: CurveKind::Ellipse(ellipse), end: *to }
+            }
         })
     }
 
@@ -137,6 +161,8 @@ impl Interpolator for Curve {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
         match &mut self.kind {
             CurveKind::Line(c) => c.next_step(),
+            CurveKind::Arc(c) => c.next_step(),
+            CurveKind::Ellipse(c) => c.next_step(),
             CurveKind::Sine(c) => c.next_step(),
             CurveKind::Function(c) => c.next_step(),
         }
@@ -145,6 +171,8 @@ impl Interpolator for Curve {
     fn tangent(&self) -> Tangent {
         match &self.kind {
             CurveKind::Line(c) => c.tangent(),
+            CurveKind::Arc(c) => c.tangent(),
+            CurveKind::Ellipse(c) => c.tangent(),
             CurveKind::Sine(c) => c.tangent(),
             CurveKind::Function(c) => c.tangent(),
         }
