@@ -28,13 +28,20 @@
 
 use heapless::Vec;
 
+const _: () = assert!(EXPR_MAX_CONSTS <= u8::MAX as usize, "constant indices are u8");
+
 /// Longest accepted source text, in characters (a G-code line is at most 80 characters; the
 /// keypad entry is shorter still).
 pub const MAX_EXPR_LEN_CHARS: usize = 100;
 
 /// Most operations (numbers, `x`, operators, function calls) one expression may compile to;
-/// the capacity of [`Expr`]'s program (16 bytes each).
+/// the capacity of [`Expr`]'s program (2 bytes each).
 pub const EXPR_MAX_OPS: usize = 64;
+
+/// Most distinct numbers (literals, `pi`, `e`) one expression may hold (8 bytes each). Kept
+/// apart from the program so that an operation stays 2 bytes: the planner holds a copy of every
+/// queued curve, so an expression's size counts many times over.
+pub const EXPR_MAX_CONSTS: usize = 24;
 
 /// Depth of the evaluation stack. Parsing computes the exact depth an expression needs and
 /// refuses one that needs more, so evaluation never overflows it.
@@ -172,8 +179,8 @@ enum BinOp {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 enum Op {
-    /// Push a number.
-    Num(f64),
+    /// Push the number at this index of the constants.
+    Num(u8),
     /// Push the argument `x`.
     X,
     /// Negate the top.
@@ -200,6 +207,7 @@ impl Op {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expr {
     ops: Vec<Op, EXPR_MAX_OPS>,
+    consts: Vec<f64, EXPR_MAX_CONSTS>,
 }
 
 /// Logs show an expression's size; its text is the host's, not the firmware's.
@@ -215,11 +223,11 @@ pub fn parse(src: &str) -> Result<Expr, ParseError> {
     if let Some((pos, _)) = src.char_indices().nth(MAX_EXPR_LEN_CHARS) {
         return Err(ParseError { kind: ParseErrorKind::TooLong, pos });
     }
-    let mut parser = Parser { src: src.as_bytes(), pos: 0, ops: Vec::new(), depth: 0, nesting: 0 };
+    let mut parser = Parser { src: src.as_bytes(), pos: 0, ops: Vec::new(), consts: Vec::new(), depth: 0, nesting: 0 };
     parser.expr()?;
     let (tok, at) = parser.peek()?;
     match tok {
-        Tok::End => Ok(Expr { ops: parser.ops }),
+        Tok::End => Ok(Expr { ops: parser.ops, consts: parser.consts }),
         Tok::RParen => Err(ParseError { kind: ParseErrorKind::MismatchedParen, pos: at }),
         _ => Err(ParseError { kind: ParseErrorKind::UnexpectedChar, pos: at }),
     }
@@ -231,7 +239,8 @@ impl Expr {
         let mut stack = Stack { values: [0.0; EXPR_STACK_DEPTH], len: 0 };
         for op in self.ops.iter() {
             let value = match *op {
-                Op::Num(v) => v,
+                // Every index was made by the parser for this constant table.
+                Op::Num(i) => self.consts.get(usize::from(i)).copied().ok_or(EvalError::Overflow)?,
                 Op::X => checked(x)?,
                 Op::Neg => -stack.pop()?,
                 Op::Call(f) => call(f, stack.pop()?)?,
@@ -350,6 +359,7 @@ struct Parser<'a> {
     /// Byte offset of the next unread character.
     pos: usize,
     ops: Vec<Op, EXPR_MAX_OPS>,
+    consts: Vec<f64, EXPR_MAX_CONSTS>,
     /// Stack depth the program reaches so far at its end.
     depth: usize,
     /// Current nesting level.
@@ -453,6 +463,21 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// The index of `v` in the constants, adding it if new.
+    fn constant(&mut self, v: f64, pos: usize) -> Result<u8, ParseError> {
+        let index = match self.consts.iter().position(|c| c.to_bits() == v.to_bits()) {
+            Some(i) => i,
+            None => {
+                if self.consts.push(v).is_err() {
+                    return Self::error(ParseErrorKind::TooComplex, pos);
+                }
+                self.consts.len() - 1
+            }
+        };
+        // EXPR_MAX_CONSTS is far below 256.
+        Ok(index as u8)
+    }
+
     /// Enters one nesting level at the token at `pos`.
     fn enter(&mut self, pos: usize) -> Result<(), ParseError> {
         self.nesting += 1;
@@ -529,7 +554,10 @@ impl Parser<'_> {
     fn primary(&mut self) -> Result<(), ParseError> {
         let (tok, at) = self.bump()?;
         match tok {
-            Tok::Num(v) | Tok::Const(v) => self.emit(Op::Num(v), at),
+            Tok::Num(v) | Tok::Const(v) => {
+                let index = self.constant(v, at)?;
+                self.emit(Op::Num(index), at)
+            }
             Tok::X => self.emit(Op::X, at),
             Tok::LParen => {
                 self.enter(at)?;
@@ -875,5 +903,17 @@ mod tests {
                 Err(err) => prop_assert!(err.pos <= src.len()),
             }
         }
+    }
+
+    #[test]
+    fn constants_are_shared_and_bounded() {
+        // The same number twice takes one place.
+        let same = "1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+1+x";
+        assert_eq!(parse(same).unwrap().eval(2.0), Ok(28.0));
+        let distinct: std::string::String =
+            (1..=EXPR_MAX_CONSTS + 1).map(|k| std::format!("{k}")).collect::<std::vec::Vec<_>>().join("+");
+        let err = parse(&distinct).unwrap_err();
+        assert_eq!(err.kind, ParseErrorKind::TooComplex);
+        assert!(core::mem::size_of::<Expr>() <= 2 * EXPR_MAX_OPS + 8 * EXPR_MAX_CONSTS + 32);
     }
 }
