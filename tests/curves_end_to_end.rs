@@ -93,3 +93,18 @@ fn an_expression_syntax_error_names_its_column_and_moves_nothing() {
     assert!(answers.contains("error:2"), "{answers}");
     assert!(report.trace.pulses.is_empty());
 }
+
+#[test]
+fn a_function_with_a_hole_the_parser_cannot_see_stops_at_the_hole_and_tells_the_host() {
+    // Undefined only for |x - 2| < 0.0001 mm: between the parser's samples, but a column of the
+    // interpolator (every 0.01 mm) falls in it. The pen stops at the last column before it, and
+    // the move queued behind the curve is dropped, with a message saying so.
+    let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG1 X0 Y0\n");
+    let answers = report.answers();
+    assert!(answers.contains("[MSG:Curve stopped: Domain; queued moves dropped]"), "{answers}");
+    assert_eq!(report.position.x, 199, "stopped at x = 1.99 mm");
+    assert_eq!(report.position, *report.path().last().unwrap());
+    // The machine is usable again, from where it stopped.
+    let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG4 P0.5\nG1 X0 Y0\n");
+    assert_eq!(report.position, Point::ORIGIN, "{}", report.answers());
+}

@@ -176,6 +176,12 @@ impl<G: CurveFn> ExplicitCurve<G> {
         self.at
     }
 
+    /// Where the whole curve ends, relative to the start, `(±n, round(h(n)))`, found from its
+    /// last column alone; an error there means the curve cannot reach its end.
+    pub fn nominal_end(&self) -> Result<Point, CurveError> {
+        Ok(Point::new(i32::from(self.dir) * self.columns, nearest_step(self.offset(self.columns)?)))
+    }
+
     /// The ideal curve at `column`, relative to the start, in steps.
     fn offset(&self, column: i32) -> Result<f64, CurveError> {
         let h = self.g.y_steps(column)? - self.origin;
@@ -351,6 +357,12 @@ impl FunctionInterp {
     /// Where the steps handed out so far have taken the pen, relative to the start.
     pub fn position(&self) -> Point {
         self.curve.position()
+    }
+
+    /// Where the curve ends if nothing stops it on the way, relative to the start; an error
+    /// means f cannot be evaluated at x1. Costs one evaluation of f.
+    pub fn nominal_end(&self) -> Result<Point, CurveError> {
+        self.curve.nominal_end()
     }
 }
 

@@ -133,11 +133,10 @@ impl Curve {
                     max_jump_steps,
                     method,
                 )?;
-                // The end is where the curve really stops, found by drawing it once on paper
-                // that does not exist: an error part way makes the job end there.
-                let mut probe = f.clone();
-                while let Ok(Some(_)) = probe.next_step() {}
-                let d = probe.position();
+                // Where it ends if nothing stops it; a curve that stops early (a domain error
+                // or a jump part way) ends the program there, and the motion drops whatever
+                // was planned from this end.
+                let d = f.nominal_end().unwrap_or(Point::ORIGIN);
                 Curve { kind: CurveKind::Function(f), end: Point::new(start.x + d.x, start.y + d.y) }
             }
             Shape::Arc { center, to, rotation } => {

@@ -22,6 +22,7 @@ use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::report::REPORT_LINE_MAX_BYTES;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -234,10 +235,10 @@ async fn queue<W: Write>(link: &Link<'_, W>, job: Job, jog: bool) {
 async fn faults<W: Write>(link: &Link<'_, W>) -> ! {
     loop {
         let fault = link.machine.faults.wait().await;
-        let mut text: String<64> = String::new();
+        let mut text: String<REPORT_LINE_MAX_BYTES> = String::new();
         let _ = match fault {
             MotionFault::Setup(e) => write!(text, "Curve refused: {:?}", e),
-            MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}", e),
+            MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}; queued moves dropped", e),
         };
         link.send(|a| report::message(a, &text)).await;
     }
