@@ -203,7 +203,7 @@ fn settings_for(method: Method) -> Settings {
 }
 
 fn build(case: &CurveCase, method: Method) -> Result<Curve, String> {
-    let job = Job { shape: (case.shape)(), feed: DRAW_FEED };
+    let job = Job::draw((case.shape)(), DRAW_FEED);
     Curve::for_job(&job, Point::ORIGIN, &settings_for(method)).map_err(|e| format!("{e:?}"))
 }
 
@@ -600,7 +600,7 @@ fn chain(a: &[Point], b: &[Point]) -> Vec<Point> {
 }
 
 fn line_to(to: Point, at: Point, settings: &Settings) -> Curve {
-    match Curve::for_job(&Job { shape: Shape::Line { to }, feed: DRAW_FEED }, at, settings) {
+    match Curve::for_job(&Job::draw(Shape::Line { to }, DRAW_FEED), at, settings) {
         Ok(c) => c,
         Err(e) => panic!("a line to {to:?} was refused: {e:?}"),
     }

@@ -40,12 +40,21 @@ pub enum Shape {
     Function { expr: Expr, x0_mm: f32, x1_mm: f32 },
 }
 
-/// One drawing job.
+/// Whether a job draws or jogs. A jog is reported as such and only a jog cancel stops it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum JobKind {
+    Draw,
+    Jog,
+}
+
+/// One job for the motion task.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Job {
     pub shape: Shape,
     pub feed: Feed,
+    pub kind: JobKind,
 }
 
 /// Run-time commands that act on the motion in progress.
@@ -61,6 +70,16 @@ pub enum Control {
 }
 
 impl Job {
+    /// A drawing job.
+    pub const fn draw(shape: Shape, feed: Feed) -> Job {
+        Job { shape, feed, kind: JobKind::Draw }
+    }
+
+    /// A jog: a straight move to `to`.
+    pub const fn jog_to(to: Point, feed: Feed) -> Job {
+        Job { shape: Shape::Line { to }, feed, kind: JobKind::Jog }
+    }
+
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a
     /// straight 0°, 45° or 90° line; releasing the key aborts it, which decelerates to a stop.
     pub fn jog(direction: Step, from: Point, settings: &Settings) -> Job {
@@ -79,7 +98,7 @@ impl Job {
         let distance = room(Axis::X).min(room(Axis::Y));
         let distance = if distance == i32::MAX { 0 } else { distance };
         let to = Point::new(from.x + direction.x as i32 * distance, from.y + direction.y as i32 * distance);
-        Job { shape: Shape::Line { to }, feed: Feed::MmPerMin(JOG_FEED_MM_PER_MIN) }
+        Job::jog_to(to, Feed::MmPerMin(JOG_FEED_MM_PER_MIN))
     }
 }
 

@@ -93,3 +93,17 @@ fn after_an_abort_the_next_line_starts_from_where_the_pen_stopped() {
     let report = sim::run(SimConfig { serial, ..SimConfig::default() });
     assert_eq!(report.position, Point::new(0, 500), "the absolute target is reached from the stop point");
 }
+
+#[test]
+fn a_host_jog_reports_jog_and_a_jog_cancel_stops_it_on_its_line() {
+    let serial =
+        SimSerial::with_input(b"$J=G91 X20 Y10 F1200\n").with_byte_at(500_000, b'?').with_byte_at(700_000, 0x85);
+    let report = sim::run(SimConfig { serial, ..SimConfig::default() });
+    let answers = report.answers();
+    assert!(answers.contains("<Jog|MPos:"), "{answers}");
+    let p = report.position;
+    assert!(p.x > 0 && p.x < 2000, "stopped part way: {p:?}");
+    let off_line = (p.x as f64 - 2.0 * p.y as f64).abs() / 5f64.sqrt();
+    assert!(off_line <= 0.5, "on the jog's line: {p:?}");
+    assert_eq!(answers.matches("Grbl 1.1").count(), 1, "a jog cancel is no reset");
+}

@@ -525,7 +525,7 @@ impl GcodeState {
         let to = to_steps(settings, target_mm);
         self.position_mm = target_mm;
         self.position = to;
-        Ok((to != from).then_some(Command::Job(Job { shape: Shape::Line { to }, feed })))
+        Ok((to != from).then_some(Command::Job(Job::draw(Shape::Line { to }, feed))))
     }
 
     /// G2/G3 from the planned position to `end` (mm).
@@ -779,7 +779,7 @@ impl GcodeState {
         if to == from {
             return Ok(Commands::default());
         }
-        Ok(Commands::one(Command::Jog(Job { shape: Shape::Line { to }, feed: Feed::MmPerMin(feed) })))
+        Ok(Commands::one(Command::Jog(Job::jog_to(to, Feed::MmPerMin(feed)))))
     }
 
     /// `$E`, `$O`, `$S` with their words in `body` (compacted, after the command letter).

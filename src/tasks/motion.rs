@@ -8,7 +8,7 @@ use embassy_futures::select::{Either3, select3};
 
 use crate::geom::Point;
 use crate::interp::Curve;
-use crate::job::Control;
+use crate::job::{Control, JobKind};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use crate::status::RunState;
@@ -18,6 +18,9 @@ pub async fn run(machine: &Machine) -> ! {
     let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
     // Where the pen will be once everything planned so far has been emitted.
     let mut planned_end: Point = machine.position();
+    // What runs is reported as a jog while the last job taken was one (jogs start only at rest
+    // or behind other jogs).
+    let mut moving = RunState::Run;
     loop {
         if let Some(control) = machine.control.try_take() {
             apply(machine, &mut planner, control);
@@ -31,6 +34,10 @@ pub async fn run(machine: &Machine) -> ! {
             match Curve::for_job(&job, planned_end, &settings) {
                 Ok(curve) => {
                     planned_end = curve.end();
+                    moving = match job.kind {
+                        JobKind::Draw => RunState::Run,
+                        JobKind::Jog => RunState::Jog,
+                    };
                     info!("job planned to ({}, {}) steps", planned_end.x, planned_end.y);
                     machine.set_fault(None);
                     if planner.push(curve, job.feed, settings.method).is_err() {
@@ -46,7 +53,7 @@ pub async fn run(machine: &Machine) -> ! {
         }
         match planner.next_cmd() {
             Some(Ok(cmd)) => {
-                machine.set_run_state(RunState::Run);
+                machine.set_run_state(moving);
                 machine.steps.send(cmd).await;
             }
             Some(Err(e)) => {

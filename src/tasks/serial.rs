@@ -18,7 +18,7 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Read, Write};
 use heapless::String;
 
-use crate::job::{Control, Job};
+use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
@@ -183,9 +183,8 @@ async fn carry_out<W: Write>(
 ) -> Result<(), GrblError> {
     let machine = link.machine;
     match command {
-        Command::Job(job) => queue(link, job, false).await,
-        Command::Curve { shape, feed, .. } => queue(link, Job { shape, feed }, false).await,
-        Command::Jog(job) => queue(link, job, true).await,
+        Command::Job(job) | Command::Jog(job) => queue(link, job).await,
+        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed)).await,
         Command::Dwell { ms } => {
             link.machine_at_rest().await;
             Timer::after(Duration::from_millis(ms as u64)).await;
@@ -223,8 +222,8 @@ async fn carry_out<W: Write>(
 }
 
 /// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued.
-async fn queue<W: Write>(link: &Link<'_, W>, job: Job, jog: bool) {
-    link.jogging.set(jog);
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job) {
+    link.jogging.set(job.kind == JobKind::Jog);
     if let crate::job::Feed::MmPerMin(f) = job.feed {
         link.feed_mm_per_min.set(f);
     }

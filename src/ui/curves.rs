@@ -327,7 +327,7 @@ impl CurveJob {
                 Shape::Function { expr: crate::expr::parse(f.preset.expression())?, x0_mm: f.x0_mm, x1_mm: f.x1_mm }
             }
         };
-        Ok(Job { shape, feed: self.feed })
+        Ok(Job::draw(shape, self.feed))
     }
 }
 

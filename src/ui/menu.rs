@@ -424,7 +424,7 @@ impl Form {
             if !within_travel(to, settings) {
                 return Err(UiError::Travel);
             }
-            MenuAction::Start(Job { shape: Shape::Line { to }, feed })
+            MenuAction::Start(Job::draw(Shape::Line { to }, feed))
         } else {
             let curve = self.curve()?;
             let extent = curve.extent().ok_or(UiError::Domain)?;
@@ -681,7 +681,7 @@ mod tests {
     }
 
     fn line(x: i32, y: i32) -> MenuAction {
-        MenuAction::Start(Job { shape: Shape::Line { to: Point::new(x, y) }, feed: Feed::MmPerMin(3_000.0) })
+        MenuAction::Start(Job::draw(Shape::Line { to: Point::new(x, y) }, Feed::MmPerMin(3_000.0)))
     }
 
     fn form(menu: &Menu) -> &Form {

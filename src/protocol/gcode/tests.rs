@@ -43,7 +43,7 @@ fn refused(g: &mut GcodeState, line: &str, code: u8) {
 }
 
 fn line(x: i32, y: i32, feed: Feed) -> Command {
-    Command::Job(Job { shape: Shape::Line { to: Point::new(x, y) }, feed })
+    Command::Job(Job::draw(Shape::Line { to: Point::new(x, y) }, feed))
 }
 
 /// Where a straight job ends (the parser hands out no other shape in a `Job`).
@@ -445,7 +445,7 @@ fn restoring_defaults() {
 #[test]
 fn jogs_follow_grbls_rules_and_leave_the_modes_alone() {
     let mut g = GcodeState::new();
-    let jog = |x, y, f| Command::Jog(Job { shape: Shape::Line { to: Point::new(x, y) }, feed: feed(f) });
+    let jog = |x, y, f| Command::Jog(Job::jog_to(Point::new(x, y), feed(f)));
     assert_eq!(run(&mut g, "$J=G91 X1 F600"), Ok(std::vec![jog(100, 0, 600.0)]));
     assert_eq!(run_in(&mut g, "$J=G91 Y-2 F600", RunState::Jog), Ok(std::vec![jog(100, -200, 600.0)]));
     assert_eq!(run(&mut g, "$J=X5 Y5 F100"), Ok(std::vec![jog(500, 500, 100.0)]));
