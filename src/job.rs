@@ -57,7 +57,8 @@ pub struct Job {
     pub kind: JobKind,
 }
 
-/// Run-time commands that act on the motion in progress.
+/// Run-time commands that act on the motion in progress. Requests that arrive before the motion
+/// task takes them are merged by [`Control::then`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Control {
@@ -67,6 +68,17 @@ pub enum Control {
     Resume,
     /// Decelerate to a stop and drop the rest of the job and every queued one.
     Abort,
+}
+
+impl Control {
+    /// The request left pending when `next` arrives while `self` is still waiting to be taken:
+    /// an abort stays an abort (nothing cancels it), otherwise the newer request wins.
+    pub const fn then(self, next: Control) -> Control {
+        match self {
+            Control::Abort => Control::Abort,
+            _ => next,
+        }
+    }
 }
 
 impl Job {
@@ -105,6 +117,15 @@ impl Job {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_abort_is_never_overwritten_by_a_later_request() {
+        assert_eq!(Control::Abort.then(Control::Hold), Control::Abort);
+        assert_eq!(Control::Abort.then(Control::Resume), Control::Abort);
+        assert_eq!(Control::Hold.then(Control::Abort), Control::Abort);
+        assert_eq!(Control::Hold.then(Control::Resume), Control::Resume);
+        assert_eq!(Control::Resume.then(Control::Hold), Control::Hold);
+    }
 
     #[test]
     fn a_diagonal_jog_stays_at_45_degrees_and_inside_the_travel() {

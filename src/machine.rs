@@ -2,18 +2,20 @@
 //!
 //! One `Machine` exists per plotter (a `static` on target, a local in the simulator). Tasks
 //! receive `&Machine` and talk only through it: the job queue (inputs → motion), the control
-//! signal (inputs → motion), the step queue (motion → pulses, bounded for back-pressure), the
+//! slot (inputs → motion), the step queue (motion → pulses, bounded in count and in time), the
 //! position counters (written only by the pulse task) and a change signal that wakes the LCD.
+//! Everything here is shared across priorities, so every lock is a critical section that only
+//! copies a value in or out.
 
 use core::cell::{Cell, RefCell};
-use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
-use crate::geom::{Axis, Point, Step, StepCmd};
+use crate::geom::{Axis, Point, Step, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, CurveSetupError};
 use crate::job::{Control, Job};
 use crate::settings::Settings;
@@ -25,9 +27,14 @@ use crate::ui::Menu;
 pub const JOB_QUEUE_LEN: usize = 4;
 
 /// Step commands between the motion task and the pulse task. At 20 kHz, 32 commands are 1.6 ms
-/// of motion: enough to ride over an LCD flush on the thread executor's other tasks, short enough
-/// that a hold starts decelerating within a few milliseconds.
+/// of motion, many times the motion task's latency on its own interrupt executor.
 pub const STEP_QUEUE_LEN: usize = 32;
+
+/// At most this much motion time waits in the step queue, however slow the steps: a hold or an
+/// abort starts decelerating within it, even at a feed of 1 mm/min.
+pub const STEP_QUEUE_MAX_US: u32 = 20_000;
+/// The same in pulse timer ticks.
+pub const STEP_QUEUE_MAX_TICKS: u32 = STEP_QUEUE_MAX_US * (TICK_HZ / 1_000_000);
 
 /// Why the last job stopped early, shown on the LCD and reported to the host.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,7 +49,9 @@ pub enum MotionFault {
 /// Everything the tasks share.
 pub struct Machine {
     pub jobs: Channel<CriticalSectionRawMutex, Job, JOB_QUEUE_LEN>,
-    pub control: Signal<CriticalSectionRawMutex, Control>,
+    control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
+    /// Wakes the motion task when a control is requested.
+    control_requested: Signal<CriticalSectionRawMutex, ()>,
     pub steps: Channel<CriticalSectionRawMutex, StepCmd, STEP_QUEUE_LEN>,
     /// Wakes the LCD task after anything it shows may have changed.
     pub changed: Signal<CriticalSectionRawMutex, ()>,
@@ -53,6 +62,8 @@ pub struct Machine {
     menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
     position: [AtomicI32; 2],
     state: AtomicU8,
+    /// Sum of the intervals of the step commands queued and not yet emitted, in ticks.
+    queued_ticks: AtomicU32,
     /// True while the pulse task holds a command it has not finished emitting.
     pulsing: AtomicBool,
     settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
@@ -63,7 +74,8 @@ impl Machine {
     pub fn new(settings: Settings) -> Self {
         Machine {
             jobs: Channel::new(),
-            control: Signal::new(),
+            control: Mutex::new(Cell::new(None)),
+            control_requested: Signal::new(),
             steps: Channel::new(),
             changed: Signal::new(),
             pulses_done: Signal::new(),
@@ -71,6 +83,7 @@ impl Machine {
             menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
             state: AtomicU8::new(0),
+            queued_ticks: AtomicU32::new(0),
             pulsing: AtomicBool::new(false),
             settings: Mutex::new(RefCell::new(settings)),
             fault: Mutex::new(Cell::new(None)),
@@ -82,14 +95,49 @@ impl Machine {
         Point::new(self.position[0].load(Ordering::Relaxed), self.position[1].load(Ordering::Relaxed))
     }
 
-    /// Counts one emitted pulse per moving axis. Only the pulse task calls this.
-    pub fn count_pulse(&self, step: Step) {
+    fn count_pulse(&self, step: Step) {
         for axis in Axis::ALL {
             let d = step.on(axis) as i32;
             if d != 0 {
                 self.position[axis.index()].fetch_add(d, Ordering::Relaxed);
             }
         }
+    }
+
+    /// Asks the motion task for `control`; see [`Control::then`] for requests not yet taken.
+    pub fn request(&self, control: Control) {
+        self.control.lock(|c| c.set(Some(c.get().map_or(control, |pending| pending.then(control)))));
+        self.control_requested.signal(());
+    }
+
+    /// The pending control request, if any, taking it.
+    pub fn take_control(&self) -> Option<Control> {
+        self.control.lock(|c| c.take())
+    }
+
+    /// Waits until a control is requested (it may already be).
+    pub async fn control_requested(&self) {
+        if self.control.lock(|c| c.get().is_none()) {
+            self.control_requested.wait().await;
+        }
+    }
+
+    /// Queues a step command for the pulse task, waiting for room.
+    pub async fn queue_step(&self, cmd: StepCmd) {
+        self.queued_ticks.fetch_add(cmd.interval_ticks, Ordering::AcqRel);
+        self.steps.send(cmd).await;
+    }
+
+    /// Motion time queued for the pulse task and not yet emitted, in ticks.
+    pub fn queued_ticks(&self) -> u32 {
+        self.queued_ticks.load(Ordering::Acquire)
+    }
+
+    /// Counts one emitted pulse per moving axis and takes its command's time off the queue.
+    /// Only the pulse task calls this.
+    pub fn emitted(&self, cmd: StepCmd) {
+        self.count_pulse(cmd.step);
+        self.queued_ticks.fetch_sub(cmd.interval_ticks, Ordering::AcqRel);
     }
 
     pub fn set_pulsing(&self, busy: bool) {
@@ -154,9 +202,15 @@ impl Machine {
         self.fault.lock(|f| f.get())
     }
 
-    /// Runs `f` on the keypad menu (the keypad task changes it, the LCD task draws it).
-    pub fn with_menu<R>(&self, f: impl FnOnce(&mut Menu) -> R) -> R {
-        self.menu.lock(|m| f(&mut m.borrow_mut()))
+    /// A copy of the keypad menu (the keypad task changes it, the LCD task draws it). Work on
+    /// the menu happens on the copy, never inside the lock.
+    pub fn menu(&self) -> Menu {
+        self.menu.lock(|m| m.borrow().clone())
+    }
+
+    pub fn set_menu(&self, menu: Menu) {
+        self.menu.lock(|m| *m.borrow_mut() = menu);
+        self.changed.signal(());
     }
 
     /// True when nothing is queued, planned or moving.

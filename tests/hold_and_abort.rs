@@ -88,10 +88,19 @@ fn an_abort_decelerates_onto_the_path_and_drops_the_rest() {
 #[test]
 fn after_an_abort_the_next_line_starts_from_where_the_pen_stopped() {
     let reference = run("G1 X30 Y0 F3000", &[]);
-    let serial = SimSerial::with_input(b"G1 X30 Y0 F3000\nG4 P1.5\nG1 X0 Y5\n")
+    // The sender stops streaming at the reset; a person then types a new line.
+    let mut serial = SimSerial::with_input(b"G1 X30 Y0 F3000\nG4 P1.5\nG1 X30 Y30\n")
         .with_byte_at(reference.last_pulse_us() / 2, 0x18);
+    for (i, &b) in b"G1 X0 Y5\n".iter().enumerate() {
+        serial = serial.with_byte_at(3_000_000 + i as u64 * 100, b);
+    }
     let report = sim::run(SimConfig { serial, ..SimConfig::default() });
-    assert_eq!(report.position, Point::new(0, 500), "the absolute target is reached from the stop point");
+    assert_eq!(
+        report.position,
+        Point::new(0, 500),
+        "the absolute target is reached from the stop point: {}",
+        report.answers()
+    );
 }
 
 #[test]

@@ -21,6 +21,8 @@ struct Link {
     unsent: VecDeque<Vec<u8>>,
     /// Bytes sent at given virtual times, in order (a person pressing `!` mid-drawing).
     timed: VecDeque<(u64, u8)>,
+    /// A reset (0x18) went out and its banner has not come back yet.
+    reset_sent: bool,
     /// Answers (`ok` / `error:`) still owed for lines sent.
     owed: usize,
     /// The output seen so far that does not end in a line end yet.
@@ -96,6 +98,7 @@ impl SimSerial {
             }
             l.timed.pop_front();
             l.input.push_back(b);
+            l.reset_sent |= b == 0x18;
             sent = true;
         }
         if sent {
@@ -174,6 +177,12 @@ impl Link {
                 let line = core::mem::take(&mut self.partial);
                 if line.starts_with(b"ok") || line.starts_with(b"error:") {
                     self.owed = self.owed.saturating_sub(1);
+                } else if line.starts_with(b"Grbl ") && self.reset_sent {
+                    // The banner after a reset we sent: as a sender does, stop streaming; lines
+                    // in flight get no answer.
+                    self.reset_sent = false;
+                    self.owed = 0;
+                    self.unsent.clear();
                 }
             } else {
                 self.partial.push(b);

@@ -25,8 +25,9 @@ pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 
         for event in decoder.update(raw, now_ms) {
             let status = machine.status();
             let settings = machine.settings();
-            let action = machine.with_menu(|menu| menu.handle(event, &status, &settings));
-            machine.changed.signal(());
+            let mut menu = machine.menu();
+            let action = menu.handle(event, &status, &settings);
+            machine.set_menu(menu);
             act(machine, action);
         }
     }
@@ -55,14 +56,14 @@ fn act(machine: &Machine, action: MenuAction) {
         MenuAction::Start(job) => queue(machine, job),
         MenuAction::StartCurve(curve) => match curve.to_job(&machine.settings()) {
             Ok(job) => queue(machine, job),
-            Err(_) => machine.with_menu(|menu| menu.refuse(UiError::Domain)),
+            Err(_) => refuse(machine, UiError::Domain),
         },
         MenuAction::JogStart(direction) => {
             let job = Job::jog(direction, machine.status().position, &machine.settings());
             queue(machine, job);
         }
-        MenuAction::JogStop => machine.control.signal(Control::Abort),
-        MenuAction::Control(control) => machine.control.signal(control),
+        MenuAction::JogStop => machine.request(Control::Abort),
+        MenuAction::Control(control) => machine.request(control),
     }
 }
 
@@ -70,7 +71,14 @@ fn queue(machine: &Machine, job: Job) {
     if machine.jobs.try_send(job).is_err() {
         // The menu starts jobs only while the machine is idle, so this is a full queue from the
         // host link: the keypad job is refused, visibly, rather than waiting unseen.
-        machine.with_menu(|menu| menu.refuse(UiError::Busy));
+        refuse(machine, UiError::Busy);
         warn!("keypad job refused: job queue full");
     }
+}
+
+/// Shows on the menu why the job just confirmed did not start.
+fn refuse(machine: &Machine, why: UiError) {
+    let mut menu = machine.menu();
+    menu.refuse(why);
+    machine.set_menu(menu);
 }

@@ -83,7 +83,7 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
     loop {
         let status = machine.status();
         let settings = machine.settings();
-        let view = machine.with_menu(|menu| screen::view(menu, &status, &settings));
+        let view = screen::view(&machine.menu(), &status, &settings);
         if shown.as_ref() != Some(&view) {
             let _ = screen::render(&view, &mut lcd);
             lcd.show();

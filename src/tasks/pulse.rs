@@ -2,7 +2,9 @@
 //!
 //! It owns the step/direction pins and is the only writer of the position counters, so the
 //! position is the pulses emitted, always. Deadlines are absolute: each command's interval is
-//! added to the previous pulse's deadline, so timer latency never accumulates into drift. SIGN is
+//! added to the previous pulse's deadline, so timer latency never accumulates into drift; only
+//! a pulse already late by a whole interval starts a fresh deadline, so lateness never turns
+//! into a burst of pulses faster than planned. SIGN is
 //! set as soon as the next command is known (right after the previous pulse) and the pulse waits
 //! at least the direction setup time after any SIGN change. On target this task runs on the
 //! high-priority interrupt executor; nothing here decides anything about motion.
@@ -54,12 +56,19 @@ pub async fn run<P: OutputPin, D: DelayNs>(machine: &Machine, mut axes: [AxisPin
         let mut deadline = Instant::now();
         loop {
             let mut due = deadline + Duration::from_ticks(cmd.interval_ticks as u64);
+            let now = Instant::now();
+            if due < now {
+                // Late by more than a whole interval (the queue ran dry, or a higher priority
+                // held the CPU): start afresh from now instead of catching up in a burst the
+                // drivers could not follow.
+                due = now;
+            }
             if set_directions(&mut axes, &mut sign_level, cmd, timing.dir_invert_mask) {
-                due = due.max(Instant::now() + timing.dir_setup);
+                due = due.max(now + timing.dir_setup);
             }
             Timer::at(due).await;
             emit(&mut axes, cmd, timing.width_ns, &mut delay);
-            machine.count_pulse(cmd.step);
+            machine.emitted(cmd);
             deadline = due;
             match machine.steps.try_receive() {
                 Ok(next) => cmd = next,

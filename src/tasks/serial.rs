@@ -10,10 +10,14 @@
 use core::cell::Cell;
 use core::fmt::Write as _;
 
+use core::future::Future;
+
 use embassy_futures::join::join3;
+use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::mutex::Mutex;
 use embassy_sync::pipe::Pipe;
+use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Read, Write};
 use heapless::String;
@@ -33,8 +37,12 @@ use crate::status::RunState;
 pub const SERIAL_PIPE_BYTES: usize = 128;
 /// What a sender may assume it can have in flight (reported by `$I`).
 pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
-/// Longest answer to one line: `$$` lists every setting.
-pub const SERIAL_ANSWER_MAX_BYTES: usize = 1024;
+/// Longest answer to one line: `$$` lists every setting (about 300 bytes).
+pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
+/// Bytes taken from the UART, or from the pipe, at a time.
+pub const SERIAL_CHUNK_BYTES: usize = 32;
+/// After a UART read error (noise, overrun), the receiver waits this long before reading on.
+pub const SERIAL_ERROR_BACKOFF_MS: u64 = 1;
 /// How often waits for the machine to come to rest (G4, M0, M2) look again.
 pub const SERIAL_IDLE_POLL_MS: u64 = 5;
 
@@ -49,6 +57,10 @@ struct Link<'m, W> {
     feed_mm_per_min: Cell<f32>,
     /// The last motion line from the host was a `$J=` jog (a jog cancel aborts only that).
     jogging: Cell<bool>,
+    /// Resets received and not yet met by the line loop: bytes before them are dropped.
+    resets_pending: Cell<u32>,
+    /// Cancels a line waiting for the machine when a reset arrives.
+    reset: Signal<NoopRawMutex, ()>,
 }
 
 /// Speaks GRBL on the host link forever.
@@ -59,6 +71,8 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         bytes: Pipe::new(),
         feed_mm_per_min: Cell::new(0.0),
         jogging: Cell::new(false),
+        resets_pending: Cell::new(0),
+        reset: Signal::new(),
     };
     link.send(|a| report::welcome(a)).await;
     join3(receive(&link, rx), lines(&link), faults(&link)).await;
@@ -87,6 +101,17 @@ impl<W: Write> Link<'_, W> {
         self.send(|a| report::status(a, &status, &settings, feed, None)).await;
     }
 
+    /// Runs `work` unless a reset comes first (or is already on its way).
+    async fn unless_reset<T>(&self, work: impl Future<Output = T>) -> Result<T, Stop> {
+        if self.resets_pending.get() > 0 {
+            return Err(Stop::Reset);
+        }
+        match select(work, self.reset.wait()).await {
+            Either::First(t) => Ok(t),
+            Either::Second(()) => Err(Stop::Reset),
+        }
+    }
+
     /// Waits until nothing is queued or moving.
     async fn machine_at_rest(&self) {
         while !self.machine.is_idle() {
@@ -97,24 +122,28 @@ impl<W: Write> Link<'_, W> {
 
 /// Reads the link: realtime bytes act now, the rest go to the line loop in order.
 async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
-    let mut buf = [0u8; 32];
+    let mut buf = [0u8; SERIAL_CHUNK_BYTES];
     loop {
         let n = match rx.read(&mut buf).await {
             Ok(n) => n,
             Err(_) => {
                 warn!("host link read error");
+                Timer::after(Duration::from_millis(SERIAL_ERROR_BACKOFF_MS)).await;
                 continue;
             }
         };
         for &byte in &buf[..n] {
             match realtime(byte) {
                 Some(Realtime::StatusQuery) => link.status_report().await,
-                Some(Realtime::FeedHold) => link.machine.control.signal(Control::Hold),
-                Some(Realtime::CycleStart) => link.machine.control.signal(Control::Resume),
-                Some(Realtime::JogCancel) if link.jogging.get() => link.machine.control.signal(Control::Abort),
+                Some(Realtime::FeedHold) => link.machine.request(Control::Hold),
+                Some(Realtime::CycleStart) => link.machine.request(Control::Resume),
+                Some(Realtime::JogCancel) if link.jogging.get() => link.machine.request(Control::Abort),
                 Some(Realtime::Reset) => {
-                    link.machine.control.signal(Control::Abort);
-                    // In order with the lines: the line loop resets the parser when it meets it.
+                    link.machine.request(Control::Abort);
+                    // Like GRBL, everything received before the reset is dropped: the line loop
+                    // discards bytes up to this marker and resets the parser when it meets it.
+                    link.resets_pending.set(link.resets_pending.get() + 1);
+                    link.reset.signal(());
                     link.bytes.write_all(&[byte]).await;
                 }
                 Some(Realtime::JogCancel | Realtime::Unsupported(_)) => {}
@@ -124,21 +153,34 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
     }
 }
 
+/// Why a line's commands stopped before all were carried out.
+enum Stop {
+    /// The line was refused: answer `error:N`.
+    Error(GrblError),
+    /// A reset came: the line gets no answer (the banner follows).
+    Reset,
+}
+
 /// Assembles, parses and carries out lines, answering each.
 async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
     let machine = link.machine;
     let mut assembler = LineAssembler::new();
     let mut gcode = GcodeState::new();
-    let mut buf = [0u8; 32];
+    let mut buf = [0u8; SERIAL_CHUNK_BYTES];
     loop {
         let n = link.bytes.read(&mut buf).await;
         for &byte in &buf[..n] {
             if byte == 0x18 {
+                link.resets_pending.set(link.resets_pending.get().saturating_sub(1));
                 assembler.clear();
                 link.machine_at_rest().await;
+                link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
                 link.jogging.set(false);
                 link.send(|a| report::welcome(a)).await;
+                continue;
+            }
+            if link.resets_pending.get() > 0 {
                 continue;
             }
             let result = match assembler.push(byte) {
@@ -161,14 +203,15 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                             }
                             r
                         }
-                        Err(e) => Err(e),
+                        Err(e) => Err(Stop::Error(e)),
                     }
                 }
-                Some(other) => Err(other.error().unwrap_or(GrblError::ExpectedCommandLetter)),
+                Some(other) => Err(Stop::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
             };
             match result {
                 Ok(()) => link.send(|a| report::ok(a)).await,
-                Err(e) => link.send(|a| report::error(a, e)).await,
+                Err(Stop::Error(e)) => link.send(|a| report::error(a, e)).await,
+                Err(Stop::Reset) => {}
             }
         }
     }
@@ -180,25 +223,28 @@ async fn carry_out<W: Write>(
     gcode: &GcodeState,
     settings: &Settings,
     command: Command,
-) -> Result<(), GrblError> {
+) -> Result<(), Stop> {
     let machine = link.machine;
     match command {
-        Command::Job(job) | Command::Jog(job) => queue(link, job).await,
-        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed)).await,
+        Command::Job(job) | Command::Jog(job) => queue(link, job).await?,
+        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed)).await?,
         Command::Dwell { ms } => {
-            link.machine_at_rest().await;
-            Timer::after(Duration::from_millis(ms as u64)).await;
+            link.unless_reset(async {
+                link.machine_at_rest().await;
+                Timer::after(Duration::from_millis(u64::from(ms))).await;
+            })
+            .await?
         }
         Command::Pause => {
-            link.machine_at_rest().await;
-            machine.control.signal(Control::Hold);
+            link.unless_reset(link.machine_at_rest()).await?;
+            machine.request(Control::Hold);
         }
         Command::ProgramEnd => {
-            link.machine_at_rest().await;
+            link.unless_reset(link.machine_at_rest()).await?;
             link.send(|a| report::message(a, "Pgm End")).await;
         }
         Command::SetSetting { id, value } => {
-            machine.update_settings(|s| s.set(id, value)).map_err(|_| GrblError::InvalidStatement)?;
+            machine.update_settings(|s| s.set(id, value)).map_err(|_| Stop::Error(GrblError::InvalidStatement))?;
         }
         Command::RestoreSettings => machine.update_settings(|s| *s = Settings::default()),
         Command::Report(kind) => {
@@ -221,13 +267,17 @@ async fn carry_out<W: Write>(
     Ok(())
 }
 
-/// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued.
-async fn queue<W: Write>(link: &Link<'_, W>, job: Job) {
-    link.jogging.set(job.kind == JobKind::Jog);
-    if let crate::job::Feed::MmPerMin(f) = job.feed {
+/// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued. A
+/// reset while it waits drops the job.
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job) -> Result<(), Stop> {
+    let jog = job.kind == JobKind::Jog;
+    let feed = job.feed;
+    link.unless_reset(link.machine.jobs.send(job)).await?;
+    link.jogging.set(jog);
+    if let crate::job::Feed::MmPerMin(f) = feed {
         link.feed_mm_per_min.set(f);
     }
-    link.machine.jobs.send(job).await;
+    Ok(())
 }
 
 /// Tells the host when a curve could not start or stopped part way.

@@ -1,0 +1,90 @@
+//! Realtime commands against a streaming sender, on the simulated board: a hold, a resume and a
+//! reset act at once whatever the stream is doing, and never leave the machine stuck.
+
+use servoplot::geom::Point;
+use servoplot::sim::{self, SimConfig, SimReport, serial::SimSerial};
+
+/// A 20 mm square drawn as 40 short lines, as a sender streams it.
+fn square_program() -> String {
+    let mut g = String::from("G1 F3000\n");
+    for (x0, y0, x1, y1) in [(0, 0, 20, 0), (20, 0, 20, 20), (20, 20, 0, 20), (0, 20, 0, 0)] {
+        for k in 1..=10 {
+            let t = k as f64 / 10.0;
+            g += &format!("G1 X{:.2} Y{:.2}\n", x0 as f64 + (x1 - x0) as f64 * t, y0 as f64 + (y1 - y0) as f64 * t);
+        }
+    }
+    g
+}
+
+fn run(program: &str, timed: &[(u64, &[u8])]) -> SimReport {
+    let mut serial = SimSerial::with_input(program.as_bytes());
+    for &(t, bytes) in timed {
+        for &b in bytes {
+            serial = serial.with_byte_at(t, b);
+        }
+    }
+    let report = sim::run(SimConfig { serial, ..SimConfig::default() });
+    assert!(!report.timed_out, "the machine came to rest: {}", report.answers());
+    report
+}
+
+fn inside_the_square(report: &SimReport) -> bool {
+    report.path().iter().all(|p| (0..=2000).contains(&p.x) && (0..=2000).contains(&p.y))
+}
+
+#[test]
+fn a_hold_while_streaming_holds_and_a_resume_finishes_the_drawing() {
+    let reference = run(&square_program(), &[]);
+    let held = run(&square_program(), &[(300_000, b"!"), (2_300_000, b"~")]);
+    assert_eq!(held.path(), reference.path());
+    assert_eq!(held.position, Point::ORIGIN);
+    assert!(held.last_pulse_us() > reference.last_pulse_us() + 1_500_000, "it stood still meanwhile");
+    assert_eq!(held.answers().lines().filter(|l| *l == "ok").count(), 41);
+}
+
+#[test]
+fn a_reset_while_streaming_stops_on_the_path_and_runs_nothing_queued() {
+    let reference = run(&square_program(), &[]);
+    let t = reference.last_pulse_us() / 3;
+    let report = run(&square_program(), &[(t, b"\x18")]);
+    let cut = report.path();
+    assert!(cut.len() < reference.path().len() / 2);
+    assert_eq!(cut[..], reference.path()[..cut.len()], "every step on the square's path");
+    assert!(inside_the_square(&report));
+    assert_eq!(report.answers().matches("Grbl 1.1").count(), 2);
+}
+
+#[test]
+fn an_abort_is_not_undone_by_a_resume_or_a_hold_that_follows_it() {
+    let reference = run(&square_program(), &[]);
+    let t = reference.last_pulse_us() / 3;
+    for burst in [&b"!\x18~"[..], b"\x18!", b"\x18~!~"] {
+        let report = run(&square_program(), &[(t, burst)]);
+        assert!(report.path().len() < reference.path().len() / 2, "{burst:?} stopped the drawing");
+        assert!(inside_the_square(&report), "{burst:?}");
+        assert_eq!(report.answers().matches("Grbl 1.1").count(), 2, "{burst:?}: the reset answered");
+    }
+}
+
+#[test]
+fn a_hold_at_a_very_slow_feed_acts_within_the_step_queue_time() {
+    // 5 mm/min: 120 ms per step. Without a time bound, 32 queued steps would be 4 s.
+    let report = run("G1 X0.5 F5\n", &[(3_000_000, b"!"), (6_000_000, b"?"), (7_000_000, b"~")]);
+    let steps = report.trace.steps(0);
+    let last_before_hold = steps.iter().rev().find(|(t, _)| *t < 6_000_000).unwrap().0;
+    assert!(
+        last_before_hold < 3_000_000 + 300_000,
+        "stopped {} ms after the hold",
+        (last_before_hold - 3_000_000) / 1000
+    );
+    assert!(report.answers().contains("<Hold:0|"), "{}", report.answers());
+}
+
+#[test]
+fn a_hold_at_rest_is_reported_and_keeps_the_next_job_until_cycle_start() {
+    let report = run("G4 P0.2\nG1 X1\n", &[(100_000, b"!"), (500_000, b"?"), (1_000_000, b"~")]);
+    let answers = report.answers();
+    assert!(answers.contains("<Hold:0|MPos:0.000,0.000"), "{answers}");
+    assert_eq!(report.position, Point::new(100, 0));
+    assert!(report.trace.pulses[0].t_us >= 1_000_000, "nothing moved before the resume");
+}
