@@ -26,6 +26,11 @@ pub struct SettingInfo {
     pub max: f32,
 }
 
+/// Highest pulse rate the firmware drives per axis. The drivers take 200 kHz, but the pulse task
+/// wakes once per pulse and busy-waits the pulse width, so rates are kept where that is a small
+/// share of the CPU.
+pub const MAX_PULSE_RATE_HZ: f32 = 50_000.0;
+
 /// Every setting, in `$$` listing order.
 pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, name: "pulse width", unit: "us", min: 2.5, max: 100.0 },
@@ -45,7 +50,7 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 202, name: "interpolation (0 classic, 1 diagonal)", unit: "method", min: 0.0, max: 1.0 },
     SettingInfo { id: 203, name: "default feed rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
     SettingInfo { id: 204, name: "max function jump", unit: "mm", min: 0.01, max: 500.0 },
-    SettingInfo { id: 205, name: "max pulse rate", unit: "Hz", min: 100.0, max: 200_000.0 },
+    SettingInfo { id: 205, name: "max pulse rate", unit: "Hz", min: 100.0, max: MAX_PULSE_RATE_HZ },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817

@@ -39,6 +39,16 @@ use servoplot::tasks::{self, lcd::St7920Lcd, pulse::AxisPins};
 use static_cell::StaticCell;
 use {defmt_rtt as _, panic_probe as _};
 
+/// Crystal and core clock (see `clocks`).
+const HSE_HZ: u32 = 8_000_000;
+const SYSCLK_HZ: u32 = 168_000_000;
+
+/// Interrupt priorities, most urgent first: pulses, then motion, then the host link's UART;
+/// keypad, LCD and serial protocol run in thread mode below them all.
+const PULSE_PRIORITY: Priority = Priority::P6;
+const MOTION_PRIORITY: Priority = Priority::P7;
+const HOST_UART_PRIORITY: Priority = Priority::P8;
+
 /// Serial host link speed.
 const HOST_BAUD: u32 = 115_200;
 /// UART ring buffers. GRBL senders keep at most 128 unanswered bytes in flight (character
@@ -73,8 +83,8 @@ struct CycleDelay;
 
 impl embedded_hal::delay::DelayNs for CycleDelay {
     fn delay_ns(&mut self, ns: u32) {
-        const CPU_MHZ: u32 = 168;
-        cortex_m::asm::delay((ns.saturating_mul(CPU_MHZ)).div_ceil(1000));
+        const CYCLES_PER_US: u32 = SYSCLK_HZ / 1_000_000;
+        cortex_m::asm::delay(ns.saturating_mul(CYCLES_PER_US).div_ceil(1000));
     }
 }
 
@@ -121,11 +131,12 @@ impl embedded_hal::digital::OutputPin for NoCs {
     }
 }
 
-/// 168 MHz from the 8 MHz crystal: 8 / 4 * 168 / 2; 48 MHz for USB from Q; APB1 42 MHz, APB2 84 MHz.
+/// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
+/// 42 MHz, APB2 84 MHz.
 fn clocks() -> Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
-    config.rcc.hse = Some(Hse { freq: Hertz(8_000_000), mode: HseMode::Oscillator });
+    config.rcc.hse = Some(Hse { freq: Hertz(HSE_HZ), mode: HseMode::Oscillator });
     config.rcc.pll_src = PllSource::HSE;
     config.rcc.pll = Some(Pll {
         prediv: PllPreDiv::DIV4,
@@ -144,7 +155,7 @@ fn clocks() -> Config {
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
     let p = embassy_stm32::init(clocks());
-    info!("servoplot {} on STM32F407VG at 168 MHz", env!("CARGO_PKG_VERSION"));
+    info!("servoplot {} on STM32F407VG at {} MHz", env!("CARGO_PKG_VERSION"), SYSCLK_HZ / 1_000_000);
     let machine: &'static Machine = MACHINE.init(Machine::new(Settings::default()));
 
     // Step/direction outputs, low (no pulse) until the pulse task drives them.
@@ -161,10 +172,10 @@ async fn main(spawner: Spawner) {
     // Servo on: the drivers hold position from here on. Kept for the program's whole life.
     core::mem::forget(Output::new(p.PE13, Level::High, Speed::Low));
 
-    interrupt::UART4.set_priority(Priority::P6);
+    interrupt::UART4.set_priority(PULSE_PRIORITY);
     let pulse_spawner = EXECUTOR_PULSE.start(interrupt::UART4);
     pulse_spawner.spawn(unwrap!(pulse(machine, axes)));
-    interrupt::UART5.set_priority(Priority::P7);
+    interrupt::UART5.set_priority(MOTION_PRIORITY);
     let motion_spawner = EXECUTOR_MOTION.start(interrupt::UART5);
     motion_spawner.spawn(unwrap!(motion(machine)));
 
@@ -195,6 +206,8 @@ async fn main(spawner: Spawner) {
         Irqs,
         uart_config,
     ));
+    // Below the pulse and motion executors: a burst of received bytes never delays a pulse.
+    interrupt::USART2.set_priority(HOST_UART_PRIORITY);
     let (tx, rx) = uart.split();
     spawner.spawn(unwrap!(serial(machine, rx, tx)));
 
