@@ -108,3 +108,60 @@ fn a_function_with_a_hole_the_parser_cannot_see_stops_at_the_hole_and_tells_the_
     let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG4 P0.5\nG1 X0 Y0\n");
     assert_eq!(report.position, Point::ORIGIN, "{}", report.answers());
 }
+
+#[test]
+fn a_function_leaving_the_travel_between_the_parsers_samples_stops_at_the_edge() {
+    // 250·sin²(πx/2) is 0 at every even x, so the parser's samples (every 2 mm) and the end all
+    // lie at Y = 0; the humps between them reach 250 mm, beyond the ±200 mm travel. The pen
+    // stops at the last column inside, the move queued behind is dropped, and no step is ever
+    // taken outside the travel.
+    let report = sim::run_serial("$F X0 U128 F3000 Y=250*sin(pi*x/2)^2\nG1 X0 Y0\n");
+    let answers = report.answers();
+    assert!(answers.contains("[MSG:Curve stopped: Travel; queued moves dropped]"), "{answers}");
+    let path = report.path();
+    assert!(path.iter().all(|p| p.x.abs() <= 20_000 && p.y.abs() <= 20_000), "a step outside the travel");
+    assert_eq!(report.position, *path.last().unwrap());
+    // The column rows at 100 steps/mm; the first hump passes 200 mm at x ≈ 0.70 mm.
+    let row = |k: i32| {
+        let s = (std::f64::consts::PI * (k as f64 / 100.0) / 2.0).sin();
+        (250.0 * s * s * 100.0 + 0.5).floor() as i32
+    };
+    let last_in = (0..).take_while(|&k| row(k) <= 20_000).last().unwrap();
+    assert_eq!(report.position, Point::new(last_in, row(last_in)));
+    assert!(report.position.y.abs() <= 20_000);
+}
+
+#[test]
+fn no_curve_steps_outside_the_travel() {
+    // From 10 mm inside the top and the bottom edge, functions whose humps (30 and 20 mm) fall
+    // between the parser's samples (every 2 and every 1 mm, where they are 0): the interpolator
+    // stops them at the edge, with either method.
+    for method in [0, 1] {
+        for (start, line) in [(190, "$F X0 U128 F3000 Y=30*sin(pi*x/2)^2"), (-190, "$F X0 U64 F3000 Y=-20*sin(pi*x)^2")]
+        {
+            let report = sim::run_serial(&format!("$202={method}\nG0 Y{start}\n{line}\n"));
+            let answers = report.answers();
+            assert!(answers.contains("[MSG:Curve stopped: Travel; queued moves dropped]"), "{line}: {answers}");
+            assert!(report.path().iter().all(|p| p.y.abs() <= 20_000), "{line}: a step outside the travel");
+            assert!(report.position.y.abs() >= 19_900, "{line}: stopped at {:?}", report.position);
+        }
+    }
+}
+
+#[test]
+fn a_sine_steeper_than_the_jump_limit_is_refused_before_anything_moves() {
+    let report = sim::run_serial("$S A200 W1000 L100\n");
+    let answers = report.answers();
+    assert!(answers.contains("error:33"), "{answers}");
+    assert!(report.trace.pulses.is_empty());
+}
+
+#[test]
+fn arcs_too_small_to_draw_are_refused_by_the_parser() {
+    let report = sim::run_serial("G2 X0.01 Y0 R0.005\nG2 X0.01 Y0 I0.005\n$O R0.005 S45 W360\n");
+    let answers = report.answers();
+    assert_eq!(answers.lines().filter(|l| *l == "error:33").count(), 3, "{answers}");
+    assert!(!answers.contains("Curve refused"), "{answers}");
+    assert!(report.trace.pulses.is_empty());
+    assert_eq!(report.position, Point::ORIGIN);
+}

@@ -29,11 +29,22 @@
 //!   `1 + |r(k+1) - r(k)|` steps, so the curve always terminates.
 //!
 //! Each column value is computed just before its chord is stepped. If it cannot be computed
-//! (the function's domain error, [`CurveError::Overflow`] beyond [`MAX_CURVE_OFFSET_STEPS`]) or
-//! the chord rises or falls by more than the curve's `max_jump_steps`, the curve ends with that
-//! error *before* any step of the chord, the pen standing at `(k, r(k))`; afterwards
-//! `next_step` returns `Ok(None)`. A jump is an error, never a travel: the machine has no pen
-//! lift, so crossing a pole would draw a line the function does not contain.
+//! (the function's domain error, [`CurveError::Overflow`] beyond [`MAX_CURVE_OFFSET_STEPS`]),
+//! the chord rises or falls by more than the curve's `max_jump_steps`
+//! ([`CurveError::Jump`]), or its end row lies outside the curve's [`RowRange`]
+//! ([`CurveError::Travel`]), the curve ends with that error *before* any step of the chord,
+//! the pen standing at `(k, r(k))`; afterwards `next_step` returns `Ok(None)`. Since the
+//! planner's look-ahead runs a clone of the curve ahead of the pen, it meets the error as early
+//! as any end and brings the pen to a stop there.
+//!
+//! * A jump is an error, never a travel: the machine has no pen lift, so crossing a pole would
+//!   draw a line the function does not contain.
+//! * The row range is the machine's travel seen from the start (`Curve::for_job` derives it with
+//!   [`RowRange::within_travel`]). Every step of a chord lies between the rows of its two
+//!   columns, so a curve that starts inside the travel never takes a step outside it, and one
+//!   that leaves the travel part way stops at the last column inside. This check is exact, at
+//!   every column; the G-code parser only samples a function to refuse most such curves before
+//!   anything moves.
 //!
 //! [`Interpolator::tangent`] is the direction of the current chord, `(1, h(k+1) - h(k))`
 //! normalised and pointing in the direction of travel (the derivative by finite difference).
@@ -70,6 +81,40 @@ impl From<EvalError> for CurveError {
             EvalError::Overflow => CurveError::Overflow,
         }
     }
+}
+
+/// The rows an explicit curve may reach, relative to its start, both ends included: the
+/// machine's travel on Y as seen from the start. A column whose row lies outside ends the curve
+/// with [`CurveError::Travel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct RowRange {
+    pub min: i32,
+    pub max: i32,
+}
+
+impl RowRange {
+    /// Every row: no travel limit.
+    pub const ANY: RowRange = RowRange { min: i32::MIN, max: i32::MAX };
+
+    /// The rows `r` with `|start_y + r| <= limit_steps`, for a curve that starts at the absolute
+    /// row `start_y` on a machine whose travel is ±`limit_steps` (a negative limit allows no
+    /// row at all).
+    pub fn within_travel(start_y: i32, limit_steps: i32) -> RowRange {
+        let (start, limit) = (i64::from(start_y), i64::from(limit_steps));
+        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        RowRange { min: clamp(-limit - start), max: clamp(limit - start) }
+    }
+
+    pub fn contains(self, row: i32) -> bool {
+        self.min <= row && row <= self.max
+    }
+}
+
+/// The jump limit of an explicit curve, in rows: the `max_jump_mm` setting (`$204`) at
+/// `y_steps_per_mm`, rounded down, and at least one row, or any slope at all would be a jump.
+pub fn jump_limit_steps(max_jump_mm: f32, y_steps_per_mm: f32) -> i32 {
+    (max_jump_mm * y_steps_per_mm).max(1.0) as i32
 }
 
 /// An explicit curve as [`ExplicitCurve`] sees it.
@@ -109,6 +154,8 @@ pub struct ExplicitCurve<G> {
     /// Number of columns to travel (|length|).
     columns: i32,
     max_jump_steps: i32,
+    /// Rows every column must lie in.
+    rows: RowRange,
     /// g(0): the curve is translated by it so that it starts at the pen.
     origin: f64,
     /// The current chord runs from column `seg` to `seg + 1`...
@@ -131,9 +178,16 @@ pub struct ExplicitCurve<G> {
 
 impl<G: CurveFn> ExplicitCurve<G> {
     /// A curve over `length_steps` columns (negative: toward -x), refusing jumps of more than
-    /// `max_jump_steps` rows between neighbouring columns (`i32::MAX`: no limit). Evaluates g at
-    /// the start; an error there is [`CurveSetupError::Start`] and nothing moves.
-    pub fn new(g: G, length_steps: i32, max_jump_steps: i32, method: Method) -> Result<Self, CurveSetupError> {
+    /// `max_jump_steps` rows between neighbouring columns (`i32::MAX`: no limit) and columns
+    /// outside `rows` ([`RowRange::ANY`]: no limit; the start, row 0, is not checked). Evaluates
+    /// g at the start; an error there is [`CurveSetupError::Start`] and nothing moves.
+    pub fn new(
+        g: G,
+        length_steps: i32,
+        max_jump_steps: i32,
+        rows: RowRange,
+        method: Method,
+    ) -> Result<Self, CurveSetupError> {
         if max_jump_steps < 0 {
             return Err(CurveSetupError::BadParameter);
         }
@@ -151,6 +205,7 @@ impl<G: CurveFn> ExplicitCurve<G> {
             dir,
             columns: length_steps.abs(),
             max_jump_steps,
+            rows,
             origin,
             seg: 0,
             h0: 0.0,
@@ -199,6 +254,9 @@ impl<G: CurveFn> ExplicitCurve<G> {
         let r1 = nearest_step(h1);
         if (r1 - self.y).abs() > self.max_jump_steps {
             return Err(CurveError::Jump);
+        }
+        if !self.rows.contains(r1) {
+            return Err(CurveError::Travel);
         }
         self.seg = seg;
         self.h0 = self.h1;
@@ -327,7 +385,9 @@ impl FunctionInterp {
     /// the pen: the path is `(xs - xs0, ys(x) - ys(x0))` in steps. The range becomes
     /// `round(|x1 - x0|·steps_per_mm[0])` columns. A rise or fall of more than `max_jump_steps`
     /// between neighbouring columns ends the curve with [`CurveError::Jump`] (the caller derives
-    /// it from the `max_jump_mm` setting).
+    /// it from the `max_jump_mm` setting with [`jump_limit_steps`]), a column outside `rows`
+    /// with [`CurveError::Travel`] (the caller derives it from the travel limits with
+    /// [`RowRange::within_travel`]).
     ///
     /// f(x0) is evaluated here: a domain error there is [`CurveSetupError::Start`] and nothing
     /// moves.
@@ -337,6 +397,7 @@ impl FunctionInterp {
         x1_mm: f64,
         steps_per_mm: [f64; 2],
         max_jump_steps: i32,
+        rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let [x_spm, y_spm] = steps_per_mm;
@@ -351,7 +412,7 @@ impl FunctionInterp {
         }
         let length_steps = nearest_step(length);
         let g = ExprFn { expr, x0_mm, x1_mm, columns: length_steps.abs(), y_steps_per_mm: y_spm };
-        Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, method)? })
+        Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, rows, method)? })
     }
 
     /// Where the steps handed out so far have taken the pen, relative to the start.
@@ -494,6 +555,7 @@ mod tests {
     use std::vec::Vec;
 
     const METHODS: [Method; 2] = [Method::Classic, Method::Diagonal];
+    const ANY: RowRange = RowRange::ANY;
 
     /// Curve values at columns 0..=n: a random walk mixing flat, steep and exactly-half rises,
     /// from an arbitrary origin.
@@ -535,7 +597,7 @@ mod tests {
             let r = rounded(&h);
             let rises: Vec<i32> = r.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
             for method in METHODS {
-                let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, i32::MAX, method).unwrap();
+                let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, i32::MAX, ANY, method).unwrap();
                 let w = walk(&mut curve, method, 100_000);
                 prop_assert_eq!(w.end, Ok(()));
                 prop_assert_eq!(w.last(), Point::new(dir * n, r[n as usize]));
@@ -558,7 +620,7 @@ mod tests {
             let r = rounded(&relative(&g));
             let first_jump = r.windows(2).position(|w| (w[1] - w[0]).abs() > max_jump);
             for method in METHODS {
-                let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, method).unwrap();
+                let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, ANY, method).unwrap();
                 let w = walk(&mut curve, method, 100_000);
                 match first_jump {
                     None => prop_assert_eq!(w.last(), Point::new(dir * n, r[n as usize])),
@@ -578,7 +640,7 @@ mod tests {
             let err = [CurveError::Domain, CurveError::DivisionByZero, CurveError::Overflow][which];
             let r = rounded(&relative(&g));
             for method in METHODS {
-                match ExplicitCurve::new(sampled(&g, Some((at, err))), n as i32, i32::MAX, method) {
+                match ExplicitCurve::new(sampled(&g, Some((at, err))), n as i32, i32::MAX, ANY, method) {
                     Err(e) => prop_assert_eq!((e, at), (CurveSetupError::Start(err), 0)),
                     Ok(mut curve) => {
                         let w = walk(&mut curve, method, 100_000);
@@ -591,16 +653,70 @@ mod tests {
         }
     }
 
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// No step ever leaves the rows: the curve ends, with the first error met (a jump is
+        /// reported before the travel), at the last column before the first column that jumps
+        /// or lies outside them.
+        #[test]
+        fn a_column_outside_the_rows_ends_the_curve_at_the_last_column_inside(
+            g in sampled_curve(),
+            below in 0i32..300,
+            above in 0i32..300,
+            max_jump in prop_oneof![Just(i32::MAX), 0i32..30],
+            backwards: bool,
+        ) {
+            let n = g.len() as i32 - 1;
+            let dir = if backwards { -1 } else { 1 };
+            let r = rounded(&relative(&g));
+            let rows = RowRange { min: -below, max: above };
+            let jumps = |k: usize| (r[k] - r[k - 1]).abs() > max_jump;
+            let first = (1..r.len()).find(|&k| jumps(k) || !rows.contains(r[k]));
+            for method in METHODS {
+                let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, rows, method).unwrap();
+                let w = walk(&mut curve, method, 100_000);
+                prop_assert!(w.path.iter().all(|p| rows.contains(p.y)), "a step outside {:?}", rows);
+                match first {
+                    None => prop_assert_eq!((w.end, w.last()), (Ok(()), Point::new(dir * n, r[n as usize]))),
+                    Some(k) => {
+                        let error = if jumps(k) { CurveError::Jump } else { CurveError::Travel };
+                        prop_assert_eq!(w.end, Err(error));
+                        prop_assert_eq!(w.last(), Point::new(dir * (k as i32 - 1), r[k - 1]));
+                        prop_assert!(w.path.iter().all(|p| p.x * dir < k as i32), "stepped toward column {}", k);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_row_range_is_the_travel_seen_from_the_start() {
+        assert_eq!(RowRange::within_travel(0, 20_000), RowRange { min: -20_000, max: 20_000 });
+        assert_eq!(RowRange::within_travel(5_000, 20_000), RowRange { min: -25_000, max: 15_000 });
+        assert_eq!(RowRange::within_travel(-20_000, 20_000), RowRange { min: 0, max: 40_000 });
+        // Beyond i32: clamped, never wrapped.
+        assert_eq!(RowRange::within_travel(i32::MIN, i32::MAX), RowRange { min: 1, max: i32::MAX });
+        // A start outside the travel: only the rows back inside.
+        assert_eq!(RowRange::within_travel(20_005, 20_000), RowRange { min: -40_005, max: -5 });
+        assert!(!RowRange::within_travel(0, -1).contains(0));
+        assert!(RowRange::ANY.contains(i32::MIN) && RowRange::ANY.contains(i32::MAX));
+        // The jump limit: `$204` in rows, at least one.
+        assert_eq!(jump_limit_steps(5.0, 100.0), 500);
+        assert_eq!(jump_limit_steps(0.001, 100.0), 1);
+        assert_eq!(jump_limit_steps(0.0, 100.0), 1);
+    }
+
     #[test]
     fn a_steep_rise_advances_x_halfway_up() {
         // One column rising four rows: the chord (0,0)-(1,4) crosses the middle at row 2.
         let g = [0.0, 4.0];
-        let mut diagonal = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, Method::Diagonal).unwrap();
+        let mut diagonal = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, ANY, Method::Diagonal).unwrap();
         let w = walk(&mut diagonal, Method::Diagonal, 10);
         let pts = |v: &[(i32, i32)]| v.iter().map(|&(x, y)| Point::new(x, y)).collect::<Vec<_>>();
         assert_eq!(w.path, pts(&[(0, 0), (0, 1), (1, 2), (1, 3), (1, 4)]));
         // Classic goes through the corner nearer to the chord: up two, across, up two.
-        let mut classic = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, Method::Classic).unwrap();
+        let mut classic = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, ANY, Method::Classic).unwrap();
         let w = walk(&mut classic, Method::Classic, 10);
         assert_eq!(w.path, pts(&[(0, 0), (0, 1), (0, 2), (1, 2), (1, 3), (1, 4)]));
     }
@@ -609,19 +725,19 @@ mod tests {
     fn values_beyond_the_machine_overflow_and_bad_parameters_are_refused() {
         let g = [0.0, 10.0, 2e6];
         for method in METHODS {
-            let mut curve = ExplicitCurve::new(sampled(&g, None), 2, i32::MAX, method).unwrap();
+            let mut curve = ExplicitCurve::new(sampled(&g, None), 2, i32::MAX, ANY, method).unwrap();
             let w = walk(&mut curve, method, 100);
             assert_eq!((w.end, w.last()), (Err(CurveError::Overflow), Point::new(1, 10)));
             let f = |_| Ok(0.0);
-            assert_eq!(ExplicitCurve::new(f, 10, -1, method).err(), Some(CurveSetupError::BadParameter));
+            assert_eq!(ExplicitCurve::new(f, 10, -1, ANY, method).err(), Some(CurveSetupError::BadParameter));
             assert_eq!(
-                ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, method).err(),
+                ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, ANY, method).err(),
                 Some(CurveSetupError::OutOfRange)
             );
-            assert_eq!(ExplicitCurve::new(f, i32::MIN, 0, method).err(), Some(CurveSetupError::OutOfRange));
+            assert_eq!(ExplicitCurve::new(f, i32::MIN, 0, ANY, method).err(), Some(CurveSetupError::OutOfRange));
             let nan = |_| Ok(f64::NAN);
             assert_eq!(
-                ExplicitCurve::new(nan, 10, 0, method).err(),
+                ExplicitCurve::new(nan, 10, 0, ANY, method).err(),
                 Some(CurveSetupError::Start(CurveError::Overflow))
             );
         }
@@ -640,7 +756,7 @@ mod tests {
         method: Method,
         f: impl Fn(f64) -> f64,
     ) -> (Walk, Vec<f64>, i32) {
-        let mut interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], max_jump, method).unwrap();
+        let mut interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], max_jump, ANY, method).unwrap();
         let n = ((x1 - x0) * spm).round() as i32;
         let dir = if n < 0 { -1 } else { 1 };
         let h: Vec<f64> = (0..=n.abs())
@@ -699,14 +815,16 @@ mod tests {
     fn one_over_x_stops_before_zero() {
         for method in METHODS {
             // Generous jump limit: the curve reaches x = -0.1 mm and fails on the division at 0.
-            let mut interp = FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 1000, method).unwrap();
+            let mut interp =
+                FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 1000, ANY, method).unwrap();
             let w = walk(&mut interp, method, 10_000);
             assert_eq!(w.end, Err(CurveError::DivisionByZero));
             // x = -0.1 mm: 1/x - 1/x0 = -10 + 1 = -9 mm.
             assert_eq!(w.last(), Point::new(9, -90));
             assert!(w.path.iter().all(|p| p.x <= 9));
             // A tighter limit stops it earlier, at the first rise of more than 30 steps.
-            let mut interp = FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 30, method).unwrap();
+            let mut interp =
+                FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 30, ANY, method).unwrap();
             let w = walk(&mut interp, method, 10_000);
             assert_eq!(w.end, Err(CurveError::Jump));
             // -1/0.3 → -1/0.2 falls 16.7 steps; -1/0.2 → -1/0.1 falls 50.
@@ -721,7 +839,7 @@ mod tests {
             // tan(x) on [1, 2] mm at 100 steps/mm: x = 1.57 gives 1255.8 mm, x = 1.58 gives
             // -108.6 mm; a 1000-step jump limit stops it before the pole.
             let mut interp =
-                FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, method).unwrap();
+                FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, ANY, method).unwrap();
             let w = walk(&mut interp, method, 1_000_000);
             assert_eq!(w.end, Err(CurveError::Jump));
             let last = w.last();
@@ -731,9 +849,16 @@ mod tests {
             assert!((last.y as f64 - ideal).abs() <= 0.5 + FLOAT_SLACK_STEPS);
             // Without a jump limit a pole between two columns goes unseen: over [0, π] at one
             // step/mm the columns are 0, π/3, 2π/3 and π, drawn as their polyline. Hence the limit.
-            let mut interp =
-                FunctionInterp::new(parse("tan(x)").unwrap(), 0.0, core::f64::consts::PI, [1.0, 1.0], i32::MAX, method)
-                    .unwrap();
+            let mut interp = FunctionInterp::new(
+                parse("tan(x)").unwrap(),
+                0.0,
+                core::f64::consts::PI,
+                [1.0, 1.0],
+                i32::MAX,
+                ANY,
+                method,
+            )
+            .unwrap();
             assert_eq!(walk(&mut interp, method, 100_000).end, Ok(()));
             // Started exactly at π/2, the pole is an error and nothing moves.
             let at_pole = FunctionInterp::new(
@@ -742,6 +867,7 @@ mod tests {
                 3.0,
                 [1.0, 1.0],
                 10,
+                ANY,
                 method,
             );
             assert_eq!(at_pole.err(), Some(CurveSetupError::Start(CurveError::DivisionByZero)));
@@ -754,14 +880,43 @@ mod tests {
             // sqrt(-1-x) is defined for x <= -1: from x = -3 mm it climbs down to x = -1 mm
             // (column 20 at 10 steps/mm) and fails at the next column.
             let mut interp =
-                FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, method).unwrap();
+                FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, ANY, method).unwrap();
             let w = walk(&mut interp, method, 10_000);
             assert_eq!(w.end, Err(CurveError::Domain));
             assert_eq!(w.last(), Point::new(20, (-libm::sqrt(2.0) * 10.0).round() as i32));
             assert!(w.path.iter().all(|p| p.x <= 20));
             // Started outside the domain, it does not start at all.
-            let outside = FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), 0.0, 1.0, [10.0, 10.0], 1000, method);
+            let outside = FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), 0.0, 1.0, [10.0, 10.0], 1000, ANY, method);
             assert_eq!(outside.err(), Some(CurveSetupError::Start(CurveError::Domain)));
+        }
+    }
+
+    #[test]
+    fn a_function_leaving_the_travel_part_way_stops_at_the_last_column_inside() {
+        // y = 250·sin²(πx/2) mm on [0, 4] mm at 100 steps/mm, the pen at row 1_000 of a ±20_000-row
+        // travel: rows above 19_000 (relative) are outside. The first hump (up to 25_000 rows)
+        // passes them, at most 393 rows per column, within the 500-row jump limit.
+        let (spm, start_y, limit) = (100.0, 1_000, 20_000);
+        let rows = RowRange::within_travel(start_y, limit);
+        let row = |k: i32| {
+            let s = libm::sin(core::f64::consts::PI * (k as f64 / spm) / 2.0);
+            nearest_step(250.0 * s * s * spm)
+        };
+        let first_out = (0..=400).find(|&k| row(k) > 19_000).unwrap();
+        let last_in = first_out - 1;
+        for method in METHODS {
+            let e = parse("250*sin(pi*x/2)^2").unwrap();
+            let mut interp = FunctionInterp::new(e, 0.0, 4.0, [spm, spm], 500, rows, method).unwrap();
+            assert_eq!(interp.nominal_end(), Ok(Point::new(400, 0)), "its end is inside");
+            let w = walk(&mut interp, method, 1_000_000);
+            assert_eq!(w.end, Err(CurveError::Travel));
+            assert_eq!(w.last(), Point::new(last_in, row(last_in)));
+            assert!(w.path.iter().all(|p| p.x <= last_in), "stepped toward column {first_out}");
+            assert!(w.path.iter().all(|p| (start_y + p.y).abs() <= limit), "a step outside the travel");
+            // Without the limit it draws both humps to its end.
+            let e = parse("250*sin(pi*x/2)^2").unwrap();
+            let mut free = FunctionInterp::new(e, 0.0, 4.0, [spm, spm], 500, ANY, method).unwrap();
+            assert_eq!(walk(&mut free, method, 1_000_000).end, Ok(()));
         }
     }
 
@@ -782,7 +937,7 @@ mod tests {
     fn steps_per_mm_differ_per_axis() {
         // y = x/2 on [0, 10] mm at 40 X steps/mm and 100 Y steps/mm: 400 columns, 500 rows.
         let mut interp =
-            FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, Method::Diagonal).unwrap();
+            FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, ANY, Method::Diagonal).unwrap();
         let w = walk(&mut interp, Method::Diagonal, 10_000);
         assert_eq!(w.last(), Point::new(400, 500));
         assert_eq!(w.steps(), 500);
@@ -792,7 +947,7 @@ mod tests {
     fn the_tangent_follows_the_curve_in_the_direction_of_travel() {
         let e = parse("x^2/10").unwrap();
         // At x = -10 mm the slope is 2x/10 = -2.
-        let mut fwd = FunctionInterp::new(e.clone(), -10.0, 10.0, [20.0, 20.0], 100, Method::Diagonal).unwrap();
+        let mut fwd = FunctionInterp::new(e.clone(), -10.0, 10.0, [20.0, 20.0], 100, ANY, Method::Diagonal).unwrap();
         let t = fwd.tangent();
         let want = (1.0 / 5f32.sqrt(), -2.0 / 5f32.sqrt());
         assert!((t.x - want.0).abs() < 0.01 && (t.y - want.1).abs() < 0.01, "{t:?}");
@@ -802,7 +957,7 @@ mod tests {
         }
         assert!(fwd.tangent().x > 0.999, "{:?}", fwd.tangent());
         // Drawn from x = 10 mm toward -x, the curve falls to the left.
-        let back = FunctionInterp::new(e, 10.0, -10.0, [20.0, 20.0], 100, Method::Classic).unwrap();
+        let back = FunctionInterp::new(e, 10.0, -10.0, [20.0, 20.0], 100, ANY, Method::Classic).unwrap();
         let t = back.tangent();
         assert!((t.x + want.0).abs() < 0.01 && (t.y - want.1).abs() < 0.01, "{t:?}");
     }
@@ -811,7 +966,7 @@ mod tests {
     fn bad_parameters_are_refused_and_an_empty_range_takes_no_step() {
         let e = parse("x").unwrap();
         let new = |x0: f64, x1: f64, spm: [f64; 2], jump: i32| {
-            FunctionInterp::new(e.clone(), x0, x1, spm, jump, Method::Diagonal).err()
+            FunctionInterp::new(e.clone(), x0, x1, spm, jump, ANY, Method::Diagonal).err()
         };
         assert_eq!(new(f64::NAN, 1.0, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(0.0, f64::INFINITY, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
@@ -819,7 +974,7 @@ mod tests {
         assert_eq!(new(0.0, 1.0, [10.0, -1.0], 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(0.0, 1.0, [10.0, 10.0], -1), Some(CurveSetupError::BadParameter));
         assert_eq!(new(-1e6, 1e6, [10.0, 10.0], 10), Some(CurveSetupError::OutOfRange));
-        let mut empty = FunctionInterp::new(e, 3.0, 3.0, [10.0, 10.0], 10, Method::Classic).unwrap();
+        let mut empty = FunctionInterp::new(e, 3.0, 3.0, [10.0, 10.0], 10, ANY, Method::Classic).unwrap();
         assert_eq!(empty.next_step(), Ok(None));
     }
 }

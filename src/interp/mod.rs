@@ -44,6 +44,9 @@ pub enum CurveError {
     Overflow,
     /// The curve jumps by more than the allowed distance between two points.
     Jump,
+    /// The curve would leave the machine's travel area (`$130`, `$131`): it ends at the last
+    /// point inside, before any step toward the first point outside.
+    Travel,
 }
 
 /// A unit vector in step space: the direction of travel of the ideal curve.
@@ -112,30 +115,37 @@ impl Curve {
                 Curve { kind: CurveKind::Line(LineInterp::new(d.x, d.y, method)), end: *to }
             }
             Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps } => {
+                // The same limits as a function's: no stroke between columns longer than `$204`,
+                // no row outside the travel.
+                let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let sine = SineInterp::new(
                     f64::from(*amplitude_steps),
                     f64::from(*omega_rad_per_step),
                     f64::from(*phase_rad),
                     *length_steps,
+                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    function::RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
                 let d = sine.end();
                 Curve { kind: CurveKind::Sine(sine), end: Point::new(start.x + d.x, start.y + d.y) }
             }
             Shape::Function { expr, x0_mm, x1_mm } => {
-                // At least one row between columns, or any slope at all would be a "jump".
-                let max_jump_steps = (settings.max_jump_mm * settings.steps_per_mm[1]).max(1.0) as i32;
+                // The parser checks X exactly (it is linear) and Y only on samples; the
+                // interpolator holds every column to the travel.
+                let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let f = FunctionInterp::new(
                     expr.clone(),
                     f64::from(*x0_mm),
                     f64::from(*x1_mm),
                     spm,
-                    max_jump_steps,
+                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    function::RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
-                // Where it ends if nothing stops it; a curve that stops early (a domain error
-                // or a jump part way) ends the program there, and the motion drops whatever
-                // was planned from this end.
+                // Where it ends if nothing stops it; a curve that stops early (a domain error,
+                // a jump or the travel limit part way) ends the program there, and the motion
+                // drops whatever was planned from this end.
                 let d = f.nominal_end().unwrap_or(Point::ORIGIN);
                 Curve { kind: CurveKind::Function(f), end: Point::new(start.x + d.x, start.y + d.y) }
             }

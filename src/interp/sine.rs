@@ -5,10 +5,19 @@
 //! exactly at `(length, round(f(length) - f(0)))`. The stepping itself — chords between
 //! columns, classic and diagonal rules, deviation bounds, tangent — is the explicit-curve core
 //! of `crate::interp::function` ([`ExplicitCurve`]); this module only supplies the function.
-//! A sine is continuous, so it has no jump limit and, once set up, never fails.
+//!
+//! A sine is continuous, but it is sampled once per X step: where |A·ω| (the steepest slope,
+//! in rows per column) is large, neighbouring columns lie far apart and the chord between them
+//! is a stroke the curve does not contain. It is therefore held to the same rules as a
+//! function: a rise or fall of more than `max_jump_steps` rows between neighbouring columns
+//! ends it with [`CurveError::Jump`], and a column outside its [`RowRange`] (the machine's
+//! travel) with [`CurveError::Travel`], both before any step toward that column. Otherwise, once
+//! set up, it never fails.
 
 use crate::geom::{Point, Step};
-use crate::interp::function::{CurveFn, CurveSetupError, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, nearest_step};
+use crate::interp::function::{
+    CurveFn, CurveSetupError, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, RowRange, nearest_step,
+};
 use crate::interp::{CurveError, Interpolator, Method, Tangent};
 
 /// Largest amplitude, in steps: the curve then spans at most [`MAX_CURVE_OFFSET_STEPS`] from its
@@ -49,11 +58,21 @@ impl SineInterp {
     /// `phase_rad` for x from 0 to `length_steps` (0: no step). Every parameter must be finite
     /// ([`CurveSetupError::BadParameter`]); |A| up to [`MAX_SINE_AMPLITUDE_STEPS`] and |length|
     /// up to [`MAX_CURVE_OFFSET_STEPS`] ([`CurveSetupError::OutOfRange`]).
+    ///
+    /// A rise or fall of more than `max_jump_steps` rows between neighbouring columns
+    /// (`i32::MAX`: no limit; a negative limit is [`CurveSetupError::BadParameter`]) ends the
+    /// curve with [`CurveError::Jump`], a column outside `rows` ([`RowRange::ANY`]: no limit)
+    /// with [`CurveError::Travel`]; the caller derives them from the settings with
+    /// `crate::interp::function::jump_limit_steps` and [`RowRange::within_travel`]. With
+    /// `|A·ω| <= max_jump_steps` no jump can occur: the sine rises by at most |A·ω| per column,
+    /// and the rounded rows of two values at most an integer `J` apart are at most `J` apart.
     pub fn new(
         amplitude_steps: f64,
         omega_rad_per_step: f64,
         phase_rad: f64,
         length_steps: i32,
+        max_jump_steps: i32,
+        rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let span_rad = omega_rad_per_step * f64::from(length_steps);
@@ -70,8 +89,7 @@ impl SineInterp {
         let f =
             SineFn { amplitude_steps, omega_rad_per_step, phase_rad, dir: if length_steps < 0 { -1.0 } else { 1.0 } };
         let end = Point::new(length_steps, nearest_step(f.at(f64::from(length_steps)) - f.at(0.0)));
-        // Continuous: no jump limit.
-        let curve = ExplicitCurve::new(f, length_steps, i32::MAX, method)?;
+        let curve = ExplicitCurve::new(f, length_steps, max_jump_steps, rows, method)?;
         Ok(SineInterp { curve, end })
     }
 
@@ -123,8 +141,10 @@ mod tests {
         let n = length.abs();
         let rows: Vec<i32> = h.iter().map(|&v| libm::floor(v + 0.5) as i32).collect();
         let rises: Vec<i32> = rows.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
+        // |A·ω| rows bounds the rise from one column to the next, so this jump limit never stops it.
+        let max_jump = libm::ceil(libm::fabs(a * omega)) as i32;
         for method in METHODS {
-            let mut sine = SineInterp::new(a, omega, phase, length, method).unwrap();
+            let mut sine = SineInterp::new(a, omega, phase, length, max_jump, RowRange::ANY, method).unwrap();
             let end = sine.end();
             let expected_steps: i32 = match method {
                 Method::Classic => n + rises.iter().sum::<i32>(),
@@ -186,14 +206,14 @@ mod tests {
     fn one_period_peaks_and_troughs_where_the_sine_does() {
         for method in METHODS {
             // A = 10, one period over 40 steps.
-            let mut sine = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, 40, method).unwrap();
+            let mut sine = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, 40, i32::MAX, RowRange::ANY, method).unwrap();
             let w = walk(&mut sine, method, 200);
             assert_eq!(w.last(), Point::new(40, 0));
             assert_eq!(w.path.iter().map(|p| p.y).max(), Some(10));
             assert_eq!(w.path.iter().map(|p| p.y).min(), Some(-10));
             assert!(w.path.contains(&Point::new(10, 10)) && w.path.contains(&Point::new(30, -10)));
             // Drawn toward -x it first falls: sin(-ωk) < 0.
-            let mut back = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, -40, method).unwrap();
+            let mut back = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, -40, i32::MAX, RowRange::ANY, method).unwrap();
             let w = walk(&mut back, method, 200);
             assert_eq!(w.last(), Point::new(-40, 0));
             assert!(w.path.contains(&Point::new(-10, -10)) && w.path.contains(&Point::new(-30, 10)));
@@ -201,9 +221,56 @@ mod tests {
     }
 
     #[test]
+    fn a_sine_steeper_than_the_jump_limit_stops_before_its_first_steep_chord() {
+        for method in METHODS {
+            // A = 1000 rows, ω = 1 rad/step: the first column is already 841 rows up.
+            let mut sine = SineInterp::new(1000.0, 1.0, 0.0, 100, 500, RowRange::ANY, method).unwrap();
+            let w = walk(&mut sine, method, 10);
+            assert_eq!((w.end, w.steps()), (Err(CurveError::Jump), 0));
+            // A = 100 rows, ω = 0.05 rad/step from the crest (phase 90°): level at first, steepest
+            // (|A·ω| = 5 rows per column) a quarter period later. A limit of 4 stops it on the way
+            // down, at the column before the first rise of 5...
+            let (a, omega, phase) = (100.0, 0.05, FRAC_PI_2);
+            let rows: Vec<i32> = ideal(a, omega, phase, 200).iter().map(|&v| nearest_step(v)).collect();
+            let first = rows.windows(2).position(|w| (w[1] - w[0]).abs() > 4).unwrap();
+            let mut sine = SineInterp::new(a, omega, phase, 200, 4, RowRange::ANY, method).unwrap();
+            let w = walk(&mut sine, method, 10_000);
+            assert_eq!(w.end, Err(CurveError::Jump));
+            assert_eq!(w.last(), Point::new(first as i32, rows[first]));
+            assert!(w.path.iter().all(|p| p.x <= first as i32));
+            // ...and a limit of |A·ω| lets it through.
+            let mut sine = SineInterp::new(a, omega, phase, 200, 5, RowRange::ANY, method).unwrap();
+            assert_eq!(walk(&mut sine, method, 10_000).end, Ok(()));
+            assert_eq!(
+                SineInterp::new(a, omega, phase, 200, -1, RowRange::ANY, method).err(),
+                Some(CurveSetupError::BadParameter)
+            );
+        }
+    }
+
+    #[test]
+    fn a_sine_leaving_the_travel_stops_at_the_last_column_inside() {
+        // A = 100 rows, half a period over 200 columns, from a pen at row 50 of a ±120-row
+        // travel: rows -170..=70 relative. The crest, 100 rows up, is outside.
+        let (start_y, limit) = (50, 120);
+        let rows = RowRange::within_travel(start_y, limit);
+        let h: Vec<i32> = ideal(100.0, PI / 200.0, 0.0, 200).iter().map(|&v| nearest_step(v)).collect();
+        let first_out = h.iter().position(|&r| r > 70).unwrap();
+        for method in METHODS {
+            let mut sine = SineInterp::new(100.0, PI / 200.0, 0.0, 200, i32::MAX, rows, method).unwrap();
+            assert_eq!(sine.end(), Point::new(200, 0), "its end is inside");
+            let w = walk(&mut sine, method, 10_000);
+            assert_eq!(w.end, Err(CurveError::Travel));
+            assert_eq!(w.last(), Point::new(first_out as i32 - 1, h[first_out - 1]));
+            assert!(w.path.iter().all(|p| (start_y + p.y).abs() <= limit), "a step outside the travel");
+        }
+    }
+
+    #[test]
     fn the_curve_starts_at_the_pen_whatever_the_phase() {
         // cos-shaped: f(0) = 5, so the path starts at 0 and falls to -10 at half a period.
-        let mut sine = SineInterp::new(5.0, PI / 20.0, FRAC_PI_2, 40, Method::Diagonal).unwrap();
+        let mut sine =
+            SineInterp::new(5.0, PI / 20.0, FRAC_PI_2, 40, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
         let w = walk(&mut sine, Method::Diagonal, 200);
         assert_eq!(w.path[0], Point::ORIGIN);
         assert!(w.path.contains(&Point::new(20, -10)));
@@ -214,16 +281,16 @@ mod tests {
     #[test]
     fn the_tangent_points_along_the_travel() {
         // A·ω = 1: at the start the curve rises at 45°.
-        let sine = SineInterp::new(10.0, 0.1, 0.0, 100, Method::Diagonal).unwrap();
+        let sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
         let t = sine.tangent();
         let s = core::f32::consts::FRAC_1_SQRT_2;
         assert!((t.x - s).abs() < 0.01 && (t.y - s).abs() < 0.01, "{t:?}");
         // Toward -x it falls to the left.
-        let sine = SineInterp::new(10.0, 0.1, 0.0, -100, Method::Classic).unwrap();
+        let sine = SineInterp::new(10.0, 0.1, 0.0, -100, i32::MAX, RowRange::ANY, Method::Classic).unwrap();
         let t = sine.tangent();
         assert!((t.x + s).abs() < 0.01 && (t.y + s).abs() < 0.01, "{t:?}");
         // At the crest (x = π/2/ω ≈ 15.7) it is level.
-        let mut sine = SineInterp::new(10.0, 0.1, 0.0, 100, Method::Diagonal).unwrap();
+        let mut sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
         while sine.position().x < 15 {
             sine.next_step().unwrap();
         }
@@ -232,7 +299,9 @@ mod tests {
 
     #[test]
     fn bad_parameters_are_refused_and_length_zero_takes_no_step() {
-        let new = |a: f64, w: f64, p: f64, l: i32| SineInterp::new(a, w, p, l, Method::Diagonal).err();
+        let new = |a: f64, w: f64, p: f64, l: i32| {
+            SineInterp::new(a, w, p, l, i32::MAX, RowRange::ANY, Method::Diagonal).err()
+        };
         assert_eq!(new(f64::NAN, 0.1, 0.0, 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(1.0, f64::INFINITY, 0.0, 10), Some(CurveSetupError::BadParameter));
         assert_eq!(new(1.0, 0.1, f64::NEG_INFINITY, 10), Some(CurveSetupError::BadParameter));
@@ -240,7 +309,7 @@ mod tests {
         assert_eq!(new(MAX_SINE_AMPLITUDE_STEPS * 1.01, 0.1, 0.0, 10), Some(CurveSetupError::OutOfRange));
         assert_eq!(new(1.0, 0.1, 0.0, -MAX_CURVE_OFFSET_STEPS - 1), Some(CurveSetupError::OutOfRange));
         for method in METHODS {
-            let mut sine = SineInterp::new(100.0, 0.3, 1.0, 0, method).unwrap();
+            let mut sine = SineInterp::new(100.0, 0.3, 1.0, 0, i32::MAX, RowRange::ANY, method).unwrap();
             assert_eq!(sine.end(), Point::ORIGIN);
             assert_eq!(sine.next_step(), Ok(None));
         }

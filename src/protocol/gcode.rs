@@ -56,12 +56,24 @@
 //! | `$F X<x0> U<x1> [F] Y=<expression>` | y = f(x) for x from x0 to x1, moved so that (x0, f(x0)) is at the pen; everything after `Y=` (up to a `;`) is the expression ([`crate::expr`]) |
 //!
 //! `$O` rather than `$C`, and `$SLP` kept apart from `$S`, so that a sender's check-mode or
-//! sleep button never draws. Every point of the curve must lie inside the travel limits
-//! (checked exactly for arcs, ellipses and sines, on [`FUNCTION_CHECK_SAMPLES`] samples plus the
-//! end for functions), else error 15 and nothing moves. Curves end on a step: the planned
-//! position afterwards is the [`Command::Curve`]'s `end`. A curve that ends on its own start step
-//! is a full turn if it sweeps more than half a turn, and draws nothing otherwise (it is shorter
-//! than a step).
+//! sleep button never draws. Every point of the curve must lie inside the travel limits, else
+//! error 15 and nothing moves. The check is exact for arcs, ellipses and sines, and for the X
+//! range of a function (it is linear); the Y of a function is checked on
+//! [`FUNCTION_CHECK_SAMPLES`] samples plus the end, an early refusal that catches most curves
+//! before anything moves. The interpolator enforces the travel exactly, at every column: a
+//! function that leaves it between the samples stops at its last column inside
+//! (`CurveError::Travel`, reported by the motion as the curve stopping).
+//!
+//! What the parser accepts, the interpolators accept: every arc or ellipse is set up here with
+//! the very steps it hands out (`ArcInterp::new`, `EllipseInterp::new`) and refused with error 33
+//! if its interpolator would refuse it (a radius that rounds to a centre on the start or the
+//! end, say), and so is a sine (`SineInterp::new`). A sine whose steepest rise between
+//! neighbouring X steps, |A·ω| in steps, exceeds the jump limit (`$204`, as for functions) is
+//! error 33 too: its interpolator would stop at the first such chord.
+//!
+//! Curves end on a step: the planned position afterwards is the [`Command::Curve`]'s `end`. A
+//! curve that ends on its own start step is a full turn if it sweeps more than half a turn, and
+//! draws nothing otherwise (it is shorter than a step).
 
 // Limits are written `!(value <= limit)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -71,6 +83,8 @@ use core::f32::consts::{FRAC_PI_2, PI, TAU};
 use super::GrblError;
 use super::line::LINE_MAX_BYTES;
 use crate::geom::{Axis, Point, Rotation};
+use crate::interp::function::{RowRange, jump_limit_steps};
+use crate::interp::{ArcInterp, EllipseInterp, SineInterp};
 use crate::job::{Feed, Job, Shape};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
@@ -147,7 +161,8 @@ pub const CURVE_RADIUS_MAX_MM: f32 = 5_000.0;
 /// Rounding allowance when a target is compared with the travel limits.
 pub const TRAVEL_SLACK_MM: f32 = 0.0005;
 
-/// Samples of a `$F` function checked against the travel limits (plus both ends).
+/// Samples of a `$F` function checked against the travel limits (plus both ends): an early
+/// refusal only; the interpolator holds every column to the travel.
 pub const FUNCTION_CHECK_SAMPLES: u32 = 64;
 
 /// Arc sweeps closer than this to zero count as a full turn (GRBL's epsilon).
@@ -634,6 +649,19 @@ impl GcodeState {
         } else {
             Shape::Ellipse { center, a_steps: semi[0] as i32, b_steps: semi[1] as i32, to, rotation }
         };
+        // Set up as the motion will set it up, from the same steps: a curve its interpolator
+        // would refuse (a tiny radius whose rounded centre falls on the start or the end) is
+        // refused here, before the planned position moves.
+        let accepted = match shape {
+            Shape::Arc { center, to, rotation } => ArcInterp::new(from, center, to, rotation, settings.method).is_ok(),
+            Shape::Ellipse { center, a_steps, b_steps, to, rotation } => {
+                EllipseInterp::new(from, center, a_steps, b_steps, to, rotation, settings.method).is_ok()
+            }
+            _ => true,
+        };
+        if !accepted {
+            return Err(GrblError::InvalidTarget);
+        }
         self.position_mm = c.end;
         self.position = to;
         Ok(Some(Command::Curve { shape, feed, end: to }))
@@ -887,11 +915,33 @@ impl GcodeState {
         }
         let amplitude_steps = amplitude_mm * spm[1];
         let omega_rad_per_step = omega_rad_per_mm / spm[0];
-        let dy = libm::roundf(amplitude_steps * (libm::sinf(omega_rad_per_step * dx + phase_rad) - s0));
-        // Both are within the travel checked above (±500 mm at 200 steps/mm at most).
-        let to = Point::new(self.position.x + dx as i32, self.position.y + dy as i32);
+        // The sine rises by at most |A·ω| steps from one X step to the next; above the jump
+        // limit its interpolator would stop at the first chord that steep (as a function does
+        // at a jump), so refuse it before anything moves. Computed as the interpolator does, in
+        // f64 from the same f32 values.
+        let max_jump_steps = jump_limit_steps(settings.max_jump_mm, spm[1]);
+        let steepest = libm::fabs(f64::from(amplitude_steps) * f64::from(omega_rad_per_step));
+        if !(steepest <= f64::from(max_jump_steps)) {
+            return Err(GrblError::InvalidTarget);
+        }
+        let length_steps = dx as i32;
+        // Set up as the motion will set it up (the travel is checked above, in millimetres);
+        // its end is where the parser plans the pen.
+        let sine = SineInterp::new(
+            f64::from(amplitude_steps),
+            f64::from(omega_rad_per_step),
+            f64::from(phase_rad),
+            length_steps,
+            max_jump_steps,
+            RowRange::ANY,
+            settings.method,
+        )
+        .map_err(|_| GrblError::InvalidTarget)?;
+        let d = sine.end();
+        // Within the travel checked above (±500 mm at 200 steps/mm at most).
+        let to = Point::new(self.position.x + d.x, self.position.y + d.y);
         self.land_on(to, settings);
-        let shape = Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps: dx as i32 };
+        let shape = Shape::Sine { amplitude_steps, omega_rad_per_step, phase_rad, length_steps };
         Ok(Some(Command::Curve { shape, feed, end: to }))
     }
 

@@ -565,6 +565,52 @@ fn sine_command() {
 }
 
 #[test]
+fn a_sine_steeper_than_the_jump_limit_is_refused() {
+    let mut g = GcodeState::new();
+    // y swings ±200 mm, inside the travel, but ω = 1000 rad/mm puts 400 mm strokes between
+    // neighbouring X steps.
+    refused(&mut g, "$S A200 W1000 L100", 33);
+    // The steepest rise per X step is A·ω steps (here, with equal steps/mm on both axes):
+    // 510 is over the 5 mm (500-step) limit, 490 under it.
+    refused(&mut g, "$S A100 W5.1 L10", 33);
+    let (_, _, end) = curve(&mut g, "$S A100 W4.9 L10");
+    assert_eq!(end.x, 1000);
+    // The limit is `$204`.
+    let mut s = settings();
+    s.max_jump_mm = 10.0;
+    let mut g = GcodeState::new();
+    assert!(g.execute("$S A100 W5.1 L10", &s, RunState::Idle).is_ok());
+    s.max_jump_mm = 1.0;
+    let before = g.clone();
+    assert_eq!(g.execute("$S A10 W11 L10", &s, RunState::Idle).map(|_| ()), Err(GrblError::InvalidTarget));
+    assert_eq!(g, before);
+    // Nothing to draw, nothing to refuse.
+    assert_eq!(run(&mut GcodeState::new(), "$S A200 W1000 L0.001"), Ok(Vec::new()));
+}
+
+#[test]
+fn arcs_too_small_for_their_interpolator_are_refused() {
+    let mut g = GcodeState::new();
+    // Radius half a step: the centre rounds onto the start or the end, which no interpolator
+    // can draw; the parser refuses them rather than plan a curve the motion would refuse.
+    refused(&mut g, "G2 X0.01 Y0 R0.005", 33);
+    refused(&mut g, "G2 X0.01 Y0 I0.005", 33);
+    refused(&mut g, "$O R0.005 S45 W360", 33);
+    refused(&mut g, "$E A0.005 B0.005 S45", 33);
+    // A step or two of radius draws.
+    let (shape, _, end) = curve(&mut g, "G2 X0.02 Y0 R0.015");
+    assert_eq!(shape, Shape::Arc { center: Point::new(1, -1), to: Point::new(2, 0), rotation: Rotation::Clockwise });
+    assert_eq!(end, Point::new(2, 0));
+    let (_, _, end) = curve(&mut g, "$O R0.01");
+    assert_eq!(end, Point::new(2, 0));
+    // An I/J end within GRBL's radius tolerance (0.1 % of r) but farther from the circle, in
+    // steps, than the interpolator follows: 0.08 mm off at r = 90 mm is 8 steps.
+    ok_all(&mut g, &["G0 X0 Y0"]);
+    refused(&mut g, "G91 G2 X180.08 Y0 I90", 33);
+    assert!(run(&mut g, "G91 G2 X180.01 Y0 I90").is_ok());
+}
+
+#[test]
 fn function_command() {
     let mut g = GcodeState::new();
     ok_all(&mut g, &["G0 X10 Y10"]);
