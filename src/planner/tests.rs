@@ -6,7 +6,7 @@ extern crate std;
 use super::*;
 use crate::geom::Point;
 use crate::interp::{LineInterp, Tangent};
-use crate::settings::Settings;
+use crate::settings::{MAX_PULSE_RATE_HZ, Settings};
 use std::vec::Vec;
 
 const DEFAULT_FEED: Feed = Feed::MmPerMin(3_000.0);
@@ -486,7 +486,7 @@ fn acceleration_stays_within_each_axis_limit() {
 #[test]
 fn rapid_runs_each_axis_at_its_max_rate_and_no_interval_is_too_short() {
     // Slow drivers: 4 kHz max pulse rate caps the steps; fast drivers: the axis max rates cap.
-    for pulse_hz in [4_000.0, 200_000.0] {
+    for pulse_hz in [4_000.0, MAX_PULSE_RATE_HZ] {
         let limits = limits_with(|s| {
             s.max_pulse_rate_hz = pulse_hz;
             s.max_rate_mm_per_min = [6_000.0, 3_000.0];
@@ -929,7 +929,7 @@ mod properties {
             (60.0f32..60_000.0, 60.0f32..60_000.0),
             (1.0f32..10_000.0, 1.0f32..10_000.0),
             0.0f32..1.0,
-            100.0f32..200_000.0,
+            100.0f32..MAX_PULSE_RATE_HZ,
             0.0f32..5.0,
         )
             .prop_map(|(spm, rate, accel, start, pulse, jd)| Settings {
