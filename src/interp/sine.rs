@@ -115,6 +115,16 @@ impl Interpolator for SineInterp {
     }
 }
 
+/// True when the sine y = A·sin(ω·x + φ) rises or falls by no more than the jump limit between
+/// two neighbouring X steps anywhere (its steepest slope is |A·ω|), so its interpolator never
+/// stops at a jump. Both inputs that draw sines (the host link and the keypad) refuse one that
+/// does not fit before anything moves.
+pub fn fits_jump_limit(amplitude_steps: f32, omega_rad_per_step: f32, settings: &crate::settings::Settings) -> bool {
+    let max_jump_steps = crate::interp::function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]);
+    let steepest = libm::fabs(f64::from(amplitude_steps) * f64::from(omega_rad_per_step));
+    steepest <= f64::from(max_jump_steps)
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;

@@ -84,7 +84,7 @@ use super::GrblError;
 use super::line::LINE_MAX_BYTES;
 use crate::geom::{Axis, Point, Rotation};
 use crate::interp::function::{RowRange, jump_limit_steps};
-use crate::interp::{ArcInterp, EllipseInterp, SineInterp};
+use crate::interp::{ArcInterp, EllipseInterp, SineInterp, sine};
 use crate::job::{Feed, Job, Shape};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
@@ -919,11 +919,10 @@ impl GcodeState {
         // limit its interpolator would stop at the first chord that steep (as a function does
         // at a jump), so refuse it before anything moves. Computed as the interpolator does, in
         // f64 from the same f32 values.
-        let max_jump_steps = jump_limit_steps(settings.max_jump_mm, spm[1]);
-        let steepest = libm::fabs(f64::from(amplitude_steps) * f64::from(omega_rad_per_step));
-        if !(steepest <= f64::from(max_jump_steps)) {
+        if !sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings) {
             return Err(GrblError::InvalidTarget);
         }
+        let max_jump_steps = jump_limit_steps(settings.max_jump_mm, spm[1]);
         let length_steps = dx as i32;
         // Set up as the motion will set it up (the travel is checked above, in millimetres);
         // its end is where the parser plans the pen.

@@ -43,7 +43,7 @@
 //! | 30 | `G53InvalidMotionMode`    | G53 while G2/G3/G80 is the motion mode |
 //! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode |
 //! | 32 | `NoAxisWordsInPlane`      | G2/G3 with only a Z word |
-//! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, a curve of less than one step radius, sweep above 360° |
+//! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, a curve of less than one step radius, sweep above 360°, a sine steeper than the max function jump (`$204`) |
 //! | 33 | `FunctionUndefined`       | the `$F` function cannot be evaluated on its range (an info line gives x) |
 //! | 34 | `ArcRadius`               | R arc whose radius is shorter than half the chord |
 //! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |

@@ -267,6 +267,8 @@ pub enum UiError {
     SameEnds,
     /// The function is undefined somewhere between x0 and x1.
     Domain,
+    /// A sine rises faster between two steps than the max function jump (`$204`) allows.
+    TooSteep,
     /// The drawing would leave the travel area ($130, $131).
     Travel,
     /// The machine is moving or has jobs queued.
@@ -431,7 +433,14 @@ impl Form {
             if !extent_within_travel(start, &extent, settings) {
                 return Err(UiError::Travel);
             }
-            MenuAction::StartCurve(CurveJob { start, curve, feed })
+            let job = CurveJob { start, curve, feed };
+            if let Ok(Job { shape: Shape::Sine { amplitude_steps, omega_rad_per_step, .. }, .. }) = job.to_job(settings)
+            {
+                if !crate::interp::sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings) {
+                    return Err(UiError::TooSteep);
+                }
+            }
+            MenuAction::StartCurve(job)
         };
         match status.state {
             RunState::Alarm => Err(UiError::Alarm),
@@ -897,6 +906,10 @@ mod tests {
         );
         assert_eq!(type_keys(&mut m, "5# 20# # 0#", &idle()), []);
         assert_eq!(m.message(), Some(UiError::Zero));
+        // A 100 mm amplitude over a 1 mm period rises 628 mm per mm: far over the 5 mm jump limit.
+        type_keys(&mut m, "D", &idle());
+        assert_eq!(type_keys(&mut m, "5 100# 1# # 10#", &idle()), []);
+        assert_eq!(m.message(), Some(UiError::TooSteep));
     }
 
     #[test]

@@ -280,6 +280,7 @@ impl fmt::Display for ErrorText {
             UiError::Zero => f.write_str("Must not be 0"),
             UiError::SameEnds => f.write_str("x1 must differ from x0"),
             UiError::Domain => f.write_str("f(x) undefined there"),
+            UiError::TooSteep => f.write_str("too steep: A or 1/P"),
             UiError::Travel => f.write_str("Beyond travel limits"),
             UiError::Busy => f.write_str("Busy: wait, or D abort"),
             UiError::Alarm => f.write_str("Alarm: motion locked"),
