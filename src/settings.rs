@@ -36,7 +36,6 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, name: "pulse width", unit: "us", min: 2.5, max: 100.0 },
     SettingInfo { id: 3, name: "direction invert mask", unit: "mask", min: 0.0, max: 3.0 },
     SettingInfo { id: 11, name: "junction deviation", unit: "mm", min: 0.0, max: 5.0 },
-    SettingInfo { id: 12, name: "arc tolerance", unit: "mm", min: 0.0001, max: 1.0 },
     SettingInfo { id: 100, name: "x steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
     SettingInfo { id: 101, name: "y steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
     SettingInfo { id: 110, name: "x max rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
@@ -63,8 +62,6 @@ pub struct Settings {
     pub dir_invert_mask: u8,
     /// GRBL's junction deviation for look-ahead at corners ($11).
     pub junction_deviation_mm: f32,
-    /// Largest chord error allowed where a curve is approximated ($12).
-    pub arc_tolerance_mm: f32,
     /// Steps per millimetre, X and Y ($100, $101).
     pub steps_per_mm: [f32; 2],
     /// Fastest travel per axis ($110, $111).
@@ -93,7 +90,6 @@ impl Default for Settings {
             pulse_width_us: 5.0,
             dir_invert_mask: 0,
             junction_deviation_mm: 0.02,
-            arc_tolerance_mm: 0.002,
             steps_per_mm: [100.0, 100.0],
             max_rate_mm_per_min: [6_000.0, 6_000.0],
             accel_mm_per_s2: [500.0, 500.0],
@@ -115,7 +111,6 @@ impl Settings {
             0 => self.pulse_width_us,
             3 => self.dir_invert_mask as f32,
             11 => self.junction_deviation_mm,
-            12 => self.arc_tolerance_mm,
             100 | 101 => self.steps_per_mm[(id - 100) as usize],
             110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize],
             120 | 121 => self.accel_mm_per_s2[(id - 120) as usize],
@@ -145,7 +140,6 @@ impl Settings {
             0 => next.pulse_width_us = value,
             3 if whole => next.dir_invert_mask = value as u8,
             11 => next.junction_deviation_mm = value,
-            12 => next.arc_tolerance_mm = value,
             100 | 101 => next.steps_per_mm[(id - 100) as usize] = value,
             110 | 111 => next.max_rate_mm_per_min[(id - 110) as usize] = value,
             120 | 121 => next.accel_mm_per_s2[(id - 120) as usize] = value,

@@ -115,6 +115,24 @@ impl Interpolator for SineInterp {
     }
 }
 
+/// The least and greatest sin(t) for t between `t0` and `t1` (either order).
+pub fn sin_range(t0: f32, t1: f32) -> (f32, f32) {
+    use core::f32::consts::{FRAC_PI_2, TAU};
+    let (lo, hi) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
+    if hi - lo >= TAU {
+        return (-1.0, 1.0);
+    }
+    let (a, b) = (libm::sinf(lo), libm::sinf(hi));
+    let (mut min, mut max) = (a.min(b), a.max(b));
+    if FRAC_PI_2 + libm::ceilf((lo - FRAC_PI_2) / TAU) * TAU <= hi {
+        max = 1.0;
+    }
+    if -FRAC_PI_2 + libm::ceilf((lo + FRAC_PI_2) / TAU) * TAU <= hi {
+        min = -1.0;
+    }
+    (min, max)
+}
+
 /// True when the sine y = A·sin(ω·x + φ) rises or falls by no more than the jump limit between
 /// two neighbouring X steps anywhere (its steepest slope is |A·ω|), so its interpolator never
 /// stops at a jump. Both inputs that draw sines (the host link and the keypad) refuse one that

@@ -84,7 +84,8 @@ use super::GrblError;
 use super::line::LINE_MAX_BYTES;
 use crate::geom::{Axis, Point, Rotation};
 use crate::interp::function::{RowRange, jump_limit_steps};
-use crate::interp::{ArcInterp, EllipseInterp, SineInterp, sine};
+use crate::interp::sine::{self, sin_range};
+use crate::interp::{ArcInterp, EllipseInterp, SineInterp};
 use crate::job::{Feed, Job, Shape};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
@@ -1364,23 +1365,6 @@ fn check_travel(settings: &Settings, mm: [f32; 2]) -> Result<(), GrblError> {
 /// Machine millimetres (inside the travel limits) to the nearest step.
 fn to_steps(settings: &Settings, mm: [f32; 2]) -> Point {
     Point::new(settings.mm_to_steps(Axis::X, mm[0]), settings.mm_to_steps(Axis::Y, mm[1]))
-}
-
-/// The smallest and largest value of sin(t) for t between `t0` and `t1`.
-fn sin_range(t0: f32, t1: f32) -> (f32, f32) {
-    let (lo, hi) = if t0 <= t1 { (t0, t1) } else { (t1, t0) };
-    if hi - lo >= TAU {
-        return (-1.0, 1.0);
-    }
-    let (a, b) = (libm::sinf(lo), libm::sinf(hi));
-    let (mut min, mut max) = (a.min(b), a.max(b));
-    if FRAC_PI_2 + libm::ceilf((lo - FRAC_PI_2) / TAU) * TAU <= hi {
-        max = 1.0;
-    }
-    if -FRAC_PI_2 + libm::ceilf((lo + FRAC_PI_2) / TAU) * TAU <= hi {
-        min = -1.0;
-    }
-    (min, max)
 }
 
 #[cfg(test)]

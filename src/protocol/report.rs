@@ -284,14 +284,13 @@ mod tests {
     #[test]
     fn settings_list_like_grbl() {
         let mut s = Settings::default();
-        s.set(12, 0.0005).unwrap();
+        s.set(11, 0.0005).unwrap();
         let list = text(|o| settings(o, &s));
         let lines: std::vec::Vec<&str> = list.split("\r\n").filter(|l| !l.is_empty()).collect();
         assert_eq!(lines.len(), SETTING_INFO.len());
         assert_eq!(lines[0], "$0=5.000");
         assert!(lines.contains(&"$3=0"));
-        assert!(lines.contains(&"$11=0.020"));
-        assert!(lines.contains(&"$12=0.0005"));
+        assert!(lines.contains(&"$11=0.0005"));
         assert!(lines.contains(&"$100=100.000"));
         assert!(lines.contains(&"$202=1"));
         assert!(lines.contains(&"$205=20000.000"));

@@ -15,10 +15,11 @@
 //!
 //! This module owns no state and reads no settings.
 
-use core::f32::consts::{FRAC_PI_2, PI, TAU};
+use core::f32::consts::TAU;
 
 use crate::expr::ParseError;
 use crate::geom::{Axis, Point, Rotation};
+use crate::interp::sine::sin_range;
 use crate::job::{Feed, Job, Shape};
 use crate::settings::Settings;
 
@@ -346,24 +347,6 @@ fn sin_cos_deg(deg: f32) -> (f32, f32) {
     }
 }
 
-/// The least and greatest sin(u) for u in [u0, u1].
-fn sin_range(u0: f32, u1: f32) -> (f32, f32) {
-    if u1 - u0 >= TAU {
-        return (-1.0, 1.0);
-    }
-    let (s0, s1) = (libm::sinf(u0), libm::sinf(u1));
-    let (mut min, mut max) = (s0.min(s1), s0.max(s1));
-    // Peaks and troughs at π/2 + kπ; fewer than three fit in less than a full turn.
-    let k_first = libm::ceilf((u0 - FRAC_PI_2) / PI) as i32;
-    let k_last = libm::floorf((u1 - FRAC_PI_2) / PI) as i32;
-    for k in k_first..=k_last {
-        let s = if k.rem_euclid(2) == 0 { 1.0 } else { -1.0 };
-        min = min.min(s);
-        max = max.max(s);
-    }
-    (min, max)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -432,6 +415,21 @@ mod tests {
         assert_extent(b.extent().unwrap(), (0.0, 60.0), (0.0, 20.0 - y0));
         for p in FunctionPreset::ALL {
             assert_eq!(FunctionPreset::ALL[p.index()], p);
+        }
+    }
+
+    #[test]
+    fn every_preset_computes_the_function_its_expression_draws() {
+        for preset in FunctionPreset::ALL {
+            let expr = crate::expr::parse(preset.expression()).unwrap();
+            for k in -40..=40 {
+                let x = k as f32 * 0.75;
+                match (preset.eval(x), expr.eval(f64::from(x))) {
+                    (Some(a), Ok(b)) => assert!((f64::from(a) - b).abs() < 1e-3 * (1.0 + b.abs()), "{preset:?} at {x}"),
+                    (None, Err(_)) => {}
+                    other => panic!("{preset:?} at {x}: {other:?}"),
+                }
+            }
         }
     }
 }
