@@ -23,6 +23,8 @@ pub enum Feed {
 
 /// The path of one job, in steps. Curves that start "at the pen" (sine, function) are
 /// translated so their first point is wherever the pen is when the job begins.
+// No heap: a function carries its expression by value, so it is the largest.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Shape {

@@ -185,7 +185,6 @@ pub fn run(config: SimConfig) -> SimReport {
     let position = machine.position();
     let settings = machine.settings();
     let end_us = clock::now_ticks();
-    drop(firmware);
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);

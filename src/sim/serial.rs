@@ -101,10 +101,8 @@ impl SimSerial {
             l.reset_sent |= b == 0x18;
             sent = true;
         }
-        if sent {
-            if let Some(w) = l.reader.take() {
-                w.wake();
-            }
+        if sent && let Some(w) = l.reader.take() {
+            w.wake();
         }
     }
 

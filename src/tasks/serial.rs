@@ -74,7 +74,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         resets_pending: Cell::new(0),
         reset: Signal::new(),
     };
-    link.send(|a| report::welcome(a)).await;
+    link.send(report::welcome).await;
     join3(receive(&link, rx), lines(&link), faults(&link)).await;
     unreachable!("the serial loops never end")
 }
@@ -177,7 +177,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
                 link.jogging.set(false);
-                link.send(|a| report::welcome(a)).await;
+                link.send(report::welcome).await;
                 continue;
             }
             if link.resets_pending.get() > 0 {
@@ -209,7 +209,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 Some(other) => Err(Stop::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
             };
             match result {
-                Ok(()) => link.send(|a| report::ok(a)).await,
+                Ok(()) => link.send(report::ok).await,
                 Err(Stop::Error(e)) => link.send(|a| report::error(a, e)).await,
                 Err(Stop::Reset) => {}
             }

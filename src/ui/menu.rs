@@ -80,6 +80,8 @@ pub fn jog_step(key: Key) -> Option<Step> {
 }
 
 /// What the menu asks the machine to do.
+// A started job carries its shape by value (no heap).
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum MenuAction {
@@ -435,10 +437,9 @@ impl Form {
             }
             let job = CurveJob { start, curve, feed };
             if let Ok(Job { shape: Shape::Sine { amplitude_steps, omega_rad_per_step, .. }, .. }) = job.to_job(settings)
+                && !crate::interp::sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings)
             {
-                if !crate::interp::sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings) {
-                    return Err(UiError::TooSteep);
-                }
+                return Err(UiError::TooSteep);
             }
             MenuAction::StartCurve(job)
         };
