@@ -43,3 +43,30 @@ fn holding_a_jog_key_moves_until_release_and_stops_on_a_step() {
     assert_eq!((xb, yf, yb), (0, 0, 0));
     assert_eq!(report.position, Point::new(xf as i32, 0), "position is the pulses emitted");
 }
+
+#[test]
+fn the_circle_mode_draws_a_closed_circle_around_the_centre_left_of_the_pen() {
+    // Mode 3 (circle): radius 8 mm #, start angle 0 # (default), sweep # (default: full turn).
+    let report = sim::run_keys("3 8 # # #").unwrap();
+    assert_eq!(report.position, Point::ORIGIN, "closed");
+    let path = report.path();
+    // Centre 8 mm left of the pen: (-800, 0) steps. Diagonal method: within half a step.
+    let off = path.iter().map(|p| ((p.x as f64 + 800.0).hypot(p.y as f64) - 800.0).abs()).fold(0.0, f64::max);
+    assert!(off <= 0.5 + 1e-9, "{off} steps off the circle");
+    assert!(path.iter().any(|p| p.x == -1600), "the far side was reached");
+}
+
+#[test]
+fn c_holds_and_resumes_a_keypad_curve_and_d_aborts_it_on_its_path() {
+    let reference = sim::run_keys("3 8 # # #").unwrap();
+    let full = reference.path();
+    // The circle starts at about 0.9 s (after the keys); C at 1.5 s holds, C at 3 s resumes.
+    let held = sim::run_keys("3 8 # # # wait:300 C wait:1400 C").unwrap();
+    assert_eq!(held.path(), full, "the same steps after a hold and a resume");
+    assert!(held.last_pulse_us() > reference.last_pulse_us() + 1_000_000, "it stood still while held");
+    let aborted = sim::run_keys("3 8 # # # wait:300 D").unwrap();
+    let cut = aborted.path();
+    assert!(cut.len() < full.len() / 2, "D stopped it");
+    assert_eq!(cut[..], full[..cut.len()], "on the circle's path");
+    assert_eq!(aborted.position, *cut.last().unwrap());
+}
