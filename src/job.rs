@@ -57,6 +57,10 @@ pub struct Job {
     pub shape: Shape,
     pub feed: Feed,
     pub kind: JobKind,
+    /// Aborts the machine had counted when the job was planned (`Machine::aborts`): a job
+    /// planned before an abort was planned from a point the pen never reached, and the motion
+    /// task drops it.
+    pub aborts_before: u32,
 }
 
 /// Run-time commands that act on the motion in progress. Requests that arrive before the motion
@@ -86,12 +90,18 @@ impl Control {
 impl Job {
     /// A drawing job.
     pub const fn draw(shape: Shape, feed: Feed) -> Job {
-        Job { shape, feed, kind: JobKind::Draw }
+        Job { shape, feed, kind: JobKind::Draw, aborts_before: 0 }
     }
 
     /// A jog: a straight move to `to`.
     pub const fn jog_to(to: Point, feed: Feed) -> Job {
-        Job { shape: Shape::Line { to }, feed, kind: JobKind::Jog }
+        Job { shape: Shape::Line { to }, feed, kind: JobKind::Jog, aborts_before: 0 }
+    }
+
+    /// The same job, planned after `aborts` aborts.
+    pub const fn planned_after(mut self, aborts: u32) -> Job {
+        self.aborts_before = aborts;
+        self
     }
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a

@@ -57,6 +57,13 @@ pub struct Machine {
     pub changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
     pub faults: Signal<CriticalSectionRawMutex, MotionFault>,
+    /// Counts aborts (a control, a curve stopped part way): jobs planned before one were
+    /// planned from a point the pen may never reach.
+    aborts: AtomicU32,
+    /// Wakes whoever waits to hand over a job when an abort happens.
+    pub aborted: Signal<CriticalSectionRawMutex, ()>,
+    /// The planner holds nothing (set by the motion task).
+    plan_empty: AtomicBool,
     /// Wakes the motion task when the pulse task has emitted everything queued.
     pub pulses_done: Signal<CriticalSectionRawMutex, ()>,
     menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
@@ -79,6 +86,9 @@ impl Machine {
             steps: Channel::new(),
             changed: Signal::new(),
             pulses_done: Signal::new(),
+            aborts: AtomicU32::new(0),
+            aborted: Signal::new(),
+            plan_empty: AtomicBool::new(true),
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
@@ -211,6 +221,27 @@ impl Machine {
     pub fn set_menu(&self, menu: Menu) {
         self.menu.lock(|m| *m.borrow_mut() = menu);
         self.changed.signal(());
+    }
+
+    /// Counts an abort: what was planned is dropped. Only the motion task calls this.
+    pub fn note_abort(&self) {
+        self.aborts.fetch_add(1, Ordering::AcqRel);
+        self.aborted.signal(());
+    }
+
+    /// Aborts so far: when this changes, positions planned before it are stale.
+    pub fn aborts(&self) -> u32 {
+        self.aborts.load(Ordering::Acquire)
+    }
+
+    /// Whether the planner holds anything. Only the motion task calls this.
+    pub fn set_plan_empty(&self, empty: bool) {
+        self.plan_empty.store(empty, Ordering::Release);
+    }
+
+    /// True when nothing is queued, planned or moving, held or not: the position is final.
+    pub fn stopped(&self) -> bool {
+        self.plan_empty.load(Ordering::Acquire) && self.jobs.is_empty() && self.pulses_idle()
     }
 
     /// True when nothing is queued, planned or moving.

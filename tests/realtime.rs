@@ -88,3 +88,81 @@ fn a_hold_at_rest_is_reported_and_keeps_the_next_job_until_cycle_start() {
     assert_eq!(report.position, Point::new(100, 0));
     assert!(report.trace.pulses[0].t_us >= 1_000_000, "nothing moved before the resume");
 }
+
+/// Bytes typed or pasted at `t_us`, all at once, ignoring flow control.
+fn paste(t_us: u64, text: &str) -> Vec<(u64, u8)> {
+    text.bytes().map(|b| (t_us, b)).collect()
+}
+
+fn run_timed(program: &str, timed: &[(u64, u8)], keys: Option<&str>) -> SimReport {
+    let mut serial = SimSerial::with_input(program.as_bytes());
+    for &(t, b) in timed {
+        serial = serial.with_byte_at(t, b);
+    }
+    let keys = keys.map(|k| servoplot::sim::keys::KeyScript::parse(k).unwrap()).unwrap_or_default();
+    let report = sim::run(SimConfig { serial, keys, ..SimConfig::default() });
+    assert!(!report.timed_out, "the machine came to rest: {}", report.answers());
+    report
+}
+
+fn inside_the_travel(report: &SimReport) -> bool {
+    let limit = (report.settings.max_travel_mm[0] * report.settings.steps_per_mm[0]) as i32;
+    report.path().iter().all(|p| p.x.abs() <= limit && p.y.abs() <= limit)
+}
+
+#[test]
+fn lines_planned_before_a_curve_stopped_part_way_are_planned_again_from_where_it_stopped() {
+    // The function jumps 6 mm at x = 10 mm (over the 5 mm limit) and stops there; lines
+    // streamed behind it were planned from its end, 40 mm further right.
+    let mut g = String::from("$F X0 U50 F3000 Y=floor(x/10)*6\n");
+    for k in 0..19 {
+        g += if k % 2 == 0 { "G1 X50 Y31\n" } else { "G1 X50 Y30\n" };
+    }
+    g += "$S A1 W0.5 L-245 F3000\n"; // from X50 it would end at X-195; from X10, at X-235
+    let report = run_timed(&g, &[], None);
+    let answers = report.answers();
+    assert!(answers.contains("[MSG:Curve stopped: Jump; queued moves dropped]"), "{answers}");
+    assert!(inside_the_travel(&report), "a step outside the travel");
+}
+
+#[test]
+fn a_jog_cancel_makes_the_next_jog_start_from_where_the_pen_stopped() {
+    let mut timed = vec![(1_000_000, 0x85)];
+    timed.extend(paste(1_005_000, "$J=G91 X1 F600\n"));
+    let cancelled = run_timed("$J=G91 X50 F1200\n", &[(1_000_000, 0x85)], None);
+    let nudged = run_timed("$J=G91 X50 F1200\n", &timed, None);
+    let stop = cancelled.position.x;
+    assert!(stop < 2500, "the jog was cancelled at {stop}");
+    assert!((nudged.position.x - (stop + 100)).abs() <= 1, "nudged 1 mm from {stop}: {:?}", nudged.position);
+}
+
+#[test]
+fn a_jog_cancel_does_not_stop_a_keypad_drawing_after_a_host_jog() {
+    let reference = run_timed("$J=G91 X10 F3000\n", &[], Some("wait:1000 3 8 # # #"));
+    let report = run_timed("$J=G91 X10 F3000\n", &[(2_157_000, 0x85)], Some("wait:1000 3 8 # # #"));
+    assert_eq!(report.path(), reference.path(), "the circle was drawn whole");
+}
+
+#[test]
+fn a_hold_right_after_a_reset_still_gets_the_banner() {
+    for dt in [0, 50_000, 90_000, 95_000, 120_000] {
+        let timed = [(1_000_000, 0x18), (1_000_000 + dt, b'!'), (3_000_000, b'~')];
+        let report = run_timed("G1 X100 F3000\n", &timed, None);
+        assert_eq!(report.answers().matches("Grbl 1.1").count(), 2, "dt {dt}: {}", report.answers());
+    }
+}
+
+#[test]
+fn a_paste_ignoring_flow_control_during_a_hold_never_locks_the_link() {
+    let lines: String = (1..=30).map(|k| format!("G1 X{k} Y0\n")).collect();
+    let mut timed = paste(0, &lines);
+    timed.push((1, b'!'));
+    timed.extend(paste(2, &lines));
+    timed.extend([(3_000_000, b'~'), (4_000_000, 0x18), (5_000_000, b'?')]);
+    let report = run_timed("", &timed, None);
+    let answers = report.answers();
+    assert!(answers.contains("[MSG:Receive buffer full: a line was dropped]"), "{answers}");
+    assert_eq!(answers.matches("Grbl 1.1").count(), 2, "the reset got through: {answers}");
+    assert!(answers.contains("<Idle|"), "the status query got through: {answers}");
+    assert_eq!(report.position, *report.path().last().unwrap());
+}

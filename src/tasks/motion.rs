@@ -44,6 +44,12 @@ pub async fn run(machine: &Machine) -> ! {
         }
         while !planner.is_full() {
             let Ok(job) = machine.jobs.try_receive() else { break };
+            if job.aborts_before != machine.aborts() {
+                // Planned before an abort, from where the dropped plan would have ended; its
+                // sender was told (`error:9`) or the abort's message covers it.
+                warn!("job planned before an abort dropped");
+                continue;
+            }
             let settings = machine.settings();
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
@@ -61,6 +67,7 @@ pub async fn run(machine: &Machine) -> ! {
         }
         match planner.next_cmd() {
             Some(Ok(cmd)) => {
+                machine.set_plan_empty(false);
                 machine.set_run_state(moving);
                 sent_end = sent_end.stepped(cmd.step);
                 machine.queue_step(cmd).await;
@@ -71,29 +78,31 @@ pub async fn run(machine: &Machine) -> ! {
                 // reached. The host is told (see the serial task).
                 warn!("curve ended early: {:?}", e);
                 machine.set_fault(Some(MotionFault::Curve(e)));
-                planner.abort();
-                while machine.jobs.try_receive().is_ok() {}
+                abort(machine, &mut planner);
             }
-            None => match planner.state() {
-                PlannerState::Idle => {
-                    // Everything planned is queued: rest once it has been emitted.
-                    while !machine.pulses_idle() {
-                        machine.pulses_done.wait().await;
+            None => {
+                machine.set_plan_empty(planner.is_idle());
+                match planner.state() {
+                    PlannerState::Idle => {
+                        // Everything planned is queued: rest once it has been emitted.
+                        while !machine.pulses_idle() {
+                            machine.pulses_done.wait().await;
+                        }
+                        if machine.run_state() != RunState::Idle {
+                            info!("at rest at ({}, {}) steps", sent_end.x, sent_end.y);
+                        }
+                        machine.set_run_state(RunState::Idle);
+                        wait_for_work(machine, &planner).await;
                     }
-                    if machine.run_state() != RunState::Idle {
-                        info!("at rest at ({}, {}) steps", sent_end.x, sent_end.y);
+                    PlannerState::Held => {
+                        machine.set_run_state(RunState::Hold);
+                        wait_for_work(machine, &planner).await;
                     }
-                    machine.set_run_state(RunState::Idle);
-                    wait_for_work(machine, &planner).await;
+                    PlannerState::Running | PlannerState::Holding | PlannerState::Aborting => {
+                        Timer::after(Duration::from_micros(MOTION_RETRY_US)).await;
+                    }
                 }
-                PlannerState::Held => {
-                    machine.set_run_state(RunState::Hold);
-                    wait_for_work(machine, &planner).await;
-                }
-                PlannerState::Running | PlannerState::Holding | PlannerState::Aborting => {
-                    Timer::after(Duration::from_micros(MOTION_RETRY_US)).await;
-                }
-            },
+            }
         }
     }
 }
@@ -145,9 +154,14 @@ fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, cont
     match control {
         Control::Hold => planner.hold(),
         Control::Resume => planner.resume(),
-        Control::Abort => {
-            planner.abort();
-            while machine.jobs.try_receive().is_ok() {}
-        }
+        Control::Abort => abort(machine, planner),
     }
+}
+
+/// Decelerates to a stop and drops everything planned and queued, telling the inputs that
+/// positions planned so far are stale.
+fn abort(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>) {
+    planner.abort();
+    while machine.jobs.try_receive().is_ok() {}
+    machine.note_abort();
 }

@@ -28,6 +28,8 @@ pub struct AxisPins<P: OutputPin> {
 /// Pin timing, read from the settings at the start of every burst of motion.
 struct PulseTiming {
     width_ns: u32,
+    /// Shortest time between two pulses (`$205`).
+    min_period: Duration,
     dir_setup: Duration,
     dir_invert_mask: u8,
 }
@@ -36,6 +38,7 @@ impl PulseTiming {
     fn from_settings(s: &Settings) -> Self {
         PulseTiming {
             width_ns: (s.pulse_width_us * 1000.0) as u32,
+            min_period: Duration::from_ticks(libm::ceilf(TICK_HZ as f32 / s.max_pulse_rate_hz) as u64),
             dir_setup: Duration::from_micros(libm::ceilf(s.dir_setup_us) as u64),
             dir_invert_mask: s.dir_invert_mask,
         }
@@ -54,6 +57,7 @@ pub async fn run<P: OutputPin, D: DelayNs>(machine: &Machine, mut axes: [AxisPin
         machine.set_pulsing(true);
         let timing = PulseTiming::from_settings(&machine.settings());
         let mut deadline = Instant::now();
+        let mut last_pulse: Option<Instant> = None;
         loop {
             let mut due = deadline + Duration::from_ticks(cmd.interval_ticks as u64);
             let now = Instant::now();
@@ -66,7 +70,12 @@ pub async fn run<P: OutputPin, D: DelayNs>(machine: &Machine, mut axes: [AxisPin
             if set_directions(&mut axes, &mut sign_level, cmd, timing.dir_invert_mask) {
                 due = due.max(now + timing.dir_setup);
             }
+            if let Some(last) = last_pulse {
+                // A pulse that went out late never makes the next one come too soon.
+                due = due.max(last + timing.min_period);
+            }
             Timer::at(due).await;
+            last_pulse = Some(Instant::now());
             emit(&mut axes, cmd, timing.width_ns, &mut delay);
             machine.emitted(cmd);
             deadline = due;

@@ -22,7 +22,7 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Read, Write};
 use heapless::String;
 
-use crate::job::{Control, Job, JobKind};
+use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
@@ -39,6 +39,11 @@ pub const SERIAL_PIPE_BYTES: usize = 128;
 pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
 /// Longest answer to one line: `$$` lists every setting (about 300 bytes).
 pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
+/// Ends a line damaged by a full pipe: the line assembler refuses lines holding it.
+const LINE_DAMAGED: u8 = 0x00;
+/// How long a byte may wait for room in the pipe before it is dropped: the line loop drains
+/// the pipe far faster unless it is waiting for the machine.
+pub const SERIAL_PIPE_WAIT_MS: u64 = 20;
 /// Bytes taken from the UART, or from the pipe, at a time.
 pub const SERIAL_CHUNK_BYTES: usize = 32;
 /// After a UART read error (noise, overrun), the receiver waits this long before reading on.
@@ -55,8 +60,8 @@ struct Link<'m, W> {
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
     /// Feed rate of the motion in progress, for status reports.
     feed_mm_per_min: Cell<f32>,
-    /// The last motion line from the host was a `$J=` jog (a jog cancel aborts only that).
-    jogging: Cell<bool>,
+    /// The pipe was full: bytes are being dropped up to the end of the damaged line.
+    overflowing: Cell<bool>,
     /// Resets received and not yet met by the line loop: bytes before them are dropped.
     resets_pending: Cell<u32>,
     /// Cancels a line waiting for the machine when a reset arrives.
@@ -70,7 +75,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         tx: Mutex::new(tx),
         bytes: Pipe::new(),
         feed_mm_per_min: Cell::new(0.0),
-        jogging: Cell::new(false),
+        overflowing: Cell::new(false),
         resets_pending: Cell::new(0),
         reset: Signal::new(),
     };
@@ -118,6 +123,34 @@ impl<W: Write> Link<'_, W> {
             Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
         }
     }
+
+    /// Waits until nothing is queued, planned or moving, held or not: the position is final.
+    async fn machine_stopped(&self) {
+        while !self.machine.stopped() {
+            Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
+        }
+    }
+
+    /// Passes a byte of a line to the line loop. When the pipe stays full for
+    /// `SERIAL_PIPE_WAIT_MS` (a sender ignoring GRBL's flow control while the line loop waits
+    /// for the machine) the byte is dropped rather than waited for, so realtime bytes behind it
+    /// are still read; the damaged line is then ended with a byte no line may hold, so it is
+    /// refused (`error:1`) rather than run in pieces, and the host is told.
+    async fn line_byte(&self, byte: u8) {
+        let ends_line = byte == b'\n' || byte == b'\r';
+        if self.overflowing.get() {
+            if ends_line && self.bytes.free_capacity() >= 2 {
+                let _ = self.bytes.try_write(&[LINE_DAMAGED, byte]);
+                self.overflowing.set(false);
+            }
+            return;
+        }
+        let wait = Timer::after(Duration::from_millis(SERIAL_PIPE_WAIT_MS));
+        if let Either::Second(()) = select(self.bytes.write_all(&[byte]), wait).await {
+            self.overflowing.set(true);
+            self.send(|a| report::message(a, "Receive buffer full: a line was dropped")).await;
+        }
+    }
 }
 
 /// Reads the link: realtime bytes act now, the rest go to the line loop in order.
@@ -137,17 +170,20 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
                 Some(Realtime::StatusQuery) => link.status_report().await,
                 Some(Realtime::FeedHold) => link.machine.request(Control::Hold),
                 Some(Realtime::CycleStart) => link.machine.request(Control::Resume),
-                Some(Realtime::JogCancel) if link.jogging.get() => link.machine.request(Control::Abort),
+                Some(Realtime::JogCancel) if link.machine.run_state() == RunState::Jog => {
+                    link.machine.request(Control::Abort)
+                }
                 Some(Realtime::Reset) => {
                     link.machine.request(Control::Abort);
                     // Like GRBL, everything received before the reset is dropped: the line loop
                     // discards bytes up to this marker and resets the parser when it meets it.
                     link.resets_pending.set(link.resets_pending.get() + 1);
                     link.reset.signal(());
+                    link.overflowing.set(false);
                     link.bytes.write_all(&[byte]).await;
                 }
                 Some(Realtime::JogCancel | Realtime::Unsupported(_)) => {}
-                None => link.bytes.write_all(&[byte]).await,
+                None => link.line_byte(byte).await,
             }
         }
     }
@@ -167,16 +203,18 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
     let mut assembler = LineAssembler::new();
     let mut gcode = GcodeState::new();
     let mut buf = [0u8; SERIAL_CHUNK_BYTES];
+    // Aborts seen: after one, the parser's planned position is stale until the machine stops.
+    let mut aborts_seen = machine.aborts();
     loop {
         let n = link.bytes.read(&mut buf).await;
         for &byte in &buf[..n] {
             if byte == 0x18 {
                 link.resets_pending.set(link.resets_pending.get().saturating_sub(1));
                 assembler.clear();
-                link.machine_at_rest().await;
+                link.machine_stopped().await;
                 link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
-                link.jogging.set(false);
+                aborts_seen = machine.aborts();
                 link.send(report::welcome).await;
                 continue;
             }
@@ -186,6 +224,15 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
             let result = match assembler.push(byte) {
                 None => continue,
                 Some(LineEvent::Line(line)) => {
+                    if machine.aborts() != aborts_seen {
+                        // An abort (keypad, jog cancel, a curve stopped part way) dropped what
+                        // was planned: plan on from where the pen stops.
+                        if link.unless_reset(link.machine_stopped()).await.is_err() {
+                            continue;
+                        }
+                        aborts_seen = machine.aborts();
+                        gcode.sync_position(machine.position(), &machine.settings());
+                    }
                     let settings = machine.settings();
                     if machine.is_idle() {
                         // The keypad, an abort or a curve that stopped early may have moved the
@@ -196,7 +243,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         Ok(commands) => {
                             let mut r = Ok(());
                             for command in commands {
-                                r = carry_out(link, &gcode, &settings, command).await;
+                                r = carry_out(link, &gcode, &settings, command, aborts_seen).await;
                                 if r.is_err() {
                                     break;
                                 }
@@ -223,11 +270,12 @@ async fn carry_out<W: Write>(
     gcode: &GcodeState,
     settings: &Settings,
     command: Command,
+    planned_after: u32,
 ) -> Result<(), Stop> {
     let machine = link.machine;
     match command {
-        Command::Job(job) | Command::Jog(job) => queue(link, job).await?,
-        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed)).await?,
+        Command::Job(job) | Command::Jog(job) => queue(link, job, planned_after).await?,
+        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed), planned_after).await?,
         Command::Dwell { ms } => {
             link.unless_reset(async {
                 link.machine_at_rest().await;
@@ -268,12 +316,26 @@ async fn carry_out<W: Write>(
 }
 
 /// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued. A
-/// reset while it waits drops the job.
-async fn queue<W: Write>(link: &Link<'_, W>, job: Job) -> Result<(), Stop> {
-    let jog = job.kind == JobKind::Jog;
+/// reset while it waits drops the job silently (the banner follows); an abort while it waits
+/// drops it with `error:9`, since it was planned from a point the pen will not reach.
+/// `planned_after` is the abort count the job was planned after.
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Result<(), Stop> {
     let feed = job.feed;
-    link.unless_reset(link.machine.jobs.send(job)).await?;
-    link.jogging.set(jog);
+    let send = link.machine.jobs.send(job.planned_after(planned_after));
+    let mut send = core::pin::pin!(send);
+    loop {
+        if link.machine.aborts() != planned_after {
+            return Err(Stop::Error(GrblError::Locked));
+        }
+        match link.unless_reset(select(send.as_mut(), link.machine.aborted.wait())).await? {
+            Either::First(()) => break,
+            Either::Second(()) => continue,
+        }
+    }
+    if link.machine.aborts() != planned_after {
+        // Queued just as an abort came: the motion task drops it.
+        return Err(Stop::Error(GrblError::Locked));
+    }
     if let crate::job::Feed::MmPerMin(f) = feed {
         link.feed_mm_per_min.set(f);
     }
