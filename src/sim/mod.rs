@@ -38,7 +38,8 @@ use serial::SimSerial;
 /// After the inputs are used up and the machine rests, the run goes on this long so the LCD
 /// shows the final state.
 pub const SIM_SETTLE_US: u64 = 500_000;
-/// A run that has not come to rest after this much virtual time is cut off.
+/// A run that has not come to rest after this much virtual time is cut off (not while a person
+/// drives it from the terminal: then virtual time is real time).
 pub const SIM_MAX_VIRTUAL_US: u64 = 3_600_000_000;
 
 /// When the keypad script begins.
@@ -143,7 +144,7 @@ pub fn run(config: SimConfig) -> SimReport {
             continue;
         }
         // Every task waits: the run may end, take live input, or jump to the next deadline.
-        serial.pump_live(false);
+        serial.pump_live(std::time::Duration::ZERO);
         if flag.0.load(Ordering::Acquire) {
             continue;
         }
@@ -160,12 +161,15 @@ pub fn run(config: SimConfig) -> SimReport {
         } else {
             rest_since = None;
         }
-        if serial.is_live() && machine.is_idle() && matrix.script_done() {
-            // Nothing moves: wait, in real time, for the person at the terminal.
-            serial.pump_live(true);
-            continue;
-        }
-        if now >= SIM_MAX_VIRTUAL_US {
+        if serial.is_live() {
+            // A person is at the terminal: let time pass as it does for them (so a `!` typed
+            // mid-move lands mid-move), waiting for their input up to the next deadline.
+            let wait_us = clock::next_deadline().map_or(u64::MAX, |d| d.saturating_sub(now));
+            serial.pump_live(std::time::Duration::from_micros(wait_us));
+            if flag.0.load(Ordering::Acquire) {
+                continue;
+            }
+        } else if now >= SIM_MAX_VIRTUAL_US {
             timed_out = true;
             break;
         }

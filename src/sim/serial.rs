@@ -123,12 +123,19 @@ impl SimSerial {
         l.input.is_empty() && l.unsent.is_empty() && l.timed.is_empty() && (l.live.is_none() || l.live_ended)
     }
 
-    /// Takes what standard input has sent; with `block`, waits (in real time) for it.
+    /// Takes what standard input has sent, waiting for it up to `wait` of real time.
     /// Returns false once standard input has ended.
-    pub fn pump_live(&self, block: bool) -> bool {
+    pub fn pump_live(&self, wait: std::time::Duration) -> bool {
         let mut l = self.link.borrow_mut();
         let Some(rx) = l.live.take() else { return false };
-        let got = if block { rx.recv().map_err(|_| mpsc::TryRecvError::Disconnected) } else { rx.try_recv() };
+        let got = if wait.is_zero() {
+            rx.try_recv()
+        } else {
+            rx.recv_timeout(wait).map_err(|e| match e {
+                mpsc::RecvTimeoutError::Timeout => mpsc::TryRecvError::Empty,
+                mpsc::RecvTimeoutError::Disconnected => mpsc::TryRecvError::Disconnected,
+            })
+        };
         match got {
             Ok(bytes) => {
                 l.input.extend(bytes);
