@@ -123,8 +123,10 @@ pub fn main() -> ExitCode {
     if demo {
         eprintln!("servoplot simulator: no input given, drawing the built-in demo");
     }
-    // A keypad script given with serial input starts once the serial drawing is done.
-    let keys_start = if has_serial { KeysStart::AfterSerial } else { KeysStart::AtOnce };
+    // A keypad script given with a serial file starts once the file's drawing is done; with a
+    // person at the terminal, at once.
+    let keys_start =
+        if has_serial && args.serial.as_deref() != Some("-") { KeysStart::AfterSerial } else { KeysStart::AtOnce };
     let report = sim::run(SimConfig { serial: serial.echo_to_stdout(), keys, keys_start, ..SimConfig::default() });
     match write_pictures(&report, &args.out) {
         Ok(()) => {}
