@@ -16,9 +16,9 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Axis, Point, Step, StepCmd, TICK_HZ};
-use crate::interp::{CurveError, CurveSetupError};
 use crate::job::{Control, Job};
 use crate::settings::Settings;
+pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
 use crate::ui::Menu;
 
@@ -35,16 +35,6 @@ pub const STEP_QUEUE_LEN: usize = 32;
 pub const STEP_QUEUE_MAX_US: u32 = 20_000;
 /// The same in pulse timer ticks.
 pub const STEP_QUEUE_MAX_TICKS: u32 = STEP_QUEUE_MAX_US * (TICK_HZ / 1_000_000);
-
-/// Why the last job stopped early, shown on the LCD and reported to the host.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum MotionFault {
-    /// The job could not start (bad parameter, function undefined at its first point).
-    Setup(CurveSetupError),
-    /// The curve ended part way (domain error, jump).
-    Curve(CurveError),
-}
 
 /// Everything the tasks share.
 pub struct Machine {
@@ -184,7 +174,12 @@ impl Machine {
 
     /// A snapshot for displays and reports.
     pub fn status(&self) -> Status {
-        Status { state: self.run_state(), position: self.position(), queued_jobs: self.jobs.len() as u8 }
+        Status {
+            state: self.run_state(),
+            position: self.position(),
+            queued_jobs: self.jobs.len() as u8,
+            fault: self.fault(),
+        }
     }
 
     /// A copy of the current settings.

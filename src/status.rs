@@ -2,6 +2,7 @@
 //! reports and the menu see it.
 
 use crate::geom::Point;
+use crate::interp::{CurveError, CurveSetupError};
 
 /// The machine's run state, named as GRBL reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -19,6 +20,16 @@ pub enum RunState {
     Alarm,
 }
 
+/// Why the last job stopped early, shown on the LCD and reported to the host.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum MotionFault {
+    /// The job could not start (bad parameter, function undefined at its first point).
+    Setup(CurveSetupError),
+    /// The curve ended part way (domain error, jump).
+    Curve(CurveError),
+}
+
 /// A snapshot of the machine for displays and reports.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -28,4 +39,6 @@ pub struct Status {
     pub position: Point,
     /// Jobs waiting behind the one in progress.
     pub queued_jobs: u8,
+    /// Why the last job stopped early, until the next one starts.
+    pub fault: Option<MotionFault>,
 }

@@ -212,7 +212,7 @@ mod tests {
     }
 
     fn st(state: RunState, x: i32, y: i32) -> Status {
-        Status { state, position: Point::new(x, y), queued_jobs: 0 }
+        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None }
     }
 
     #[test]

@@ -29,10 +29,10 @@ use embedded_graphics::text::{Baseline, Text};
 use heapless::String;
 
 use crate::geom::{Axis, Step};
-use crate::interp::Method;
+use crate::interp::{CurveError, CurveSetupError, Method};
 use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::settings::Settings;
-use crate::status::{RunState, Status};
+use crate::status::{MotionFault, RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
 
@@ -173,6 +173,8 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
     }
     if let Some(error) = menu.message() {
         lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error)), true);
+    } else if let (RunState::Idle, Some(fault)) = (status.state, status.fault) {
+        lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault)), true);
     }
     ScreenView { lines }
 }
@@ -285,6 +287,25 @@ impl fmt::Display for ErrorText {
             UiError::Busy => f.write_str("Busy: wait, or D abort"),
             UiError::Alarm => f.write_str("Alarm: motion locked"),
         }
+    }
+}
+
+/// Why the last job stopped early, as the screen says it.
+struct FaultText(MotionFault);
+
+impl fmt::Display for FaultText {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let why = match self.0 {
+            MotionFault::Setup(CurveSetupError::Start(_)) => "undefined at start",
+            MotionFault::Setup(CurveSetupError::OutOfRange) => "too large",
+            MotionFault::Setup(CurveSetupError::BadParameter) => "bad parameter",
+            MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
+            MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
+            MotionFault::Curve(CurveError::Overflow) => "value too large",
+            MotionFault::Curve(CurveError::Jump) => "jump too large",
+            MotionFault::Curve(CurveError::Travel) => "travel limit",
+        };
+        write!(f, "Stopped: {why}")
     }
 }
 
@@ -487,8 +508,12 @@ mod tests {
     #[test]
     fn nothing_is_drawn_outside_the_screen() {
         let s = Settings::default();
-        let busy =
-            Status { state: RunState::Run, queued_jobs: 255, position: crate::geom::Point::new(-50_000, -50_000) };
+        let busy = Status {
+            state: RunState::Run,
+            queued_jobs: 255,
+            position: crate::geom::Point::new(-50_000, -50_000),
+            fault: None,
+        };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
             let mut m = Menu::new();
             press(&mut m, keys, &Status::default());
@@ -514,5 +539,17 @@ mod tests {
         assert_eq!(view(&m, &idle, &s), form, "a release in a form shows nothing new");
         let moved = Status { position: crate::geom::Point::new(1, 0), ..idle };
         assert_ne!(view(&m, &moved, &s), form, "a step of the pen is visible");
+    }
+
+    #[test]
+    fn a_curve_stopped_part_way_is_shown_until_the_next_job() {
+        let m = Menu::new();
+        let s = Settings::default();
+        let stopped = Status { fault: Some(MotionFault::Curve(CurveError::Domain)), ..Status::default() };
+        let v = view(&m, &stopped, &s);
+        assert_eq!(v.lines[3].text.as_str(), "Stopped: f(x) undefined");
+        assert!(v.lines[3].inverted);
+        let running = Status { state: RunState::Run, ..stopped };
+        assert_ne!(view(&m, &running, &s).lines[3].text.as_str(), "Stopped: f(x) undefined");
     }
 }
