@@ -9,7 +9,6 @@
 
 use core::cell::Cell;
 use core::fmt::Write as _;
-
 use core::future::Future;
 
 use embassy_futures::join::join3;
@@ -32,8 +31,7 @@ use crate::settings::Settings;
 use crate::status::RunState;
 
 /// Bytes between the receiver and the line loop. GRBL senders keep at most 128 unanswered bytes
-/// in flight, so this never fills; if it did, the receiver would simply stop reading and leave
-/// the bytes in the UART's own buffer.
+/// in flight, so this never fills; should a sender ignore that, see `Link::line_byte`.
 pub const SERIAL_PIPE_BYTES: usize = 128;
 /// What a sender may assume it can have in flight (reported by `$I`).
 pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
