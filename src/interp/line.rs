@@ -1,6 +1,6 @@
 //! Straight line from the start point to an end point given as an offset in steps.
 //!
-//! `classic` is the seed's point-by-point comparison: with the discriminant
+//! `classic` is the original controller's point-by-point comparison: with the discriminant
 //! `F = x·ye − y·xe` (on absolute values) it steps X while `F >= 0` and Y otherwise, one axis per
 //! step, |dx| + |dy| steps in all. `diagonal` is the same comparison on the major axis
 //! (Bresenham's rule): every step moves the major axis and, when the error says so, the minor one
@@ -154,7 +154,7 @@ mod tests {
     }
 
     #[test]
-    fn classic_follows_the_seed_table_in_the_first_quadrant() {
+    fn classic_follows_the_textbook_table_in_the_first_quadrant() {
         // End (4, 3): F starts at 0 → +X, F=-3 → +Y, F=1 → +X, F=-2 → +Y, F=2 → +X, F=-1 → +Y, F=3 → +X.
         let mut line = LineInterp::new(4, 3, Method::Classic);
         let mut steps = Vec::new();

@@ -1,7 +1,7 @@
 //! Point-by-point (逐点比较法) interpolators: each curve becomes a stream of single steps.
 //!
 //! Every interpolator works in integer steps relative to its start point and yields [`Step`]s
-//! to lattice neighbours. Two methods exist ([`Method`]): `classic`, the seed's one-axis-per-step
+//! to lattice neighbours. Two methods exist ([`Method`]): `classic`, the original controller's one-axis-per-step
 //! comparison (error <= 1 step), and `diagonal`, which may move both axes at once (error <= 0.5
 //! step, fewer steps). Interpolators never read a clock and never allocate.
 
@@ -25,7 +25,7 @@ use crate::settings::Settings;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Method {
-    /// One axis per step, the seed's point-by-point comparison; error <= 1 step.
+    /// One axis per step, the original controller's point-by-point comparison; error <= 1 step.
     Classic,
     /// Both axes may step together; error <= 0.5 step, fewer and longer steps.
     #[default]
