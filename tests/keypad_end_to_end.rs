@@ -70,3 +70,13 @@ fn c_holds_and_resumes_a_keypad_curve_and_d_aborts_it_on_its_path() {
     assert_eq!(cut[..], full[..cut.len()], "on the circle's path");
     assert_eq!(aborted.position, *cut.last().unwrap());
 }
+
+#[test]
+fn the_lcd_redraws_at_most_ten_times_a_second_and_only_on_change() {
+    // A long line (moving for seconds) and a burst of key presses.
+    let report = sim::run_keys("2 8 0 # 0 # wait:3000 1 2 3 4 5 6").unwrap();
+    let times: Vec<u64> = report.frames.iter().map(|(t, _)| *t).collect();
+    assert!(times.windows(2).all(|w| w[1] - w[0] >= 100_000), "frames closer than 100 ms: {times:?}");
+    assert!(report.frames.windows(2).all(|w| w[0].1 != w[1].1), "a frame was sent that changed nothing");
+    assert!(report.frames.len() > 10, "the position was redrawn while moving");
+}
