@@ -1,0 +1,177 @@
+//! The cost harness: runs servoplot's motion code on QEMU's Cortex-M4F model (`mps2-an386`) and
+//! marks where each measured piece of work starts and ends; the runner (`count.py`) counts the
+//! instructions between marks with a QEMU plugin and prints the table.
+#![no_std]
+#![no_main]
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use defmt_rtt as _;
+use servoplot::geom::Point;
+use servoplot::interp::{Curve, Interpolator, Method};
+use servoplot::job::{Feed, Job, Shape};
+use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use servoplot::settings::Settings;
+
+/// Where the runner's plugin snapshots the instruction counter: called between measured pieces.
+#[unsafe(no_mangle)]
+#[inline(never)]
+pub extern "C" fn cost_mark() {
+    // A real instruction, so the function is never folded into another.
+    cortex_m::asm::nop();
+}
+
+/// Writes one result line: the runner pairs it with the last two marks.
+fn report(what: &str, case: &str, method: Method, steps: u64) {
+    let m = match method {
+        Method::Classic => "classic",
+        Method::Diagonal => "diagonal",
+    };
+    hprintln!("result {} {} {} {}", what, case, m, steps);
+}
+
+const FEED: Feed = Feed::MmPerMin(3_000.0);
+
+fn cases() -> [(&'static str, Shape); 10] {
+    let f = |src: &str| match servoplot::expr::parse(src) {
+        Ok(e) => e,
+        Err(_) => panic!("expression"),
+    };
+    [
+        ("line0", Shape::Line { to: Point::new(5_000, 0) }),
+        ("line30", Shape::Line { to: Point::new(4_330, 2_500) }),
+        ("line45", Shape::Line { to: Point::new(3_536, 3_536) }),
+        (
+            "circle",
+            Shape::Arc {
+                center: Point::new(-2_000, 0),
+                to: Point::ORIGIN,
+                rotation: servoplot::geom::Rotation::CounterClockwise,
+            },
+        ),
+        (
+            "arc",
+            Shape::Arc {
+                center: Point::new(-2_000, 0),
+                to: Point::new(-3_000, -1_732),
+                rotation: servoplot::geom::Rotation::Clockwise,
+            },
+        ),
+        (
+            "ellipse",
+            Shape::Ellipse {
+                center: Point::new(-3_000, 0),
+                a_steps: 3_000,
+                b_steps: 1_500,
+                to: Point::ORIGIN,
+                rotation: servoplot::geom::Rotation::CounterClockwise,
+            },
+        ),
+        (
+            "sine",
+            Shape::Sine { amplitude_steps: 1_000.0, omega_rad_per_step: 0.003, phase_rad: 0.0, length_steps: 6_000 },
+        ),
+        ("gauss", Shape::Function { expr: f("20*exp(-x^2/200)"), x0_mm: -30.0, x1_mm: 30.0 }),
+        ("cubic", Shape::Function { expr: f("x^3/400"), x0_mm: -30.0, x1_mm: 30.0 }),
+        ("sinx", Shape::Function { expr: f("sin(x)*x/10"), x0_mm: -30.0, x1_mm: 30.0 }),
+    ]
+}
+
+fn curve(shape: &Shape, settings: &Settings) -> Curve {
+    match Curve::for_job(&Job::draw(shape.clone(), FEED), Point::ORIGIN, settings) {
+        Ok(c) => c,
+        Err(_) => panic!("curve setup"),
+    }
+}
+
+#[inline(never)]
+fn interp_only(mut c: Curve) -> u64 {
+    let mut n = 0;
+    while let Ok(Some(_)) = c.next_step() {
+        n += 1;
+    }
+    n
+}
+
+#[inline(never)]
+fn with_planner(c: Curve, method: Method, limits: Limits) -> u64 {
+    let mut p: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(limits);
+    if p.push(c, FEED, method).is_err() {
+        panic!("push");
+    }
+    let mut n = 0;
+    while let Some(Ok(_)) = p.next_cmd() {
+        n += 1;
+    }
+    n
+}
+
+/// The harness's command line (QEMU's `-semihosting-config arg=`): only cases whose name
+/// contains it run; `*` runs them all.
+fn filter(buf: &mut [u8; 64]) -> &str {
+    let args = [buf.as_mut_ptr() as usize, buf.len()];
+    // SAFETY: GET_CMDLINE writes at most `buf.len()` bytes, NUL-terminated, into `buf`.
+    let failed = unsafe { cortex_m_semihosting::syscall(cortex_m_semihosting::nr::GET_CMDLINE, &args) } != 0;
+    let len = if failed { 0 } else { buf.iter().position(|&b| b == 0).unwrap_or(buf.len()) };
+    match core::str::from_utf8(&buf[..len]) {
+        Ok("*") | Err(_) => "",
+        Ok(text) => text,
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let mut buf = [0u8; 64];
+    let only = filter(&mut buf);
+    cost_mark();
+    cost_mark();
+    for (name, shape) in cases() {
+        if !name.contains(only) {
+            continue;
+        }
+        for method in [Method::Classic, Method::Diagonal] {
+            let settings = Settings { method, ..Settings::default() };
+            let limits = Limits::from_settings(&settings);
+            cost_mark();
+            let c = curve(&shape, &settings);
+            cost_mark();
+            report("setup", name, method, 1);
+            cost_mark();
+            let n = interp_only(c);
+            cost_mark();
+            report("interp", name, method, n);
+            let c = curve(&shape, &settings);
+            cost_mark();
+            let n = with_planner(c, method, limits);
+            cost_mark();
+            report("planner", name, method, n);
+        }
+    }
+    debug::exit(debug::EXIT_SUCCESS);
+    loop {}
+}
+
+/// The device's interrupt vectors (cortex-m-rt's `device` feature, enabled through the
+/// firmware's HAL, expects them).
+#[unsafe(link_section = ".vector_table.interrupts")]
+#[unsafe(no_mangle)]
+pub static __INTERRUPTS: [unsafe extern "C" fn(); 32] = [default_irq; 32];
+
+unsafe extern "C" fn default_irq() {
+    hprintln!("unexpected interrupt");
+    debug::exit(debug::EXIT_FAILURE);
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}
+
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    hprintln!("defmt panic");
+    debug::exit(debug::EXIT_FAILURE);
+    loop {}
+}
