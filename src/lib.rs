@@ -20,6 +20,7 @@ pub mod interp;
 pub mod job;
 pub mod keypad;
 pub mod machine;
+pub mod math;
 pub mod planner;
 pub mod protocol;
 pub mod settings;

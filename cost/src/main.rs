@@ -32,6 +32,9 @@ fn report(what: &str, case: &str, method: Method, steps: u64) {
 
 const FEED: Feed = Feed::MmPerMin(3_000.0);
 
+/// Steps per `fill` call when an interpolator runs alone.
+const INTERP_BATCH_STEPS: usize = 16;
+
 fn cases() -> [(&'static str, Shape); 10] {
     let f = |src: &str| match servoplot::expr::parse(src) {
         Ok(e) => e,
@@ -84,13 +87,20 @@ fn curve(shape: &Shape, settings: &Settings) -> Curve {
     }
 }
 
+/// Steps a curve to its end in batches, as the planner takes them.
 #[inline(never)]
 fn interp_only(mut c: Curve) -> u64 {
+    let mut buf = [servoplot::geom::Step::NONE; INTERP_BATCH_STEPS];
     let mut n = 0;
-    while let Ok(Some(_)) = c.next_step() {
-        n += 1;
+    loop {
+        let filled = c.fill(&mut buf);
+        n += filled.steps as u64;
+        match filled.end {
+            None => {}
+            Some(Ok(())) => return n,
+            Some(Err(_)) => panic!("curve failed"),
+        }
     }
-    n
 }
 
 #[inline(never)]

@@ -65,6 +65,16 @@ impl Tangent {
     }
 }
 
+/// What [`Interpolator::fill`] did: how many steps it wrote, and whether the curve ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Filled {
+    /// Steps written, from the start of the buffer.
+    pub steps: usize,
+    /// `None`: the buffer is full and the curve goes on. `Some(Ok(()))`: the curve reached its end
+    /// point after these steps; `Some(Err(e))`: it failed there (see [`Interpolator::next_step`]).
+    pub end: Option<Result<(), CurveError>>,
+}
+
 /// What every interpolator offers the motion planner.
 pub trait Interpolator {
     /// The next step, `Ok(None)` once the end point is reached. After `None` or an error the
@@ -73,6 +83,20 @@ pub trait Interpolator {
 
     /// The unit tangent of the ideal curve at the current point, in the direction of travel.
     fn tangent(&self) -> Tangent;
+
+    /// Writes the next steps into `out`, exactly those `next_step` would hand out one by one,
+    /// until `out` is full or the curve ends or fails. The planner takes steps this way: a
+    /// curve steps in a tight loop, without a call per step.
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        for (i, slot) in out.iter_mut().enumerate() {
+            match self.next_step() {
+                Ok(Some(step)) => *slot = step,
+                Ok(None) => return Filled { steps: i, end: Some(Ok(())) },
+                Err(e) => return Filled { steps: i, end: Some(Err(e)) },
+            }
+        }
+        Filled { steps: out.len(), end: None }
+    }
 }
 
 impl From<ArcError> for CurveSetupError {
@@ -186,6 +210,16 @@ impl Interpolator for Curve {
             CurveKind::Ellipse(c) => c.tangent(),
             CurveKind::Sine(c) => c.tangent(),
             CurveKind::Function(c) => c.tangent(),
+        }
+    }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        match &mut self.kind {
+            CurveKind::Line(c) => c.fill(out),
+            CurveKind::Arc(c) => c.fill(out),
+            CurveKind::Ellipse(c) => c.fill(out),
+            CurveKind::Sine(c) => c.fill(out),
+            CurveKind::Function(c) => c.fill(out),
         }
     }
 }
