@@ -23,6 +23,7 @@ pub mod machine;
 pub mod math;
 pub mod planner;
 pub mod protocol;
+pub mod pulse;
 pub mod settings;
 pub mod status;
 pub mod tasks;

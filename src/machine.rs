@@ -2,10 +2,11 @@
 //!
 //! One `Machine` exists per plotter (a `static` on target, a local in the simulator). Tasks
 //! receive `&Machine` and talk only through it: the job queue (inputs → motion), the control
-//! slot (inputs → motion), the step queue (motion → pulses, bounded in count and in time), the
-//! position counters (written only by the pulse task) and a change signal that wakes the LCD.
-//! Everything here is shared across priorities, so every lock is a critical section that only
-//! copies a value in or out.
+//! slot (inputs → motion), the counters of the step queue (the queue itself, motion → pulses,
+//! is a lock-free single-producer single-consumer ring owned by its two ends), the position
+//! counters (written only by the pulse engine) and a change signal that wakes the LCD.
+//! Everything here is shared across priorities: every lock is a critical section that only
+//! copies a value in or out, and every counter has a single writer.
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
@@ -15,7 +16,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
-use crate::geom::{Axis, Point, Step, StepCmd, TICK_HZ};
+use crate::geom::{Axis, Point, StepCmd, TICK_HZ};
 use crate::job::{Control, Job};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -25,10 +26,6 @@ use crate::ui::Menu;
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
 pub const JOB_QUEUE_LEN: usize = 4;
-
-/// Step commands between the motion task and the pulse task. At 20 kHz, 32 commands are 1.6 ms
-/// of motion, many times the motion task's latency on its own interrupt executor.
-pub const STEP_QUEUE_LEN: usize = 32;
 
 /// At most this much motion time waits in the step queue, however slow the steps: a hold or an
 /// abort starts decelerating within it, even at a feed of 1 mm/min.
@@ -42,7 +39,6 @@ pub struct Machine {
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
     /// Wakes the motion task when a control is requested.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
-    pub steps: Channel<CriticalSectionRawMutex, StepCmd, STEP_QUEUE_LEN>,
     /// Wakes the LCD task after anything it shows may have changed.
     pub changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
@@ -54,15 +50,22 @@ pub struct Machine {
     pub aborted: Signal<CriticalSectionRawMutex, ()>,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
-    /// Wakes the motion task when the pulse task has emitted everything queued.
+    /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pub pulses_done: Signal<CriticalSectionRawMutex, ()>,
     menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
+    /// Pulses emitted (written only by the pulse engine).
     position: [AtomicI32; 2],
     state: AtomicU8,
-    /// Sum of the intervals of the step commands queued and not yet emitted, in ticks.
+    /// Steps queued for the pulse engine so far, and the sum of their intervals in ticks
+    /// (written only by the motion task; both wrap).
+    queued_steps: AtomicU32,
     queued_ticks: AtomicU32,
-    /// True while the pulse task holds a command it has not finished emitting.
-    pulsing: AtomicBool,
+    /// Steps emitted so far and the sum of their intervals (written only by the pulse engine).
+    emitted_steps: AtomicU32,
+    emitted_ticks: AtomicU32,
+    /// Times the pulse engine found the queue empty while the motion was not at rest
+    /// (written only by the pulse engine).
+    underruns: AtomicU32,
     settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
     fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
 }
@@ -73,7 +76,6 @@ impl Machine {
             jobs: Channel::new(),
             control: Mutex::new(Cell::new(None)),
             control_requested: Signal::new(),
-            steps: Channel::new(),
             changed: Signal::new(),
             pulses_done: Signal::new(),
             aborts: AtomicU32::new(0),
@@ -83,8 +85,11 @@ impl Machine {
             menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
             state: AtomicU8::new(0),
+            queued_steps: AtomicU32::new(0),
             queued_ticks: AtomicU32::new(0),
-            pulsing: AtomicBool::new(false),
+            emitted_steps: AtomicU32::new(0),
+            emitted_ticks: AtomicU32::new(0),
+            underruns: AtomicU32::new(0),
             settings: Mutex::new(RefCell::new(settings)),
             fault: Mutex::new(Cell::new(None)),
         }
@@ -93,15 +98,6 @@ impl Machine {
     /// Pulses emitted so far: the position, always.
     pub fn position(&self) -> Point {
         Point::new(self.position[0].load(Ordering::Relaxed), self.position[1].load(Ordering::Relaxed))
-    }
-
-    fn count_pulse(&self, step: Step) {
-        for axis in Axis::ALL {
-            let d = step.on(axis) as i32;
-            if d != 0 {
-                self.position[axis.index()].fetch_add(d, Ordering::Relaxed);
-            }
-        }
     }
 
     /// Asks the motion task for `control`; see [`Control::then`] for requests not yet taken.
@@ -122,31 +118,56 @@ impl Machine {
         }
     }
 
-    /// Queues a step command for the pulse task, waiting for room.
-    pub async fn queue_step(&self, cmd: StepCmd) {
-        self.queued_ticks.fetch_add(cmd.interval_ticks, Ordering::AcqRel);
-        self.steps.send(cmd).await;
+    /// The motion task has queued `steps` step commands in all so far, `ticks` ticks of motion
+    /// in all (both wrapping). Only the motion task calls this.
+    pub fn set_queued(&self, steps: u32, ticks: u32) {
+        self.queued_ticks.store(ticks, Ordering::Release);
+        self.queued_steps.store(steps, Ordering::Release);
     }
 
-    /// Motion time queued for the pulse task and not yet emitted, in ticks.
+    /// Motion time queued for the pulse engine and not yet emitted, in ticks.
     pub fn queued_ticks(&self) -> u32 {
-        self.queued_ticks.load(Ordering::Acquire)
+        self.queued_ticks.load(Ordering::Acquire).wrapping_sub(self.emitted_ticks.load(Ordering::Acquire))
     }
 
-    /// Counts one emitted pulse per moving axis and takes its command's time off the queue.
-    /// Only the pulse task calls this.
+    /// Counts the pulses of `cmd`, emitted. Only the pulse engine calls this.
     pub fn emitted(&self, cmd: StepCmd) {
-        self.count_pulse(cmd.step);
-        self.queued_ticks.fetch_sub(cmd.interval_ticks, Ordering::AcqRel);
+        // Single writer: a load and a store, no read-modify-write cycle.
+        for axis in Axis::ALL {
+            let d = i32::from(cmd.step.on(axis));
+            if d != 0 {
+                let p = &self.position[axis.index()];
+                p.store(p.load(Ordering::Relaxed).wrapping_add(d), Ordering::Relaxed);
+            }
+        }
+        let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
+        self.emitted_ticks.store(t, Ordering::Release);
+        let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);
+        self.emitted_steps.store(n, Ordering::Release);
     }
 
-    pub fn set_pulsing(&self, busy: bool) {
-        self.pulsing.store(busy, Ordering::Release);
+    /// The pulse engine found the queue empty while the motion was not at rest. Only the pulse
+    /// engine calls this.
+    pub fn count_underrun(&self) {
+        self.underruns.store(self.underruns.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
+        warn!("step queue underrun: the motion task fell behind the pulses");
+    }
+
+    /// Step-queue underruns since power-on.
+    pub fn underruns(&self) -> u32 {
+        self.underruns.load(Ordering::Relaxed)
+    }
+
+    /// The pulse engine emitted everything queued and stopped. Only the pulse engine calls
+    /// this.
+    pub fn pulses_stopped(&self) {
+        self.pulses_done.signal(());
+        self.changed.signal(());
     }
 
     /// True when no step is queued or being emitted.
     pub fn pulses_idle(&self) -> bool {
-        !self.pulsing.load(Ordering::Acquire) && self.steps.is_empty()
+        self.queued_steps.load(Ordering::Acquire) == self.emitted_steps.load(Ordering::Acquire)
     }
 
     pub fn run_state(&self) -> RunState {

@@ -4,7 +4,7 @@
 #![cfg_attr(target_os = "none", no_main)]
 
 #[cfg(target_os = "none")]
-#[path = "board/stm32f407.rs"]
+#[path = "board/stm32f407/mod.rs"]
 mod stm32f407;
 
 #[cfg(not(target_os = "none"))]

@@ -6,7 +6,7 @@
 //! (Bresenham's rule): every step moves the major axis and, when the error says so, the minor one
 //! too; max(|dx|, |dy|) steps, error <= 0.5 step.
 
-use super::{CurveError, Interpolator, Method, Tangent};
+use super::{CurveError, Filled, Interpolator, Method, Tangent};
 use crate::geom::Step;
 
 /// Interpolates a straight line; see the module documentation.
@@ -110,6 +110,59 @@ impl Interpolator for LineInterp {
     fn tangent(&self) -> Tangent {
         self.tangent
     }
+
+    /// A line never kinks: a tight loop of the same comparisons as `next_step`.
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        let left = match self.method {
+            Method::Classic => self.left_x + self.left_y,
+            Method::Diagonal => self.left_x.max(self.left_y),
+        };
+        let n = out.len().min(usize::try_from(left).unwrap_or(usize::MAX));
+        let Some(out) = out.get_mut(..n) else { return Filled::more(0) };
+        match self.method {
+            Method::Classic => {
+                for slot in out.iter_mut() {
+                    *slot = self.classic();
+                }
+            }
+            Method::Diagonal => self.fill_diagonal(out),
+        }
+        if n as i64 == left { Filled::ended(n, Ok(())) } else { Filled::more(n) }
+    }
+}
+
+impl LineInterp {
+    /// `out.len()` diagonal steps (no more than are left), with the state in registers.
+    fn fill_diagonal(&mut self, out: &mut [Step]) {
+        let x_major = self.xe >= self.ye;
+        let (major, minor) = if x_major { (self.xe, self.ye) } else { (self.ye, self.xe) };
+        let (straight, both) = if x_major {
+            (Step::new(self.sx, 0), Step::new(self.sx, self.sy))
+        } else {
+            (Step::new(0, self.sy), Step::new(self.sx, self.sy))
+        };
+        let mut f = self.f;
+        let mut minor_steps = 0i64;
+        for slot in out.iter_mut() {
+            if f > 0 {
+                f -= 2 * major;
+                minor_steps += 1;
+                *slot = both;
+            } else {
+                *slot = straight;
+            }
+            f += 2 * minor;
+        }
+        self.f = f;
+        let n = out.len() as i64;
+        if x_major {
+            self.left_x -= n;
+            self.left_y -= minor_steps;
+        } else {
+            self.left_y -= n;
+            self.left_x -= minor_steps;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -175,6 +228,35 @@ mod tests {
             assert_eq!(path.len() - 1, dx.abs().max(dy.abs()) as usize);
             for p in &path {
                 assert!(distance(*p, dx, dy) <= 0.5 + 1e-9, "({dx}, {dy}): {p:?} strays");
+            }
+        }
+    }
+
+    #[test]
+    fn fill_hands_out_exactly_the_steps_of_next_step() {
+        for (dx, dy) in [(7, 3), (-7, 3), (3, -7), (0, 5), (-5, 0), (4, 4), (1000, 999), (-999, -1000), (0, 0)] {
+            for method in [Method::Classic, Method::Diagonal] {
+                let mut one = LineInterp::new(dx, dy, method);
+                let mut expected = Vec::new();
+                while let Some(s) = one.next_step().unwrap() {
+                    expected.push(s);
+                }
+                for batch in [1, 3, 16, 4096] {
+                    let mut line = LineInterp::new(dx, dy, method);
+                    let (mut got, mut buf) = (Vec::new(), std::vec![Step::NONE; batch]);
+                    loop {
+                        let filled = line.fill(&mut buf);
+                        assert_eq!(filled.kink, None);
+                        got.extend_from_slice(&buf[..filled.steps]);
+                        if let Some(end) = filled.end {
+                            assert_eq!(end, Ok(()));
+                            break;
+                        }
+                        assert_eq!(filled.steps, batch, "a short fill must say why");
+                    }
+                    assert_eq!(got, expected, "({dx}, {dy}) {method:?} in batches of {batch}");
+                    assert_eq!(line.next_step(), Ok(None));
+                }
             }
         }
     }

@@ -9,6 +9,7 @@
 use crate::geom::{Point, TICK_HZ};
 use crate::interp::{Method, Tangent};
 use crate::job::Feed;
+use crate::math;
 use crate::settings::{SETTING_INFO, Settings};
 
 /// Slowest feed the planner runs; a positive feed below it is raised to it. Also the
@@ -104,8 +105,8 @@ impl Limits {
                 *value = if value.is_nan() { default } else { value.clamp(min, max) };
             }
         }
-        let slowest_max = fixed.max_rate_mm_per_min[0].min(fixed.max_rate_mm_per_min[1]);
-        fixed.start_rate_mm_per_min = fixed.start_rate_mm_per_min.min(slowest_max);
+        let slowest_max = math::min(fixed.max_rate_mm_per_min[0], fixed.max_rate_mm_per_min[1]);
+        fixed.start_rate_mm_per_min = math::min(fixed.start_rate_mm_per_min, slowest_max);
         Limits::try_from_settings(&fixed).unwrap_or(FALLBACK)
     }
 
@@ -123,13 +124,13 @@ impl Limits {
             }
         }
         let per_s = |mm_per_min: f32| mm_per_min / SECONDS_PER_MINUTE;
-        let slowest_max = s.max_rate_mm_per_min[0].min(s.max_rate_mm_per_min[1]);
+        let slowest_max = math::min(s.max_rate_mm_per_min[0], s.max_rate_mm_per_min[1]);
         if s.start_rate_mm_per_min > slowest_max {
             return Err(LimitsError::OutOfRange(201));
         }
         // The shortest interval is a whole number of ticks, so the speed cap below and the
         // interval floor in the planner agree exactly.
-        let min_interval_ticks = libm::ceilf(TICK_HZ as f32 / s.max_pulse_rate_hz).max(1.0) as u32;
+        let min_interval_ticks = math::max(math::ceil(TICK_HZ as f32 / s.max_pulse_rate_hz), 1.0) as u32;
         Ok(Limits {
             steps_per_mm: s.steps_per_mm,
             max_speed_mm_per_s: [per_s(s.max_rate_mm_per_min[0]), per_s(s.max_rate_mm_per_min[1])],
@@ -178,7 +179,7 @@ impl Limits {
     pub fn requested_speed_mm_per_s(&self, feed: Feed) -> f32 {
         match feed {
             Feed::Rapid => f32::INFINITY,
-            Feed::MmPerMin(f) if f.is_finite() && f > 0.0 => f.max(MIN_FEED_MM_PER_MIN) / SECONDS_PER_MINUTE,
+            Feed::MmPerMin(f) if f.is_finite() && f > 0.0 => math::max(f, MIN_FEED_MM_PER_MIN) / SECONDS_PER_MINUTE,
             Feed::MmPerMin(_) => self.default_feed_mm_per_s,
         }
     }
@@ -189,11 +190,11 @@ impl Limits {
         // Distance along the ideal curve per step, in step units.
         let per_step = match method {
             Method::Classic => 1.0 / (tx + ty),
-            Method::Diagonal => 1.0 / tx.max(ty),
+            Method::Diagonal => 1.0 / math::max(tx, ty),
         };
         let mx = dir.x / self.steps_per_mm[0];
         let my = dir.y / self.steps_per_mm[1];
-        let mm_per_unit = libm::sqrtf(mx * mx + my * my);
+        let mm_per_unit = math::sqrt(mx * mx + my * my);
         StepGeometry { step_mm: per_step * mm_per_unit, dir_mm: [mx / mm_per_unit, my / mm_per_unit] }
     }
 
@@ -210,24 +211,24 @@ impl Limits {
         let u = g.dir_mm;
         // The normal (−u_y, u_x): its X share is |u_y|, its Y share |u_x|.
         let normal = [u[1].abs(), u[0].abs()];
-        let mut speed = requested_mm_per_s.min(self.max_pulse_rate_hz * g.step_mm);
+        let mut speed = math::min(requested_mm_per_s, self.max_pulse_rate_hz * g.step_mm);
         for (share, max) in u.iter().zip(self.max_speed_mm_per_s) {
             if share.abs() > DIR_EPSILON {
-                speed = speed.min(max / share.abs());
+                speed = math::min(speed, max / share.abs());
             }
         }
-        let slowest_accel = self.accel_mm_per_s2[0].min(self.accel_mm_per_s2[1]);
+        let slowest_accel = math::min(self.accel_mm_per_s2[0], self.accel_mm_per_s2[1]);
         let mut curvature_per_mm = 0.0;
         match bend {
             Bend::Straight => {}
             Bend::Kink { from } => {
                 let a = self.direction_accel(u, [0.0; 2], 0.0);
-                speed = speed.min(self.junction_speed(a, from, u).max(self.start_speed_mm_per_s));
+                speed = math::min(speed, math::max(self.junction_speed(a, from, u), self.start_speed_mm_per_s));
             }
             Bend::Curve { curvature_per_mm: k } => {
                 if k > 0.0 && k.is_finite() {
                     let v2 = CENTRIPETAL_SHARE * slowest_accel / k;
-                    speed = speed.min(libm::sqrtf(v2).max(self.start_speed_mm_per_s));
+                    speed = math::min(speed, math::max(math::sqrt(v2), self.start_speed_mm_per_s));
                     curvature_per_mm = k;
                 }
             }
@@ -247,10 +248,10 @@ impl Limits {
             let share = u[axis].abs();
             if share > DIR_EPSILON {
                 let room = self.accel_mm_per_s2[axis] - centripetal_mm_per_s2 * normal[axis];
-                accel = accel.min(room / share);
+                accel = math::min(accel, room / share);
             }
         }
-        let slowest_accel = self.accel_mm_per_s2[0].min(self.accel_mm_per_s2[1]);
+        let slowest_accel = math::min(self.accel_mm_per_s2[0], self.accel_mm_per_s2[1]);
         sanitize(accel, slowest_accel * (1.0 - CENTRIPETAL_SHARE))
     }
 
@@ -263,14 +264,14 @@ impl Limits {
         // |exit − entry|² = 4·sin²(φ/2) and |exit + entry| / 2 = cos(φ/2) = sin(θ/2), with φ the
         // turn and θ = π − φ the angle GRBL's rule names.
         let diff2 = dx * dx + dy * dy;
-        let sin_half_theta = (libm::sqrtf(sx * sx + sy * sy) / 2.0).min(1.0);
+        let sin_half_theta = math::min(math::sqrt(sx * sx + sy * sy) / 2.0, 1.0);
         if diff2 <= 0.0 || diff2.is_nan() {
             return f32::INFINITY;
         }
         // 1 − sin(θ/2) = sin²(φ/2) / (1 + cos(φ/2)), without cancellation for gentle turns.
         let one_minus = (diff2 / 4.0) / (1.0 + sin_half_theta);
         let v2 = accel_mm_per_s2 * self.junction_deviation_mm * sin_half_theta / one_minus;
-        if v2.is_finite() { libm::sqrtf(v2.max(0.0)) } else { f32::INFINITY }
+        if v2.is_finite() { math::sqrt(math::max(v2, 0.0)) } else { f32::INFINITY }
     }
 }
 
@@ -293,12 +294,12 @@ impl UnitDir {
     /// The interpolator's tangent, or — when the tangent is not a usable vector — the direction
     /// of the step taken from that point.
     pub fn from_tangent(t: Tangent, step_x: i8, step_y: i8) -> UnitDir {
-        let len = libm::sqrtf(t.x * t.x + t.y * t.y);
+        let len = math::sqrt(t.x * t.x + t.y * t.y);
         if len.is_finite() && len > DIR_EPSILON {
             UnitDir { x: t.x / len, y: t.y / len }
         } else if step_x != 0 || step_y != 0 {
             let (x, y) = (step_x as f32, step_y as f32);
-            let len = libm::sqrtf(x * x + y * y);
+            let len = math::sqrt(x * x + y * y);
             UnitDir { x: x / len, y: y / len }
         } else {
             UnitDir { x: 1.0, y: 0.0 }
@@ -315,12 +316,13 @@ pub(crate) struct StepGeometry {
     pub dir_mm: [f32; 2],
 }
 
-/// How the curve bends at a step.
+/// How the curve bends at a stretch of steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Bend {
-    /// The first step of a curve, or no turn.
+    /// No turn.
     Straight,
-    /// The direction jumps (more than [`KINK_CHORD`]) from `from` at this step.
+    /// The direction jumps (a kink, see [`crate::interp::KINK_CHORD`]) from `from` (mm) at this
+    /// step.
     Kink { from: [f32; 2] },
     /// A smooth turn of this curvature.
     Curve { curvature_per_mm: f32 },
@@ -330,73 +332,8 @@ pub(crate) enum Bend {
 /// is left for speeding up and slowing down on the curve.
 pub const CENTRIPETAL_SHARE: f32 = 0.8;
 
-/// Steps over which the curvature is measured: one step's turn on the lattice is noisy, the
-/// turn over 16 steps is within a few percent for a circle of 300 steps radius.
-pub const CURVATURE_BASELINE_STEPS: usize = 16;
-
-/// A turn between two steps with a chord (between unit directions) above this (≈ 5.7°) is a
-/// kink: no smooth curve bends so much in one step unless its radius is under about ten steps.
-const KINK_CHORD: f32 = 0.1;
-
-/// The last directions of the curve being scanned, to tell its bend at each step.
-pub(crate) struct BendTracker {
-    dirs: [[f32; 2]; CURVATURE_BASELINE_STEPS],
-    lens_mm: [f32; CURVATURE_BASELINE_STEPS],
-    /// Entries held, and the slot of the next one.
-    count: usize,
-    next: usize,
-}
-
-impl BendTracker {
-    pub const fn new() -> Self {
-        BendTracker {
-            dirs: [[0.0; 2]; CURVATURE_BASELINE_STEPS],
-            lens_mm: [0.0; CURVATURE_BASELINE_STEPS],
-            count: 0,
-            next: 0,
-        }
-    }
-
-    /// Forgets the curve: the next step starts a new one.
-    pub fn reset(&mut self) {
-        self.count = 0;
-        self.next = 0;
-    }
-
-    /// The bend at step `g` (the next step of the curve), which is then remembered.
-    pub fn bend(&mut self, g: &StepGeometry) -> Bend {
-        const K: usize = CURVATURE_BASELINE_STEPS;
-        let u = g.dir_mm;
-        let bend = if self.count == 0 {
-            Bend::Straight
-        } else {
-            let prev = self.dirs[(self.next + K - 1) % K];
-            let (dx, dy) = (u[0] - prev[0], u[1] - prev[1]);
-            if dx * dx + dy * dy > KINK_CHORD * KINK_CHORD {
-                self.reset();
-                Bend::Kink { from: prev }
-            } else {
-                // Turn since the oldest remembered step, over the distance travelled since.
-                let oldest = (self.next + K - self.count) % K;
-                let o = self.dirs[oldest];
-                let turn = libm::atan2f((o[0] * u[1] - o[1] * u[0]).abs(), o[0] * u[0] + o[1] * u[1]);
-                let mut dist_mm = g.step_mm;
-                for i in 1..self.count {
-                    dist_mm += self.lens_mm[(oldest + i) % K];
-                }
-                Bend::Curve { curvature_per_mm: turn / dist_mm }
-            }
-        };
-        self.dirs[self.next] = u;
-        self.lens_mm[self.next] = g.step_mm;
-        self.next = (self.next + 1) % K;
-        self.count = (self.count + 1).min(K);
-        bend
-    }
-}
-
 /// Speed and acceleration allowed on a stretch of path.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub(crate) struct Caps {
     pub speed_mm_per_s: f32,
     pub accel_mm_per_s2: f32,
@@ -425,7 +362,7 @@ pub fn plot_time_lower_bound(limits: &Limits, method: Method, feed: Feed, points
         let g = limits.step_geometry(method, UnitDir::from_tangent(Tangent { x: dx, y: dy }, 0, 0));
         let caps = limits.step_caps(&g, Bend::Straight, requested);
         let (mx, my) = (dx / limits.steps_per_mm[0], dy / limits.steps_per_mm[1]);
-        Some((libm::sqrtf(mx * mx + my * my), caps, g.step_mm))
+        Some((math::sqrt(mx * mx + my * my), caps, g.step_mm))
     };
     let (mut total_mm, mut accel, mut longest_step_mm) = (0.0f32, 0.0f32, 0.0f32);
     for (len, caps, step_mm) in points.windows(2).filter_map(segment) {
@@ -437,7 +374,7 @@ pub fn plot_time_lower_bound(limits: &Limits, method: Method, feed: Feed, points
         return 0.0;
     }
     let stop = limits.start_speed_mm_per_s;
-    let start = libm::sqrtf(stop * stop + 2.0 * accel * longest_step_mm);
+    let start = math::sqrt(stop * stop + 2.0 * accel * longest_step_mm);
     // Where the rising ramp (from `start` at 0) meets the falling one (to `stop` at the end).
     let half = ((total_mm + (stop * stop - start * start) / (2.0 * accel)) / 2.0).clamp(0.0, total_mm);
     let (mut at_mm, mut seconds) = (0.0f32, 0.0f32);
@@ -469,7 +406,7 @@ fn ramp_limited_time(near: f32, far: f32, cap: f32, start: f32, accel: f32) -> f
     let ramp_end = far.min(reach);
     let mut t = 0.0;
     if near < ramp_end {
-        let speed = |d: f32| libm::sqrtf(start * start + 2.0 * accel * d);
+        let speed = |d: f32| math::sqrt(start * start + 2.0 * accel * d);
         t += (speed(ramp_end) - speed(near)) / accel;
     }
     let cruise = far - near.max(reach);

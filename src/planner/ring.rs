@@ -1,5 +1,10 @@
-//! A fixed-capacity first-in first-out queue: the planner's segments and blocks.
+//! Fixed-capacity first-in first-out queues of the planner: the segments waiting to be scanned
+//! ([`Ring`]), and the scanned steps, chunks and blocks ([`CopyRing`]).
 
+use crate::geom::Step;
+use crate::planner::STEP_RING_LEN;
+
+/// A queue of values that are moved in and out (the segments, which own their curves).
 pub(crate) struct Ring<T, const N: usize> {
     slots: [Option<T>; N],
     head: usize,
@@ -11,14 +16,6 @@ impl<T, const N: usize> Ring<T, N> {
         Ring { slots: [const { None }; N], head: 0, len: 0 }
     }
 
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
     pub fn is_full(&self) -> bool {
         self.len >= N
     }
@@ -27,30 +24,11 @@ impl<T, const N: usize> Ring<T, N> {
         (self.head + i) % N.max(1)
     }
 
-    /// The `i`-th element from the front.
-    pub fn get(&self, i: usize) -> Option<&T> {
-        if i < self.len { self.slots.get(self.slot(i))?.as_ref() } else { None }
-    }
-
-    pub fn get_mut(&mut self, i: usize) -> Option<&mut T> {
-        if i < self.len {
-            let slot = self.slot(i);
-            self.slots.get_mut(slot)?.as_mut()
-        } else {
-            None
-        }
-    }
-
-    pub fn front(&self) -> Option<&T> {
-        self.get(0)
-    }
-
     pub fn front_mut(&mut self) -> Option<&mut T> {
-        self.get_mut(0)
-    }
-
-    pub fn back_mut(&mut self) -> Option<&mut T> {
-        self.get_mut(self.len.checked_sub(1)?)
+        if self.len == 0 {
+            return None;
+        }
+        self.slots.get_mut(self.head)?.as_mut()
     }
 
     /// Appends `value`, or hands it back when the queue is full.
@@ -85,5 +63,104 @@ impl<T, const N: usize> Ring<T, N> {
         }
         self.head = 0;
         self.len = 0;
+    }
+}
+
+/// A queue of plain values, `N` a power of two: indices wrap with a mask, and the free space
+/// can be handed out as a slice to write into.
+pub(crate) struct CopyRing<T: Copy + Default, const N: usize> {
+    slots: [T; N],
+    /// Pops and pushes so far, counted with wrapping: the slot of each is its count modulo `N`,
+    /// and the length is their difference.
+    head: u32,
+    tail: u32,
+}
+
+/// The ring of scanned steps.
+pub(crate) type StepRing = CopyRing<Step, STEP_RING_LEN>;
+
+impl<T: Copy + Default, const N: usize> CopyRing<T, N> {
+    const MASK: u32 = {
+        assert!(N.is_power_of_two() && N <= 1 << 16, "a CopyRing's capacity is a power of two up to 65536");
+        (N - 1) as u32
+    };
+
+    pub fn new() -> Self {
+        CopyRing { slots: [T::default(); N], head: 0, tail: 0 }
+    }
+
+    pub fn len(&self) -> usize {
+        self.tail.wrapping_sub(self.head) as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.head == self.tail
+    }
+
+    pub fn is_full(&self) -> bool {
+        self.len() >= N
+    }
+
+    /// Free slots.
+    pub fn free(&self) -> usize {
+        N - self.len()
+    }
+
+    pub fn clear(&mut self) {
+        self.head = 0;
+        self.tail = 0;
+    }
+
+    pub fn front(&self) -> Option<&T> {
+        if self.is_empty() { None } else { self.slots.get((self.head & Self::MASK) as usize) }
+    }
+
+    pub fn front_mut(&mut self) -> Option<&mut T> {
+        if self.is_empty() { None } else { self.slots.get_mut((self.head & Self::MASK) as usize) }
+    }
+
+    pub fn back_mut(&mut self) -> Option<&mut T> {
+        if self.is_empty() { None } else { self.slots.get_mut((self.tail.wrapping_sub(1) & Self::MASK) as usize) }
+    }
+
+    /// The `i`-th element from the front.
+    pub fn get_mut(&mut self, i: usize) -> Option<&mut T> {
+        if i < self.len() { self.slots.get_mut((self.head.wrapping_add(i as u32) & Self::MASK) as usize) } else { None }
+    }
+
+    /// Appends `value`; `false` (and nothing changes) when the queue is full.
+    pub fn push_back(&mut self, value: T) -> bool {
+        if self.is_full() {
+            return false;
+        }
+        if let Some(slot) = self.slots.get_mut((self.tail & Self::MASK) as usize) {
+            *slot = value;
+            self.tail = self.tail.wrapping_add(1);
+        }
+        true
+    }
+
+    pub fn pop_front(&mut self) -> Option<T> {
+        if self.is_empty() {
+            return None;
+        }
+        let value = self.slots.get((self.head & Self::MASK) as usize).copied();
+        self.head = self.head.wrapping_add(1);
+        value
+    }
+
+    /// The free slots from the back up to the end of the buffer, at most `max` of them: write
+    /// into them, then [`commit`](Self::commit) how many were written.
+    pub fn free_slice(&mut self, max: usize) -> &mut [T] {
+        let start = (self.tail & Self::MASK) as usize;
+        let until_wrap = N - start;
+        let n = self.free().min(until_wrap).min(max);
+        self.slots.get_mut(start..start + n).unwrap_or(&mut [])
+    }
+
+    /// Appends the `n` slots written through [`free_slice`](Self::free_slice).
+    pub fn commit(&mut self, n: usize) {
+        let n = n.min(self.free());
+        self.tail = self.tail.wrapping_add(n as u32);
     }
 }

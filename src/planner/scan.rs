@@ -1,46 +1,92 @@
-//! The scan: runs a clone of each queued interpolator ahead of the motion, cuts the path into
-//! blocks of steps with one cap each, and plans the blocks' exit speeds (the backward pass).
+//! The scan: steps each queued curve once, ahead of the motion, into the ring of steps; cuts
+//! the steps into chunks (one step length each) and blocks (one cap each); plans the blocks'
+//! exit speeds (the backward pass). Floating point here runs once per chunk, not per step.
 
-use crate::geom::Step;
-use crate::interp::{CurveError, Interpolator, Method};
-use crate::planner::limits::{Caps, UnitDir};
-use crate::planner::{BLOCK_MARGIN, Planner};
+use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::math;
+use crate::planner::limits::{Bend, Caps, StepGeometry, UnitDir};
+use crate::planner::{BLOCK_MARGIN, CHUNK_STEPS, Planner, STRAIGHT_CHUNK_STEPS};
 
-/// Caps of a segment's first block sit this far below those of its first step: only float
+/// Caps of a segment's first block sit this far below those of its first chunk: only float
 /// noise, so a straight line runs at its own caps.
 const FIRST_BLOCK_MARGIN: f32 = 1e-4;
 
-/// A step allowing this much (relative) more speed than its block starts a new block.
+/// A chunk allowing this much (relative) more speed than its block starts a new block.
 const BLOCK_SPLIT_GAIN: f32 = 0.1;
 
-/// Distances are counted in whole nanometres so that the scan and the motion agree exactly.
-const NM_PER_MM: f32 = 1.0e6;
-
-/// One queued segment: its interpolator and the clone that scans ahead of it.
-pub(crate) struct Track<C> {
+/// One queued curve, waiting to be scanned or being scanned.
+pub(crate) struct Segment<C> {
     pub curve: C,
-    pub scout: C,
     pub method: Method,
     /// The feed, mm/s (unbounded for rapid).
     pub requested_mm_per_s: f32,
-    /// The scout has not reached the end (or an error) yet.
-    pub scanning: bool,
-    /// Direction (mm) of the last scanned step; `None` before the first.
-    pub scout_dir_mm: Option<[f32; 2]>,
-    pub last_scanned: Step,
-    /// How many blocks in the queue belong to this segment.
-    pub blocks: usize,
 }
 
-/// Consecutive steps of one segment sharing one cap.
-#[derive(Clone, Copy, Debug)]
+/// Where the scan stands on the front segment.
+#[derive(Clone, Copy)]
+pub(crate) struct ScanPoint {
+    /// The segment's first chunk is still to come.
+    fresh: bool,
+    /// The tangent at the scan point, and the geometry of a step along it.
+    tangent: Tangent,
+    at: StepGeometry,
+    /// The last chunk ran straight (the tangent did not change over it): the next one may be
+    /// long, and extends it if it runs straight on.
+    straight: bool,
+    /// The last step scanned reached a kink from this direction (mm): the next step is a chunk
+    /// and a block of its own, passed by the junction rule.
+    kink_from_mm: Option<[f32; 2]>,
+}
+
+impl ScanPoint {
+    pub const fn new() -> Self {
+        ScanPoint {
+            fresh: true,
+            tangent: Tangent { x: 1.0, y: 0.0 },
+            at: StepGeometry { step_mm: 0.0, dir_mm: [1.0, 0.0] },
+            straight: false,
+            kink_from_mm: None,
+        }
+    }
+}
+
+/// Distances along the path are also counted in whole nanometres, so that the scan's block
+/// lengths and the generator's progress agree exactly and the motion ends exactly at the end.
+pub(crate) const NM_PER_MM: f32 = 1.0e6;
+
+/// Consecutive scanned steps that advance the same distance along the ideal curve.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Chunk {
+    /// Steps not yet emitted.
+    pub left: u32,
+    /// Distance one step advances along the ideal curve, mm, and in whole nanometres.
+    pub step_mm: f32,
+    pub step_nm: u32,
+}
+
+impl Chunk {
+    fn new(left: u32, step_mm: f32) -> Chunk {
+        // Saturating float-to-int conversion; steps are micrometres long, far from either end.
+        Chunk { left, step_mm, step_nm: (step_mm * NM_PER_MM + 0.5) as u32 }
+    }
+
+    /// Length of `n` of its steps, nm.
+    pub fn nm(&self, n: u32) -> u32 {
+        self.step_nm.saturating_mul(n)
+    }
+}
+
+/// Consecutive scanned steps of one segment sharing one cap.
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Block {
     pub steps: u32,
-    pub len_nm: u64,
+    /// Length, and distance emitted so far, nm (`u32`: up to 4.2 m, longer than any path on the
+    /// machine).
+    pub len_nm: u32,
     pub done_steps: u32,
-    pub done_nm: u64,
+    pub done_nm: u32,
     pub caps: Caps,
-    /// Direction (mm) of the first step, and after the last one when `ends_segment`.
+    /// Direction (mm) at the block's start, and at its end.
     pub entry_dir_mm: [f32; 2],
     pub exit_dir_mm: [f32; 2],
     /// The scan is still adding steps: its end is the scan's front.
@@ -56,156 +102,241 @@ pub(crate) struct Block {
 }
 
 impl Block {
-    /// Highest speed at `at_nm` from which the motion can still brake to `exit_mm_per_s` at the
-    /// block's (known) end.
-    pub fn brake_limit(&self, at_nm: u64) -> f32 {
-        let left_mm = self.len_nm.saturating_sub(at_nm) as f32 / NM_PER_MM;
-        libm::sqrtf(self.exit_mm_per_s * self.exit_mm_per_s + 2.0 * self.caps.accel_mm_per_s2 * left_mm)
+    /// Distance left after `at_nm` into the block, mm.
+    pub fn left_mm(&self, at_nm: u32) -> f32 {
+        self.len_nm.saturating_sub(at_nm) as f32 / NM_PER_MM
     }
 
-    /// Whether a step with speed cap `speed` and acceleration `accel` can join this block.
-    fn takes(&self, speed: f32, accel: f32) -> bool {
+    /// Highest speed at `at_nm` into the block from which the motion can still brake to
+    /// `exit_mm_per_s` at the block's (known) end.
+    pub fn brake_limit(&self, at_nm: u32) -> f32 {
+        math::sqrt(self.exit_mm_per_s * self.exit_mm_per_s + 2.0 * self.caps.accel_mm_per_s2 * self.left_mm(at_nm))
+    }
+
+    /// Whether steps with caps `own` can join this block.
+    fn takes(&self, own: Caps) -> bool {
         let cap = self.caps.speed_mm_per_s;
-        self.open && speed >= cap && accel >= self.caps.accel_mm_per_s2 && speed <= cap * (1.0 + BLOCK_SPLIT_GAIN)
+        self.open
+            && own.speed_mm_per_s >= cap
+            && own.accel_mm_per_s2 >= self.caps.accel_mm_per_s2
+            && own.speed_mm_per_s <= cap * (1.0 + BLOCK_SPLIT_GAIN)
     }
 }
 
-pub(crate) fn to_nm(mm: f32) -> u64 {
-    // Saturating float-to-int conversion; steps are micrometres long, far from either end.
-    (mm * NM_PER_MM + 0.5) as u64
+/// The turn between two unit directions, radians (0 to π).
+fn turn_rad(from: [f32; 2], to: [f32; 2]) -> f32 {
+    let cross = from[0] * to[1] - from[1] * to[0];
+    let dot = from[0] * to[0] + from[1] * to[1];
+    math::atan2(cross.abs(), dot)
 }
 
-impl<C: Interpolator + Clone, const N: usize> Planner<C, N> {
-    /// One scan step for the front segment, whatever the budget: the motion has caught up with
-    /// the scan (the plan has brought it to the start rate there).
-    pub(crate) fn scan_front(&mut self) {
-        let popped_block = self.blocks.front().is_some_and(|b| b.done_steps >= b.steps && !b.open && b.error.is_none());
-        if popped_block {
-            self.pop_front_block();
-            return;
-        }
-        if self.tracks.front().is_some_and(|t| t.scanning) {
-            self.scan_one(0);
-        } else {
-            // Nothing left to scan nor to emit: the segment is done.
-            self.drop_front_track();
-        }
-        self.replan();
-    }
-
-    /// Runs the scan of the first unfinished segments for up to `budget` steps.
-    pub(crate) fn scan(&mut self, budget: u32) {
-        let mut scanned = false;
-        let mut index = 0;
-        for _ in 0..budget {
-            while self.tracks.get(index).is_some_and(|t| !t.scanning) {
-                index += 1;
+impl<C: Interpolator, const N: usize> Planner<C, N> {
+    /// Scans up to about `budget` steps of the queued segments, as far as there is room, then
+    /// plans the blocks' exit speeds again.
+    pub(crate) fn scan(&mut self, budget: usize) {
+        let mut scanned = 0;
+        let mut changed = false;
+        while scanned < budget {
+            match self.scan_chunk() {
+                Some(steps) => {
+                    scanned += steps.max(1);
+                    changed = true;
+                }
+                None => break,
             }
-            if index >= self.tracks.len() || self.blocks.is_full() {
-                break;
-            }
-            self.scan_one(index);
-            scanned = true;
         }
-        if scanned {
+        if changed {
             self.replan();
         }
     }
 
-    /// Advances the scan of segment `index` by one step, adding it to the open block or starting
-    /// a new one, or ending the segment. Needs a free block.
-    fn scan_one(&mut self, index: usize) {
+    /// Scans one chunk of the front segment (or finishes it); the number of steps scanned, or
+    /// `None` when nothing could be done (no segment, or no room).
+    pub(crate) fn scan_chunk(&mut self) -> Option<usize> {
         let limits = self.limits;
-        let Some(track) = self.tracks.get_mut(index) else { return };
-        if !track.scanning || self.blocks.is_full() {
+        // Room for a chunk and two blocks (a new one and, should the curve fail, its error).
+        if self.chunks.is_full() || self.blocks.free() < 2 {
+            return None;
+        }
+        let segment = self.segments.front_mut()?;
+        if self.scan.fresh {
+            self.scan.tangent = segment.curve.tangent();
+            self.scan.at = limits.step_geometry(segment.method, UnitDir::from_tangent(self.scan.tangent, 0, 0));
+        }
+        let want = if self.scan.kink_from_mm.is_some() {
+            1
+        } else if self.scan.straight {
+            STRAIGHT_CHUNK_STEPS
+        } else {
+            CHUNK_STEPS
+        };
+        let buf = self.steps.free_slice(want);
+        if buf.is_empty() {
+            return None;
+        }
+        let filled = segment.curve.fill(buf);
+        let n = filled.steps;
+        let last_step = buf.get(n.wrapping_sub(1)).copied();
+        self.steps.commit(n);
+        let after = segment.curve.tangent();
+        let (method, requested) = (segment.method, segment.requested_mm_per_s);
+        if n > 0 {
+            // The tangent at the chunk's last point, before any kink there.
+            let end_tangent = filled.kink.unwrap_or(after);
+            let (sx, sy) = last_step.map_or((0, 0), |s| (s.x, s.y));
+            let end = limits.step_geometry(method, UnitDir::from_tangent(end_tangent, sx, sy));
+            self.take_chunk(n as u32, end, end_tangent, requested);
+            if filled.kink.is_some() {
+                self.scan.kink_from_mm = Some(end.dir_mm);
+            }
+            self.scan.tangent = after;
+            self.scan.at = if filled.kink.is_some() {
+                limits.step_geometry(method, UnitDir::from_tangent(after, sx, sy))
+            } else {
+                end
+            };
+        }
+        match filled.end {
+            None if n == 0 => None,
+            None => Some(n),
+            Some(end) => {
+                self.end_segment(end);
+                Some(n)
+            }
+        }
+    }
+
+    /// Files `n` scanned steps that end where a step has geometry `end` (tangent `end_tangent`)
+    /// into the chunks and blocks.
+    fn take_chunk(&mut self, n: u32, end: StepGeometry, end_tangent: Tangent, requested_mm_per_s: f32) {
+        let limits = self.limits;
+        let start = self.scan.at;
+        let fresh = self.scan.fresh;
+        let kink_from = self.scan.kink_from_mm.take();
+        let straight = kink_from.is_none() && end_tangent == self.scan.tangent;
+        self.scan.fresh = false;
+        if straight && self.scan.straight && !fresh && self.extend_back(n, start.step_mm) {
             return;
         }
-        let tangent = track.scout.tangent();
-        let outcome = track.scout.next_step();
-        let step = match outcome {
-            Ok(Some(step)) => step,
-            Ok(None) | Err(_) => {
-                track.scanning = false;
-                let last = track.last_scanned;
-                let exit = UnitDir::from_tangent(track.scout.tangent(), last.x, last.y);
-                let exit_dir_mm = limits.step_geometry(track.method, exit).dir_mm;
-                let owns_back = track.blocks > 0;
-                if let (true, Some(back)) = (owns_back, self.blocks.back_mut()) {
-                    back.open = false;
-                    // A junction follows the end; a failure block follows a failure.
-                    back.ends_segment = outcome.is_ok();
-                    back.exit_dir_mm = exit_dir_mm;
-                    back.dirty = true;
-                }
-                if let Err(e) = outcome {
-                    let start = limits.start_speed_mm_per_s;
-                    let failure = Block {
-                        steps: 0,
-                        len_nm: 0,
-                        done_steps: 0,
-                        done_nm: 0,
-                        caps: Caps { speed_mm_per_s: start, accel_mm_per_s2: limits.accel_mm_per_s2[0] },
-                        entry_dir_mm: exit_dir_mm,
-                        exit_dir_mm,
-                        open: false,
-                        ends_segment: true,
-                        error: Some(e),
-                        exit_mm_per_s: start,
-                        dirty: true,
-                    };
-                    if self.blocks.push_back(failure).is_ok() {
-                        track.blocks += 1;
-                    }
-                }
-                return;
-            }
+        self.scan.straight = straight;
+        // One step length and direction for the whole chunk: the mean of its ends'.
+        let step_mm = 0.5 * (start.step_mm + end.step_mm);
+        let (dx, dy) = (start.dir_mm[0] + end.dir_mm[0], start.dir_mm[1] + end.dir_mm[1]);
+        let len = math::sqrt(dx * dx + dy * dy);
+        let dir_mm = if len > 1e-3 { [dx / len, dy / len] } else { end.dir_mm };
+        let g = StepGeometry { step_mm, dir_mm };
+        let bend = match kink_from {
+            Some(from) => Bend::Kink { from },
+            None if straight => Bend::Straight,
+            None => Bend::Curve { curvature_per_mm: turn_rad(start.dir_mm, end.dir_mm) / (n as f32 * step_mm) },
         };
-        let g = limits.step_geometry(track.method, UnitDir::from_tangent(tangent, step.x, step.y));
-        let first = track.scout_dir_mm.is_none();
-        if first {
-            self.bend.reset();
-        }
-        let own = limits.step_caps(&g, self.bend.bend(&g), track.requested_mm_per_s);
-        let speed = own.speed_mm_per_s;
-        track.scout_dir_mm = Some(g.dir_mm);
-        track.last_scanned = step;
-        let step_nm = to_nm(g.step_mm);
+        let own = limits.step_caps(&g, bend, requested_mm_per_s);
+        let chunk = Chunk::new(n, step_mm);
         // The open block, if any, is this segment's: the last block in the queue.
-        if let (false, true, Some(back)) = (first, track.blocks > 0, self.blocks.back_mut()) {
+        if !fresh && let Some(back) = self.blocks.back_mut() {
             back.dirty = true;
-            if back.takes(speed, own.accel_mm_per_s2) {
-                back.steps = back.steps.saturating_add(1);
-                back.len_nm = back.len_nm.saturating_add(step_nm);
+            if back.takes(own) {
+                back.steps = back.steps.saturating_add(n);
+                back.len_nm = back.len_nm.saturating_add(chunk.nm(n));
+                back.exit_dir_mm = end.dir_mm;
+                self.push_chunk(chunk, true);
                 return;
             }
             back.open = false;
         }
-        let keep = 1.0 - if first { FIRST_BLOCK_MARGIN } else { BLOCK_MARGIN };
+        let keep = 1.0 - if fresh { FIRST_BLOCK_MARGIN } else { BLOCK_MARGIN };
         let block = Block {
-            steps: 1,
-            len_nm: step_nm,
+            steps: n,
+            len_nm: chunk.nm(n),
             done_steps: 0,
             done_nm: 0,
             caps: Caps {
                 // The margin only where the machine limits the speed: the feed itself is kept.
-                speed_mm_per_s: if own.speed_mm_per_s >= track.requested_mm_per_s {
+                speed_mm_per_s: if own.speed_mm_per_s >= requested_mm_per_s {
                     own.speed_mm_per_s
                 } else {
                     own.speed_mm_per_s * keep
                 },
                 accel_mm_per_s2: own.accel_mm_per_s2 * keep,
             },
-            entry_dir_mm: g.dir_mm,
-            exit_dir_mm: g.dir_mm,
+            entry_dir_mm: start.dir_mm,
+            exit_dir_mm: end.dir_mm,
             open: true,
             ends_segment: false,
             error: None,
             exit_mm_per_s: limits.start_speed_mm_per_s,
             dirty: true,
         };
-        if self.blocks.push_back(block).is_ok() {
-            track.blocks += 1;
+        if self.blocks.push_back(block) {
+            self.push_chunk(chunk, false);
         }
+    }
+
+    /// Adds `n` steps of `step_mm` to the open block and its last chunk (a straight run going
+    /// on); false when there is no such block.
+    fn extend_back(&mut self, n: u32, step_mm: f32) -> bool {
+        let Some(back) = self.blocks.back_mut() else { return false };
+        if !back.open {
+            return false;
+        }
+        let chunk = Chunk::new(n, step_mm);
+        back.steps = back.steps.saturating_add(n);
+        back.len_nm = back.len_nm.saturating_add(chunk.nm(n));
+        back.dirty = true;
+        self.push_chunk(chunk, true);
+        true
+    }
+
+    /// Appends `chunk`, or adds its steps to the last one when it is in the same block
+    /// (`same_block`) and its steps have the same length.
+    fn push_chunk(&mut self, chunk: Chunk, same_block: bool) {
+        if same_block
+            && let Some(back) = self.chunks.back_mut()
+            && back.step_mm == chunk.step_mm
+            && back.left > 0
+        {
+            back.left = back.left.saturating_add(chunk.left);
+            return;
+        }
+        // The scan checked for room before it took the steps.
+        let _ = self.chunks.push_back(chunk);
+    }
+
+    /// The front segment is scanned to its end (`Ok`) or to the point where it fails.
+    fn end_segment(&mut self, end: Result<(), CurveError>) {
+        let limits = self.limits;
+        let fresh = self.scan.fresh;
+        let exit_dir_mm = self.scan.at.dir_mm;
+        if !fresh && let Some(back) = self.blocks.back_mut() {
+            back.open = false;
+            back.ends_segment = end.is_ok();
+            back.exit_dir_mm = exit_dir_mm;
+            back.dirty = true;
+        }
+        match end {
+            Ok(()) if fresh => {
+                // Not a single step: nothing to emit.
+                self.held = self.held.saturating_sub(1);
+            }
+            Ok(()) => {}
+            Err(e) => {
+                let start = limits.start_speed_mm_per_s;
+                let failure = Block {
+                    caps: Caps { speed_mm_per_s: start, accel_mm_per_s2: limits.accel_mm_per_s2[0] },
+                    entry_dir_mm: exit_dir_mm,
+                    exit_dir_mm,
+                    ends_segment: true,
+                    error: Some(e),
+                    exit_mm_per_s: start,
+                    dirty: true,
+                    ..Block::default()
+                };
+                // The scan checked for room before it took the steps.
+                let _ = self.blocks.push_back(failure);
+            }
+        }
+        self.segments.pop_front();
+        self.scan = ScanPoint::new();
     }
 
     /// Backward pass: each block's exit speed, from a stop at the end of the plan. Stops early
@@ -220,10 +351,10 @@ impl<C: Interpolator + Clone, const N: usize> Planner<C, N> {
             let Some(block) = self.blocks.get_mut(i) else { continue };
             let exit = match next {
                 Some((entry, caps, reachable)) if !block.open && block.error.is_none() => {
-                    let mut exit = caps.speed_mm_per_s.max(start).min(reachable);
+                    let mut exit = math::min(math::max(caps.speed_mm_per_s, start), reachable);
                     if block.ends_segment {
-                        let a = caps.accel_mm_per_s2.min(block.caps.accel_mm_per_s2);
-                        exit = exit.min(limits.junction_speed(a, block.exit_dir_mm, entry).max(start));
+                        let a = math::min(caps.accel_mm_per_s2, block.caps.accel_mm_per_s2);
+                        exit = math::min(exit, math::max(limits.junction_speed(a, block.exit_dir_mm, entry), start));
                     }
                     exit
                 }

@@ -4,8 +4,10 @@
 extern crate std;
 
 use super::*;
-use crate::geom::Point;
+use crate::geom::{Point, Step, StepCmd, TICK_HZ};
+use crate::interp::{CurveError, Interpolator, Method};
 use crate::interp::{LineInterp, Tangent};
+use crate::job::Feed;
 use crate::settings::{MAX_PULSE_RATE_HZ, Settings};
 use std::vec::Vec;
 

@@ -81,15 +81,6 @@ pub fn jump_to_next_deadline() -> bool {
     true
 }
 
-/// A busy-wait that costs virtual time, as the pulse width costs the pulse task real time.
-pub struct BusyDelay;
-
-impl DelayNs for BusyDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        advance((ns as u64).div_ceil(1000));
-    }
-}
-
 /// A delay that costs no virtual time: blocking work of the lowest-priority task (the LCD), which
 /// on target is pre-empted by the pulse task and so never delays a pulse.
 pub struct FreeDelay;

@@ -12,6 +12,7 @@ pub mod lcd;
 pub mod picture;
 pub mod pins;
 pub mod serial;
+pub mod step_timer;
 
 use core::future::Future;
 use core::pin::pin;
@@ -27,13 +28,17 @@ use embassy_futures::join::join5;
 
 use crate::geom::{Axis, Point};
 use crate::machine::Machine;
+use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
-use crate::tasks::{self, lcd::St7920Lcd, pulse::AxisPins};
-use clock::{BusyDelay, FreeDelay};
+use crate::tasks::{self, lcd::St7920Lcd};
+use clock::FreeDelay;
+use embassy_sync::blocking_mutex::raw::NoopRawMutex;
+use embassy_sync::signal::Signal;
 use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SimSpi};
 use pins::{PulseTrace, TracePin};
 use serial::SimSerial;
+use step_timer::SimStepTimer;
 
 /// After the inputs are used up and the machine rests, the run goes on this long so the LCD
 /// shows the final state.
@@ -109,10 +114,11 @@ pub fn run(config: SimConfig) -> SimReport {
     clock::reset();
     let machine = Machine::new(config.settings);
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
-    let axes = Axis::ALL.map(|axis| {
-        let (puls, sign) = TracePin::pair(&trace, axis);
-        AxisPins { puls, sign }
-    });
+    let mut step_queue = StepQueue::new();
+    let (steps, step_consumer) = step_queue.split();
+    let mut engine =
+        PulseEngine::new(SimStepTimer::new(Axis::ALL.map(|axis| TracePin::pair(&trace, axis))), step_consumer);
+    let kicks = Signal::<NoopRawMutex, ()>::new();
     let matrix = match config.keys_start {
         KeysStart::AtOnce => KeyMatrix::new(config.keys),
         KeysStart::AfterSerial => KeyMatrix::waiting(config.keys),
@@ -124,8 +130,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
 
     let firmware = join5(
-        tasks::pulse::run(&machine, axes, BusyDelay),
-        tasks::motion::run(&machine),
+        step_timer::run(&machine, &mut engine, &kicks),
+        tasks::motion::run(&machine, steps, || kicks.signal(())),
         tasks::keypad::run(&machine, columns, rows),
         tasks::serial::run(&machine, serial.clone(), serial.clone()),
         tasks::lcd::run(&machine, lcd),

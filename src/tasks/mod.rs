@@ -5,5 +5,4 @@
 pub mod keypad;
 pub mod lcd;
 pub mod motion;
-pub mod pulse;
 pub mod serial;

@@ -1,35 +1,60 @@
 //! The motion task: turns jobs into curves, curves into timed step commands through the
-//! planner, and feeds them to the pulse task through the step queue.
+//! planner, and feeds them to the pulse engine through the step queue.
 //!
 //! It only moves values: which curve a job is, and how fast each step goes, are decided by the
-//! core (`interp::Curve::for_job`, `planner::Planner`). It waits for exactly one of three things:
-//! room in the step queue (bounded in count, and in time by `STEP_QUEUE_MAX_US`, so a hold acts
-//! within that time even at the slowest feed), a job when the planner has room for one, or a
-//! control request. On target it runs on its own interrupt executor, between the pulse task and
+//! core (`interp::Curve::for_job`, `planner::Planner`). Each time it runs it takes controls and
+//! jobs, then fills the step queue in one tight loop — as many steps as fit, up to
+//! `STEP_QUEUE_MAX_US` of motion, so a hold acts within that time even at the slowest feed —
+//! publishes what it queued, and wakes the pulse engine. Then it waits for exactly one of three
+//! things: the queue half emitted, a job when the planner has room for one, or a control
+//! request. On target it runs on its own interrupt executor, between the pulse engine and
 //! everything else.
 
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
+use heapless::spsc::Producer;
 
 use crate::geom::Point;
-use crate::interp::Curve;
+use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
 use crate::planner::{Limits, PLANNER_SEGMENTS, Planner, PlannerState};
+use crate::pulse::PulseCmd;
 use crate::settings::Settings;
 use crate::status::RunState;
 
 /// Should the planner ever have nothing to emit while it says it is moving, the task looks
-/// again after this long instead of spinning.
+/// again after this long instead of spinning; also the shortest wait for the queue to drain.
 pub const MOTION_RETRY_US: u64 = 100;
 
-/// Runs the motion forever.
-pub async fn run(machine: &Machine) -> ! {
+/// Why a fill of the step queue stopped.
+enum FillEnd {
+    /// The queue holds as much as it may.
+    QueueFull,
+    /// The planner has nothing more now.
+    PlanEmpty,
+    /// The curve failed part way.
+    CurveFailed(CurveError),
+}
+
+/// What the task has queued for the pulse engine: the totals it publishes, and where the
+/// steps take the pen.
+struct Queued {
+    steps: u32,
+    ticks: u32,
+    /// Where the steps queued so far take the pen.
+    end: Point,
+    /// A rest ends what was queued: the pulse engine stops when it is done.
+    resting: bool,
+}
+
+/// Runs the motion forever. `steps` is the producer end of the step queue; `kick` wakes the
+/// pulse engine after steps were queued.
+pub async fn run(machine: &Machine, mut steps: Producer<'_, PulseCmd>, mut kick: impl FnMut()) -> ! {
     let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
-    // Where the steps handed to the pulse task so far take the pen.
-    let mut sent_end: Point = machine.position();
+    let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
     // Where the pen will be once everything planned so far has been emitted.
-    let mut planned_end = sent_end;
+    let mut planned_end = queued.end;
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
@@ -40,7 +65,7 @@ pub async fn run(machine: &Machine) -> ! {
         if planner.is_idle() {
             // Nothing planned (after an abort, a curve error, or at rest): the next job starts
             // where the pen stops, not where an abandoned plan would have ended.
-            planned_end = sent_end;
+            planned_end = queued.end;
         }
         while !planner.is_full() {
             let Ok(job) = machine.jobs.try_receive() else { break };
@@ -58,29 +83,37 @@ pub async fn run(machine: &Machine) -> ! {
                 moving = kind;
             }
         }
-        let queued = machine.queued_ticks();
-        if queued >= STEP_QUEUE_MAX_TICKS {
-            // Enough motion queued: wait until half of it is emitted, or for a control.
-            let wait = Duration::from_ticks(u64::from(queued - STEP_QUEUE_MAX_TICKS / 2));
-            select(Timer::after(wait), machine.control_requested()).await;
-            continue;
+        let steps_before = queued.steps;
+        let filled = fill(machine, &mut planner, &mut steps, &mut queued);
+        if queued.steps != steps_before {
+            machine.set_plan_empty(false);
+            machine.set_run_state(moving);
         }
-        match planner.next_cmd() {
-            Some(Ok(cmd)) => {
-                machine.set_plan_empty(false);
-                machine.set_run_state(moving);
-                sent_end = sent_end.stepped(cmd.step);
-                machine.queue_step(cmd).await;
+        if let FillEnd::CurveFailed(e) = filled {
+            // The curve left its domain or the travel area part way: stop there and drop what
+            // was planned after it, since it was planned from a point the pen never reached.
+            // The host is told (see the serial task).
+            warn!("curve ended early: {:?}", e);
+            machine.set_fault(Some(MotionFault::Curve(e)));
+            abort(machine, &mut planner);
+        }
+        let mut rest_queued = false;
+        if !matches!(filled, FillEnd::QueueFull) && planner.is_idle() && !queued.resting {
+            // The motion comes to rest after the steps queued (a slot is kept for this).
+            rest_queued = steps.enqueue(PulseCmd::Rest).is_ok();
+            queued.resting = rest_queued;
+        }
+        machine.set_queued(queued.steps, queued.ticks);
+        if queued.steps != steps_before || rest_queued {
+            kick();
+        }
+        match filled {
+            FillEnd::QueueFull => {
+                // Enough motion queued: wait until half of it is emitted, or for a control.
+                let wait_us = u64::from(machine.queued_ticks() / 2).max(MOTION_RETRY_US);
+                select(Timer::after(Duration::from_ticks(wait_us)), machine.control_requested()).await;
             }
-            Some(Err(e)) => {
-                // The curve left its domain or the travel area part way: stop there and drop
-                // what was planned after it, since it was planned from a point the pen never
-                // reached. The host is told (see the serial task).
-                warn!("curve ended early: {:?}", e);
-                machine.set_fault(Some(MotionFault::Curve(e)));
-                abort(machine, &mut planner);
-            }
-            None => {
+            FillEnd::PlanEmpty | FillEnd::CurveFailed(_) => {
                 machine.set_plan_empty(planner.is_idle());
                 match planner.state() {
                     PlannerState::Idle => {
@@ -89,7 +122,7 @@ pub async fn run(machine: &Machine) -> ! {
                             machine.pulses_done.wait().await;
                         }
                         if machine.run_state() != RunState::Idle {
-                            info!("at rest at ({}, {}) steps", sent_end.x, sent_end.y);
+                            info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
                         }
                         machine.set_run_state(RunState::Idle);
                         wait_for_work(machine, &planner).await;
@@ -105,6 +138,46 @@ pub async fn run(machine: &Machine) -> ! {
             }
         }
     }
+}
+
+/// Moves step commands from the planner into the step queue: as many as fit (one slot stays
+/// free for a rest), up to [`STEP_QUEUE_MAX_TICKS`] of motion queued.
+fn fill(
+    machine: &Machine,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    steps: &mut Producer<'_, PulseCmd>,
+    queued: &mut Queued,
+) -> FillEnd {
+    let room = steps.capacity().saturating_sub(steps.len() + 1);
+    let ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
+    let (mut n, mut ticks) = (0u32, 0u32);
+    let (mut x, mut y) = (queued.end.x, queued.end.y);
+    let filled = loop {
+        if n as usize >= room || ticks >= ticks_room {
+            break FillEnd::QueueFull;
+        }
+        match planner.next_cmd() {
+            Some(Ok(cmd)) => {
+                // `room` free slots were counted above, and only this task enqueues.
+                if steps.enqueue(PulseCmd::Step(cmd)).is_err() {
+                    break FillEnd::QueueFull;
+                }
+                n += 1;
+                ticks = ticks.wrapping_add(cmd.interval_ticks);
+                x += i32::from(cmd.step.x);
+                y += i32::from(cmd.step.y);
+            }
+            Some(Err(e)) => break FillEnd::CurveFailed(e),
+            None => break FillEnd::PlanEmpty,
+        }
+    };
+    if n > 0 {
+        queued.resting = false;
+    }
+    queued.steps = queued.steps.wrapping_add(n);
+    queued.ticks = queued.ticks.wrapping_add(ticks);
+    queued.end = Point::new(x, y);
+    filled
 }
 
 /// Turns `job` into a curve from `planned_end` and queues it in the planner; the kind of

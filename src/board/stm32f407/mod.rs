@@ -1,15 +1,15 @@
 //! The STM32F407VG board: clocks, the whole pin map, peripherals and executors.
 //!
-//! Nothing else in the firmware names a pin or a peripheral instance. Three priorities:
-//! the pulse task runs on an interrupt executor (UART4's vector, unused as a UART) above
-//! everything else; the motion task on a second one just below it (UART5's vector), so the step
-//! queue stays full while a blocking LCD flush (~20 ms) runs; keypad, serial and LCD share the
-//! thread-mode executor.
+//! Nothing else in the firmware names a pin or a peripheral instance. Priorities, most urgent
+//! first: the pulse engine runs in the step timer's update interrupt (TIM1, see `step_timer`);
+//! then embassy-time's timer (TIM2); the motion task on an interrupt executor (UART5's vector,
+//! unused as a UART), so the step queue stays full while a blocking LCD flush (~20 ms) runs;
+//! then the host link's UART; keypad, serial and LCD share the thread-mode executor.
 //!
 //! | signal              | pin  | notes                                              |
 //! |---------------------|------|----------------------------------------------------|
-//! | X PULS / X SIGN     | PE9 / PE10  | to the X driver's PULS+/SIGN+ inputs        |
-//! | Y PULS / Y SIGN     | PE11 / PE12 | to the Y driver's PULS+/SIGN+ inputs        |
+//! | X PULS / X SIGN     | PE9 / PE10  | TIM1 CH1 / GPIO, to the X driver's PULS+/SIGN+ |
+//! | Y PULS / Y SIGN     | PE11 / PE12 | TIM1 CH2 / GPIO, to the Y driver's PULS+/SIGN+ |
 //! | servo on (SON)      | PE13 | high once the firmware runs, both drivers          |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
@@ -19,35 +19,45 @@
 //! | LCD RST             | PB11 | PSB tied to GND selects serial mode                |
 //! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
 
+mod step_timer;
+
 use core::convert::Infallible;
 
 use defmt::{info, unwrap};
 use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Blocking;
 use embassy_stm32::peripherals::USART2;
 use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
 use embassy_stm32::{Config, bind_interrupts, interrupt};
 use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
+use heapless::spsc::Producer;
 use servoplot::machine::Machine;
+use servoplot::pulse::{PulseCmd, StepQueue};
 use servoplot::settings::Settings;
-use servoplot::tasks::{self, lcd::St7920Lcd, pulse::AxisPins};
+use servoplot::tasks::{self, lcd::St7920Lcd};
 use static_cell::StaticCell;
+use step_timer::Tim1StepTimer;
 use {defmt_rtt as _, panic_probe as _};
 
 /// Crystal and core clock (see `clocks`).
 const HSE_HZ: u32 = 8_000_000;
 const SYSCLK_HZ: u32 = 168_000_000;
 
-/// Interrupt priorities, most urgent first: pulses, then motion, then the host link's UART;
-/// keypad, LCD and serial protocol run in thread mode below them all.
-const PULSE_PRIORITY: Priority = Priority::P6;
-const MOTION_PRIORITY: Priority = Priority::P7;
-const HOST_UART_PRIORITY: Priority = Priority::P8;
+/// Interrupt priorities, most urgent first: the step timer (the pulse engine), embassy-time's
+/// timer, motion, then the host link's UART; keypad, LCD and serial protocol run in thread mode
+/// below them all. The step timer's hardware places every pulse edge; its interrupt only has
+/// to preload the next period before the current one ends.
+const PULSE_PRIORITY: Priority = Priority::P0;
+const TIME_DRIVER_PRIORITY: Priority = Priority::P1;
+const MOTION_PRIORITY: Priority = Priority::P2;
+const HOST_UART_PRIORITY: Priority = Priority::P3;
 
 /// Serial host link speed.
 const HOST_BAUD: u32 = 115_200;
@@ -62,15 +72,9 @@ bind_interrupts!(struct Irqs {
     USART2 => usart::BufferedInterruptHandler<USART2>;
 });
 
-static EXECUTOR_PULSE: InterruptExecutor = InterruptExecutor::new();
 static EXECUTOR_MOTION: InterruptExecutor = InterruptExecutor::new();
 static MACHINE: StaticCell<Machine> = StaticCell::new();
-
-#[interrupt]
-unsafe fn UART4() {
-    // SAFETY: UART4 serves only as the pulse executor's software interrupt.
-    unsafe { EXECUTOR_PULSE.on_interrupt() }
-}
+static STEP_QUEUE: StaticCell<StepQueue> = StaticCell::new();
 
 #[interrupt]
 unsafe fn UART5() {
@@ -78,26 +82,11 @@ unsafe fn UART5() {
     unsafe { EXECUTOR_MOTION.on_interrupt() }
 }
 
-/// Busy-waits with the CPU's cycle count: exact to a cycle, where a timer tick is 1 µs.
-struct CycleDelay;
-
-impl embedded_hal::delay::DelayNs for CycleDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        const CYCLES_PER_US: u32 = SYSCLK_HZ / 1_000_000;
-        cortex_m::asm::delay(ns.saturating_mul(CYCLES_PER_US).div_ceil(1000));
-    }
-}
-
 type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, Delay>, Output<'static>, Delay>;
 
 #[embassy_executor::task]
-async fn pulse(machine: &'static Machine, axes: [AxisPins<Output<'static>>; 2]) -> ! {
-    tasks::pulse::run(machine, axes, CycleDelay).await
-}
-
-#[embassy_executor::task]
-async fn motion(machine: &'static Machine) -> ! {
-    tasks::motion::run(machine).await
+async fn motion(machine: &'static Machine, steps: Producer<'static, PulseCmd>) -> ! {
+    tasks::motion::run(machine, steps, step_timer::kick).await
 }
 
 #[embassy_executor::task]
@@ -159,25 +148,22 @@ async fn main(spawner: Spawner) {
     let machine: &'static Machine = MACHINE.init(Machine::new(Settings::default()));
 
     // Step/direction outputs, low (no pulse) until the pulse task drives them.
-    let axes = [
-        AxisPins {
-            puls: Output::new(p.PE9, Level::Low, Speed::VeryHigh),
-            sign: Output::new(p.PE10, Level::Low, Speed::VeryHigh),
-        },
-        AxisPins {
-            puls: Output::new(p.PE11, Level::Low, Speed::VeryHigh),
-            sign: Output::new(p.PE12, Level::Low, Speed::VeryHigh),
-        },
-    ];
+    // PULS on TIM1's PWM outputs (low until a period ends with a pulse), SIGN on GPIO.
+    let step_timer = Tim1StepTimer::new(
+        p.TIM1,
+        PwmPin::new(p.PE9, OutputType::PushPull),
+        PwmPin::new(p.PE11, OutputType::PushPull),
+        [Output::new(p.PE10, Level::Low, Speed::VeryHigh), Output::new(p.PE12, Level::Low, Speed::VeryHigh)],
+    );
     // Servo on: the drivers hold position from here on. Kept for the program's whole life.
     core::mem::forget(Output::new(p.PE13, Level::High, Speed::Low));
 
-    interrupt::UART4.set_priority(PULSE_PRIORITY);
-    let pulse_spawner = EXECUTOR_PULSE.start(interrupt::UART4);
-    pulse_spawner.spawn(unwrap!(pulse(machine, axes)));
+    interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
+    let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
+    step_timer::start(step_timer, step_consumer, machine, PULSE_PRIORITY);
     interrupt::UART5.set_priority(MOTION_PRIORITY);
     let motion_spawner = EXECUTOR_MOTION.start(interrupt::UART5);
-    motion_spawner.spawn(unwrap!(motion(machine)));
+    motion_spawner.spawn(unwrap!(motion(machine, steps)));
 
     let columns = [
         Output::new(p.PD0, Level::High, Speed::Low),

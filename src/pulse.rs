@@ -1,0 +1,510 @@
+//! The pulse engine: what the step timer does at every one of its periods. It owns the
+//! PULS/SIGN timing and is the only writer of the position counters, so the position is the
+//! pulses emitted, always.
+//!
+//! The motion task fills the step queue ([`StepQueue`], single producer, single consumer, no
+//! lock) with [`PulseCmd`]s. The step timer counts one *period* at a time; a period is as long
+//! as the interval before a step, and the hardware ends it with a pulse of the pulse width on
+//! the axes that step (PWM outputs), so every pulse edge is placed by the timer, not by
+//! software. The period after the current one is *preloaded*: the timer switches to it by
+//! itself. At the start of each period (an update event) [`PulseEngine::on_period`] runs: it
+//! counts the pulses of the period that just ended, drives SIGN for the pulse that ends the
+//! period now starting (so SIGN settles for nearly a whole period before its edge, and never
+//! changes under a pulse), and preloads the next period from the next command.
+//!
+//! * A command whose directions differ from the last ones gets a period of at least the pulse
+//!   width plus the direction setup (`$0`, `$200`), and no period is shorter than one period of
+//!   `$205`.
+//! * An interval longer than the timer counts is split into pulse-less periods before its
+//!   pulse.
+//! * When the queue runs dry while the motion is not at rest ([`PulseCmd::Rest`]), the engine
+//!   counts an *underrun* (the motion task fell behind) and waits in short pulse-less periods;
+//!   the next pulse then comes a whole interval after the wait, never sooner than planned.
+//! * After a [`PulseCmd::Rest`] with nothing behind it, the engine stops the timer once the last
+//!   pulse is out, and signals the motion task.
+//!
+//! Nothing here decides anything about motion. On the board [`PulseEngine::on_period`] runs in
+//! the step timer's interrupt, the highest priority; in the simulator a model of the timer
+//! calls it at the virtual times the hardware would.
+
+use heapless::spsc::Consumer;
+
+use crate::geom::{Axis, StepCmd, TICK_HZ};
+use crate::machine::Machine;
+use crate::math;
+use crate::settings::Settings;
+
+/// Commands between the motion task and the pulse engine (one slot of the ring stays empty).
+/// At 100 kHz, 255 steps are 2.5 ms of motion, many times the motion task's latency on its own
+/// interrupt executor, and the motion task wakes once per half of them.
+pub const STEP_QUEUE_LEN: usize = 256;
+
+/// The step queue: the motion task holds its producer, the pulse engine its consumer.
+pub type StepQueue = heapless::spsc::Queue<PulseCmd, STEP_QUEUE_LEN>;
+
+/// Length of a pulse-less period while the engine waits for the motion task, ticks.
+pub const UNDERRUN_WAIT_TICKS: u32 = 20 * (TICK_HZ / 1_000_000);
+
+/// Length of the pulse-less period after the last pulse, at whose start the timer stops.
+const TAIL_TICKS: u32 = 10 * (TICK_HZ / 1_000_000);
+
+/// An entry of the step queue.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum PulseCmd {
+    /// One step, its interval counted from the pulse before (from now at rest).
+    Step(StepCmd),
+    /// The motion came to rest after the steps before: an empty queue behind this is no
+    /// underrun, and the timer stops.
+    Rest,
+}
+
+/// The hardware the engine drives: a timer that counts one period at a time and ends each with
+/// a pulse on the axes chosen for it, and the two SIGN outputs.
+pub trait StepTimer {
+    /// Longest period the timer counts, ticks.
+    const MAX_PERIOD_TICKS: u32;
+
+    /// Drives the SIGN output of `axis` high or low.
+    fn set_sign(&mut self, axis: Axis, high: bool);
+
+    /// Loads the period after the current one: `ticks` long, ending with a pulse on the axes of
+    /// `axes` (bit 0 X, bit 1 Y; none: no pulse).
+    fn preload(&mut self, ticks: u32, axes: u8);
+
+    /// Starts counting with pulses `width_ticks` wide: the preloaded period begins at once, as
+    /// at an update event, so [`PulseEngine::on_period`] must run now.
+    fn start(&mut self, width_ticks: u32);
+
+    /// Stops counting: no period follows the current one.
+    fn stop(&mut self);
+}
+
+/// Pulse timing, taken from the settings whenever the timer starts.
+#[derive(Clone, Copy, Debug)]
+struct Timing {
+    width_ticks: u32,
+    /// Shortest period: the pulse width plus the direction setup, where SIGN changes.
+    dir_change_ticks: u32,
+    /// Shortest period between two pulses (`$205`).
+    min_period_ticks: u32,
+    invert_mask: u8,
+}
+
+impl Timing {
+    fn from_settings(s: &Settings) -> Timing {
+        let ticks_per_us = (TICK_HZ / 1_000_000) as f32;
+        let width_ticks = math::ceil(s.pulse_width_us * ticks_per_us) as u32;
+        Timing {
+            width_ticks,
+            dir_change_ticks: width_ticks + math::ceil(s.dir_setup_us * ticks_per_us) as u32,
+            min_period_ticks: math::ceil(TICK_HZ as f32 / s.max_pulse_rate_hz) as u32,
+            invert_mask: s.dir_invert_mask,
+        }
+    }
+}
+
+/// One period of the timer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Period {
+    /// `ticks` long, ending with the pulse of this step.
+    Step { cmd: StepCmd, ticks: u32 },
+    /// `ticks` long, no pulse: waiting through a long interval, or for the motion task.
+    Wait { ticks: u32 },
+    /// The timer stops when this period starts.
+    Tail,
+}
+
+impl Period {
+    /// Ticks, and the axes pulsed at the end (bit 0 X, bit 1 Y).
+    fn timer_load(self) -> (u32, u8) {
+        match self {
+            Period::Step { cmd, ticks } => (ticks, u8::from(cmd.step.x != 0) | (u8::from(cmd.step.y != 0) << 1)),
+            Period::Wait { ticks } => (ticks, 0),
+            Period::Tail => (TAIL_TICKS, 0),
+        }
+    }
+}
+
+/// See the module documentation. `T` is the step timer.
+pub struct PulseEngine<'q, T: StepTimer> {
+    timer: T,
+    queue: Consumer<'q, PulseCmd>,
+    timing: Timing,
+    running: bool,
+    /// The period counting now and the one preloaded after it.
+    active: Period,
+    preloaded: Period,
+    /// SIGN levels driven, and those in force once the preloaded period starts.
+    sign: [Option<bool>; 2],
+    sign_preloaded: [Option<bool>; 2],
+    /// A step whose interval is longer than the timer counts, and the ticks still to wait.
+    long_wait: Option<(StepCmd, u32)>,
+    /// The queue ran dry before a rest: an underrun is under way (counted once).
+    starving: bool,
+    /// The last command taken was a rest.
+    resting: bool,
+}
+
+impl<'q, T: StepTimer> PulseEngine<'q, T> {
+    pub fn new(timer: T, queue: Consumer<'q, PulseCmd>) -> Self {
+        PulseEngine {
+            timer,
+            queue,
+            timing: Timing::from_settings(&Settings::default()),
+            running: false,
+            active: Period::Tail,
+            preloaded: Period::Tail,
+            sign: [None, None],
+            sign_preloaded: [None, None],
+            long_wait: None,
+            starving: false,
+            resting: true,
+        }
+    }
+
+    /// The timer, to read what it did (the simulator's model).
+    pub fn timer(&self) -> &T {
+        &self.timer
+    }
+
+    pub fn timer_mut(&mut self) -> &mut T {
+        &mut self.timer
+    }
+
+    /// True while the timer runs.
+    pub fn is_running(&self) -> bool {
+        self.running
+    }
+
+    /// The motion task queued commands: starts the timer if it is stopped and a step is queued.
+    pub fn kick(&mut self, machine: &Machine) {
+        if self.running {
+            return;
+        }
+        self.timing = Timing::from_settings(&machine.settings());
+        self.sign_preloaded = self.sign;
+        self.resting = true;
+        let first = self.next_period(machine);
+        if first == Period::Tail {
+            // Nothing but rests queued.
+            return;
+        }
+        self.active = Period::Tail;
+        self.preload(first);
+        self.running = true;
+        self.timer.start(self.timing.width_ticks);
+    }
+
+    /// A period starts (the timer's update event): counts the pulses of the period that ended,
+    /// drives SIGN for this period's pulse, and preloads the next period.
+    pub fn on_period(&mut self, machine: &Machine) {
+        if !self.running {
+            return;
+        }
+        if let Period::Step { cmd, .. } = self.active {
+            machine.emitted(cmd);
+        }
+        self.active = self.preloaded;
+        match self.active {
+            Period::Step { cmd, .. } => self.drive_signs(cmd),
+            Period::Wait { .. } => {}
+            Period::Tail => {
+                // The last pulse is out. Go on from rest if more came in behind the rest.
+                self.resting = true;
+                let next = self.next_period(machine);
+                if next == Period::Tail {
+                    self.timer.stop();
+                    self.running = false;
+                    machine.pulses_stopped();
+                    return;
+                }
+                self.preload(next);
+                return;
+            }
+        }
+        let next = self.next_period(machine);
+        self.preload(next);
+    }
+
+    fn preload(&mut self, period: Period) {
+        self.preloaded = period;
+        let (ticks, axes) = period.timer_load();
+        self.timer.preload(ticks, axes);
+    }
+
+    /// Drives SIGN for the axes `cmd` steps.
+    fn drive_signs(&mut self, cmd: StepCmd) {
+        for axis in Axis::ALL {
+            if let Some(high) = self.sign_for(cmd, axis) {
+                let i = axis.index();
+                if self.sign[i] != Some(high) {
+                    self.timer.set_sign(axis, high);
+                    self.sign[i] = Some(high);
+                }
+            }
+        }
+    }
+
+    /// The SIGN level `cmd` needs on `axis`, `None` if it does not step there.
+    fn sign_for(&self, cmd: StepCmd, axis: Axis) -> Option<bool> {
+        match cmd.step.on(axis) {
+            0 => None,
+            d => Some((d > 0) != (self.timing.invert_mask & (1 << axis.index()) != 0)),
+        }
+    }
+
+    /// What follows the preloaded period.
+    fn next_period(&mut self, machine: &Machine) -> Period {
+        if let Some((cmd, left)) = self.long_wait {
+            return self.step_period(cmd, left);
+        }
+        loop {
+            match self.queue.dequeue() {
+                Some(PulseCmd::Step(cmd)) => {
+                    self.starving = false;
+                    self.resting = false;
+                    let ticks = self.step_ticks(cmd);
+                    return self.step_period(cmd, ticks);
+                }
+                Some(PulseCmd::Rest) => self.resting = true,
+                None if self.resting => return Period::Tail,
+                None => {
+                    if !self.starving {
+                        self.starving = true;
+                        machine.count_underrun();
+                    }
+                    return Period::Wait { ticks: UNDERRUN_WAIT_TICKS };
+                }
+            }
+        }
+    }
+
+    /// The period before `cmd`'s pulse: its interval, at least one period of the max pulse
+    /// rate, and where a direction changes, at least the pulse width plus the direction setup.
+    fn step_ticks(&mut self, cmd: StepCmd) -> u32 {
+        let mut ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
+        for axis in Axis::ALL {
+            if let Some(high) = self.sign_for(cmd, axis) {
+                let i = axis.index();
+                if self.sign_preloaded[i] != Some(high) {
+                    ticks = ticks.max(self.timing.dir_change_ticks);
+                    self.sign_preloaded[i] = Some(high);
+                }
+            }
+        }
+        ticks
+    }
+
+    /// `ticks` before `cmd`'s pulse: pulse-less periods first where the timer cannot count so
+    /// far.
+    fn step_period(&mut self, cmd: StepCmd, ticks: u32) -> Period {
+        if ticks > T::MAX_PERIOD_TICKS {
+            let wait = T::MAX_PERIOD_TICKS / 2;
+            self.long_wait = Some((cmd, ticks - wait));
+            return Period::Wait { ticks: wait };
+        }
+        self.long_wait = None;
+        Period::Step { cmd, ticks }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::geom::{Point, Step};
+    use std::vec::Vec;
+
+    /// What a mock timer saw: every period in the order the hardware counted them, with the
+    /// SIGN levels in force while it counted.
+    #[derive(Default)]
+    struct MockTimer {
+        preload: (u32, u8),
+        running: bool,
+        started: bool,
+        sign: [bool; 2],
+        /// (ticks, axes pulsed at the end, SIGN levels).
+        periods: Vec<(u32, u8, [bool; 2])>,
+    }
+
+    impl StepTimer for MockTimer {
+        const MAX_PERIOD_TICKS: u32 = 65_535;
+        fn set_sign(&mut self, axis: Axis, high: bool) {
+            self.sign[axis.index()] = high;
+        }
+        fn preload(&mut self, ticks: u32, axes: u8) {
+            self.preload = (ticks, axes);
+        }
+        fn start(&mut self, _width_ticks: u32) {
+            self.running = true;
+            self.started = true;
+        }
+        fn stop(&mut self) {
+            self.running = false;
+        }
+    }
+
+    /// Runs the engine as the hardware would until it stops (or `max` periods): at each update
+    /// event the preloaded period becomes active and the interrupt runs. `between` runs after
+    /// each period, as the motion task could.
+    fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, mut between: impl FnMut(usize)) {
+        engine.kick(machine);
+        if !core::mem::take(&mut engine.timer_mut().started) {
+            return;
+        }
+        for k in 0..max {
+            let (ticks, axes) = engine.timer().preload;
+            engine.on_period(machine);
+            if !engine.timer().running {
+                return;
+            }
+            let sign = engine.timer().sign;
+            engine.timer_mut().periods.push((ticks, axes, sign));
+            between(k);
+        }
+    }
+
+    fn step(x: i8, y: i8, interval_ticks: u32) -> PulseCmd {
+        PulseCmd::Step(StepCmd { step: Step::new(x, y), interval_ticks })
+    }
+
+    #[test]
+    fn steps_become_periods_ending_in_their_pulses_and_the_timer_stops_after_the_rest() {
+        let machine = Machine::new(Settings::default()); // 5 µs pulses, 10 µs direction setup
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for cmd in [step(1, 0, 100), step(1, 1, 60), step(0, 1, 60), PulseCmd::Rest] {
+            p.enqueue(cmd).unwrap();
+        }
+        machine.set_queued(3, 220);
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        run(&mut engine, &machine, 100, |_| {});
+        let periods = &engine.timer().periods;
+        assert_eq!(periods.iter().map(|&(t, a, _)| (t, a)).collect::<Vec<_>>()[..3], [(100, 1), (60, 3), (60, 2)]);
+        // SIGN high (forward) on each moving axis for its pulse.
+        assert_eq!(periods[1].2, [true, true]);
+        assert!(!engine.is_running());
+        assert_eq!(machine.position(), Point::new(2, 2));
+        assert!(machine.pulses_idle());
+        assert_eq!(machine.underruns(), 0);
+        assert_eq!(machine.queued_ticks(), 0);
+    }
+
+    /// The ticks of the periods an engine with `settings` makes of `cmds`.
+    fn period_ticks(settings: Settings, cmds: &[PulseCmd]) -> Vec<u32> {
+        let machine = Machine::new(settings);
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for &cmd in cmds {
+            p.enqueue(cmd).unwrap();
+        }
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        run(&mut engine, &machine, 100, |_| {});
+        engine.timer().periods.iter().map(|p| p.0).collect()
+    }
+
+    #[test]
+    fn a_direction_change_gets_the_pulse_width_plus_the_direction_setup() {
+        // 5 µs pulses and 10 µs direction setup; at up to 100 kHz a reversal 10 µs after the
+        // last pulse is stretched to 15 µs, the steps after it keep their 10 µs.
+        let fast = Settings { max_pulse_rate_hz: 100_000.0, ..Settings::default() };
+        let cmds = [step(1, 0, 50), step(-1, 0, 10), step(-1, 0, 10), step(-1, 1, 10), PulseCmd::Rest];
+        assert_eq!(period_ticks(fast.clone(), &cmds)[..4], [50, 15, 10, 15]);
+        // At the default 20 kHz the 50 µs floor of `$205` covers the setup.
+        assert_eq!(period_ticks(Settings::default(), &cmds)[..4], [50, 50, 50, 50]);
+        // SIGN changes at the start of the period that ends with the reversed pulse.
+        let machine = Machine::new(fast);
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for cmd in cmds {
+            p.enqueue(cmd).unwrap();
+        }
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        run(&mut engine, &machine, 100, |_| {});
+        let signs: Vec<[bool; 2]> = engine.timer().periods.iter().map(|p| p.2).collect();
+        assert_eq!(signs[..4], [[true, false], [false, false], [false, false], [false, true]]);
+    }
+
+    #[test]
+    fn an_interval_longer_than_the_timer_counts_waits_in_pulseless_periods() {
+        let machine = Machine::new(Settings::default());
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for cmd in [step(0, -1, 600_000), step(0, -1, 100), PulseCmd::Rest] {
+            p.enqueue(cmd).unwrap();
+        }
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        run(&mut engine, &machine, 100, |_| {});
+        let periods = &engine.timer().periods;
+        let until_first: u32 = periods.iter().take_while(|p| p.1 == 0).map(|p| p.0).sum::<u32>();
+        let first = periods.iter().position(|p| p.1 != 0).unwrap();
+        assert_eq!(until_first + periods[first].0, 600_000);
+        assert!(periods.iter().all(|p| p.0 <= 65_535));
+        assert_eq!(periods[first + 1], (100, 2, [false, false]));
+        assert_eq!(machine.position(), Point::new(0, -2));
+    }
+
+    #[test]
+    fn a_queue_run_dry_before_the_rest_is_one_underrun_and_never_a_burst() {
+        let machine = Machine::new(Settings::default());
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for _ in 0..3 {
+            p.enqueue(step(1, 0, 100)).unwrap();
+        }
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        // The motion task catches up only after the 10th period, then finishes.
+        run(&mut engine, &machine, 1_000, |k| {
+            if k == 10 {
+                p.enqueue(step(1, 0, 100)).unwrap();
+                p.enqueue(step(1, 0, 100)).unwrap();
+                p.enqueue(PulseCmd::Rest).unwrap();
+            }
+        });
+        let periods = &engine.timer().periods;
+        assert_eq!(machine.underruns(), 1);
+        assert_eq!(machine.position(), Point::new(5, 0));
+        // Every pulse comes at least its interval after the one before.
+        let mut since = 0;
+        let mut gaps = Vec::new();
+        for &(t, a, _) in periods.iter() {
+            since += t;
+            if a != 0 {
+                gaps.push(since);
+                since = 0;
+            }
+        }
+        assert!(gaps.iter().all(|&g| g >= 100), "{gaps:?}");
+        assert!(periods.iter().any(|p| p.1 == 0 && p.0 == UNDERRUN_WAIT_TICKS));
+    }
+
+    #[test]
+    fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
+        let machine = Machine::new(Settings::default());
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        for cmd in [step(1, 0, 100), PulseCmd::Rest] {
+            p.enqueue(cmd).unwrap();
+        }
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        let mut more = Some([step(0, 1, 2_000), PulseCmd::Rest]);
+        run(&mut engine, &machine, 100, |_| {
+            if let Some(cmds) = more.take() {
+                for cmd in cmds {
+                    p.enqueue(cmd).unwrap();
+                }
+            }
+        });
+        assert_eq!(machine.position(), Point::new(1, 1));
+        assert_eq!(machine.underruns(), 0);
+        assert!(!engine.is_running());
+        // A kick with nothing but a rest queued does not start the timer.
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        p.enqueue(PulseCmd::Rest).unwrap();
+        let mut engine = PulseEngine::new(MockTimer::default(), c);
+        engine.kick(&machine);
+        assert!(!engine.is_running());
+    }
+}
