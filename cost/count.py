@@ -90,10 +90,12 @@ def run(only, profile):
         sys.exit(f"{len(marks)} marks for {len(results)} results:\n{done.stdout}")
     # The first two marks are back to back: what a pair of marks costs by itself.
     overhead = marks[1] - marks[0]
+    # Lines of the same measure, case and method add up (the motion task reports every poll).
     measured = {}
     for k, (_, what, case, method, count) in enumerate(results):
         instructions = marks[2 * k + 3] - marks[2 * k + 2] - overhead
-        measured[(case, method, what)] = (instructions, int(count))
+        total, steps = measured.get((case, method, what), (0, 0))
+        measured[(case, method, what)] = (total + instructions, steps + int(count))
     blocks = [l.split() for l in lines if l.startswith("block ")]
     return measured, blocks, syms
 
@@ -124,11 +126,12 @@ def main():
         build()
     measured, blocks, syms = run(args.only, args.profile)
     cases = []
-    for case, method, _ in measured:
-        if (case, method) not in cases:
+    for case, method, what in measured:
+        if what != "pulse" and (case, method) not in cases:
             cases.append((case, method))
-    print("| curve | method | setup (instructions) | steps | interp (instr/step) | + planner (instr/step) |")
-    print("|---|---|---:|---:|---:|---:|")
+    print("| curve | method | setup (instructions) | steps | interp (instr/step) | + planner (instr/step) "
+          "| + motion task (instr/step) |")
+    print("|---|---|---:|---:|---:|---:|---:|")
     for case, method in cases:
         def per_step(what):
             if (case, method, what) not in measured:
@@ -137,7 +140,13 @@ def main():
             return f"{n / max(steps, 1):.1f}"
         setup = measured.get((case, method, "setup"), (0, 0))[0]
         steps = measured.get((case, method, "interp"), (0, 0))[1]
-        print(f"| {case} | {method} | {setup} | {steps} | {per_step('interp')} | {per_step('planner')} |")
+        print(f"| {case} | {method} | {setup} | {steps} | {per_step('interp')} | {per_step('planner')} "
+              f"| {per_step('task')} |")
+    short, long_ = measured.get(("short", "both", "pulse")), measured.get(("long", "both", "pulse"))
+    if short and long_:
+        per_pulse = (long_[0] - short[0]) / (long_[1] - short[1])
+        print(f"\nPulse path: {per_pulse:.1f} instructions per pulse (step timer interrupt, entry to return, "
+              f"and the sleep loop around it)")
     if args.profile:
         print_profile(blocks, syms)
 

@@ -16,7 +16,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
-use crate::geom::{Axis, Point, StepCmd, TICK_HZ};
+use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::job::{Control, Job};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -130,16 +130,17 @@ impl Machine {
         self.queued_ticks.load(Ordering::Acquire).wrapping_sub(self.emitted_ticks.load(Ordering::Acquire))
     }
 
+    /// Step commands queued for the pulse engine and not yet emitted.
+    pub fn queued_steps(&self) -> u32 {
+        self.queued_steps.load(Ordering::Acquire).wrapping_sub(self.emitted_steps.load(Ordering::Acquire))
+    }
+
     /// Counts the pulses of `cmd`, emitted. Only the pulse engine calls this.
     pub fn emitted(&self, cmd: StepCmd) {
         // Single writer: a load and a store, no read-modify-write cycle.
-        for axis in Axis::ALL {
-            let d = i32::from(cmd.step.on(axis));
-            if d != 0 {
-                let p = &self.position[axis.index()];
-                p.store(p.load(Ordering::Relaxed).wrapping_add(d), Ordering::Relaxed);
-            }
-        }
+        let [x, y] = &self.position;
+        x.store(x.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.x)), Ordering::Relaxed);
+        y.store(y.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.y)), Ordering::Relaxed);
         let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
         self.emitted_ticks.store(t, Ordering::Release);
         let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);

@@ -102,6 +102,7 @@ use crate::interp::{Interpolator, Method};
 use crate::job::Feed;
 use ring::{CopyRing, Ring, StepRing};
 use scan::{Block, Chunk, ScanPoint, Segment};
+pub use stepgen::Emitted;
 use stepgen::Slice;
 
 /// Segments the planner holds (pushed and not yet fully emitted): its look-ahead depth in

@@ -3,7 +3,7 @@
 //! pulses emitted, always.
 //!
 //! The motion task fills the step queue ([`StepQueue`], single producer, single consumer, no
-//! lock) with [`PulseCmd`]s. The step timer counts one *period* at a time; a period is as long
+//! lock) with step commands, and marks where its motion comes to rest. The step timer counts one *period* at a time; a period is as long
 //! as the interval before a step, and the hardware ends it with a pulse of the pulse width on
 //! the axes that step (PWM outputs), so every pulse edge is placed by the timer, not by
 //! software. The period after the current one is *preloaded*: the timer switches to it by
@@ -17,47 +17,31 @@
 //!   `$205`.
 //! * An interval longer than the timer counts is split into pulse-less periods before its
 //!   pulse.
-//! * When the queue runs dry while the motion is not at rest ([`PulseCmd::Rest`]), the engine
-//!   counts an *underrun* (the motion task fell behind) and waits in short pulse-less periods;
-//!   the next pulse then comes a whole interval after the wait, never sooner than planned.
-//! * After a [`PulseCmd::Rest`] with nothing behind it, the engine stops the timer once the last
-//!   pulse is out, and signals the motion task.
+//! * When the queue runs dry while the motion is not at rest ([`StepProducer::rest`]), the
+//!   engine counts an *underrun* (the motion task fell behind) and waits in short pulse-less
+//!   periods; the next pulse then comes a whole interval after the wait, never sooner than
+//!   planned.
+//! * When the queue runs dry at a rest, the engine stops the timer once the last pulse is out,
+//!   and signals the motion task.
 //!
 //! Nothing here decides anything about motion. On the board [`PulseEngine::on_period`] runs in
 //! the step timer's interrupt, the highest priority; in the simulator a model of the timer
 //! calls it at the virtual times the hardware would.
-
-use heapless::spsc::Consumer;
 
 use crate::geom::{Axis, StepCmd, TICK_HZ};
 use crate::machine::Machine;
 use crate::math;
 use crate::settings::Settings;
 
-/// Commands between the motion task and the pulse engine (one slot of the ring stays empty).
-/// At 100 kHz, 255 steps are 2.5 ms of motion, many times the motion task's latency on its own
-/// interrupt executor, and the motion task wakes once per half of them.
-pub const STEP_QUEUE_LEN: usize = 256;
+pub use queue::{STEP_QUEUE_LEN, StepConsumer, StepProducer, StepQueue};
 
-/// The step queue: the motion task holds its producer, the pulse engine its consumer.
-pub type StepQueue = heapless::spsc::Queue<PulseCmd, STEP_QUEUE_LEN>;
+mod queue;
 
 /// Length of a pulse-less period while the engine waits for the motion task, ticks.
 pub const UNDERRUN_WAIT_TICKS: u32 = 20 * (TICK_HZ / 1_000_000);
 
 /// Length of the pulse-less period after the last pulse, at whose start the timer stops.
 const TAIL_TICKS: u32 = 10 * (TICK_HZ / 1_000_000);
-
-/// An entry of the step queue.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum PulseCmd {
-    /// One step, its interval counted from the pulse before (from now at rest).
-    Step(StepCmd),
-    /// The motion came to rest after the steps before: an empty queue behind this is no
-    /// underrun, and the timer stops.
-    Rest,
-}
 
 /// The hardware the engine drives: a timer that counts one period at a time and ends each with
 /// a pulse on the axes chosen for it, and the two SIGN outputs.
@@ -104,6 +88,35 @@ impl Timing {
     }
 }
 
+/// SIGN levels of both axes as bits (bit 0 X, bit 1 Y), and which of them are known.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Signs {
+    high: u8,
+    known: u8,
+}
+
+impl Signs {
+    /// Of the axes in `moving`, those whose level is not `high` (or not known yet).
+    fn changes(self, moving: u8, high: u8) -> u8 {
+        moving & (!self.known | (self.high ^ high))
+    }
+
+    /// The levels once the axes in `moving` are set to `high`.
+    fn set(&mut self, moving: u8, high: u8) {
+        self.high = (self.high & !moving) | high;
+        self.known |= moving;
+    }
+}
+
+/// The axes `cmd` steps (bits, bit 0 X, bit 1 Y), and the SIGN levels it needs on them with
+/// the direction invert mask `invert` (`$3`).
+fn step_bits(cmd: StepCmd, invert: u8) -> (u8, u8) {
+    let s = cmd.step;
+    let moving = u8::from(s.x != 0) | (u8::from(s.y != 0) << 1);
+    let forward = u8::from(s.x > 0) | (u8::from(s.y > 0) << 1);
+    (moving, (forward ^ invert) & moving)
+}
+
 /// One period of the timer.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Period {
@@ -119,7 +132,7 @@ impl Period {
     /// Ticks, and the axes pulsed at the end (bit 0 X, bit 1 Y).
     fn timer_load(self) -> (u32, u8) {
         match self {
-            Period::Step { cmd, ticks } => (ticks, u8::from(cmd.step.x != 0) | (u8::from(cmd.step.y != 0) << 1)),
+            Period::Step { cmd, ticks } => (ticks, step_bits(cmd, 0).0),
             Period::Wait { ticks } => (ticks, 0),
             Period::Tail => (TAIL_TICKS, 0),
         }
@@ -129,25 +142,23 @@ impl Period {
 /// See the module documentation. `T` is the step timer.
 pub struct PulseEngine<'q, T: StepTimer> {
     timer: T,
-    queue: Consumer<'q, PulseCmd>,
+    queue: StepConsumer<'q>,
     timing: Timing,
     running: bool,
     /// The period counting now and the one preloaded after it.
     active: Period,
     preloaded: Period,
     /// SIGN levels driven, and those in force once the preloaded period starts.
-    sign: [Option<bool>; 2],
-    sign_preloaded: [Option<bool>; 2],
+    sign: Signs,
+    sign_preloaded: Signs,
     /// A step whose interval is longer than the timer counts, and the ticks still to wait.
     long_wait: Option<(StepCmd, u32)>,
     /// The queue ran dry before a rest: an underrun is under way (counted once).
     starving: bool,
-    /// The last command taken was a rest.
-    resting: bool,
 }
 
 impl<'q, T: StepTimer> PulseEngine<'q, T> {
-    pub fn new(timer: T, queue: Consumer<'q, PulseCmd>) -> Self {
+    pub fn new(timer: T, queue: StepConsumer<'q>) -> Self {
         PulseEngine {
             timer,
             queue,
@@ -155,11 +166,10 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             running: false,
             active: Period::Tail,
             preloaded: Period::Tail,
-            sign: [None, None],
-            sign_preloaded: [None, None],
+            sign: Signs::default(),
+            sign_preloaded: Signs::default(),
             long_wait: None,
             starving: false,
-            resting: true,
         }
     }
 
@@ -182,14 +192,12 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         if self.running {
             return;
         }
-        self.timing = Timing::from_settings(&machine.settings());
-        self.sign_preloaded = self.sign;
-        self.resting = true;
-        let first = self.next_period(machine);
-        if first == Period::Tail {
-            // Nothing but rests queued.
+        if !self.queue.ready() {
             return;
         }
+        self.timing = Timing::from_settings(&machine.settings());
+        self.sign_preloaded = self.sign;
+        let first = self.next_period(machine);
         self.active = Period::Tail;
         self.preload(first);
         self.running = true;
@@ -211,7 +219,6 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             Period::Wait { .. } => {}
             Period::Tail => {
                 // The last pulse is out. Go on from rest if more came in behind the rest.
-                self.resting = true;
                 let next = self.next_period(machine);
                 if next == Period::Tail {
                     self.timer.stop();
@@ -235,22 +242,16 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
 
     /// Drives SIGN for the axes `cmd` steps.
     fn drive_signs(&mut self, cmd: StepCmd) {
-        for axis in Axis::ALL {
-            if let Some(high) = self.sign_for(cmd, axis) {
-                let i = axis.index();
-                if self.sign[i] != Some(high) {
-                    self.timer.set_sign(axis, high);
-                    self.sign[i] = Some(high);
+        let (moving, high) = step_bits(cmd, self.timing.invert_mask);
+        let changes = self.sign.changes(moving, high);
+        if changes != 0 {
+            for axis in Axis::ALL {
+                let bit = 1 << axis.index();
+                if changes & bit != 0 {
+                    self.timer.set_sign(axis, high & bit != 0);
                 }
             }
-        }
-    }
-
-    /// The SIGN level `cmd` needs on `axis`, `None` if it does not step there.
-    fn sign_for(&self, cmd: StepCmd, axis: Axis) -> Option<bool> {
-        match cmd.step.on(axis) {
-            0 => None,
-            d => Some((d > 0) != (self.timing.invert_mask & (1 << axis.index()) != 0)),
+            self.sign.set(moving, high);
         }
     }
 
@@ -259,23 +260,19 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         if let Some((cmd, left)) = self.long_wait {
             return self.step_period(cmd, left);
         }
-        loop {
-            match self.queue.dequeue() {
-                Some(PulseCmd::Step(cmd)) => {
-                    self.starving = false;
-                    self.resting = false;
-                    let ticks = self.step_ticks(cmd);
-                    return self.step_period(cmd, ticks);
+        match self.queue.pop() {
+            Some(cmd) => {
+                self.starving = false;
+                let ticks = self.step_ticks(cmd);
+                self.step_period(cmd, ticks)
+            }
+            None if self.queue.at_rest() => Period::Tail,
+            None => {
+                if !self.starving {
+                    self.starving = true;
+                    machine.count_underrun();
                 }
-                Some(PulseCmd::Rest) => self.resting = true,
-                None if self.resting => return Period::Tail,
-                None => {
-                    if !self.starving {
-                        self.starving = true;
-                        machine.count_underrun();
-                    }
-                    return Period::Wait { ticks: UNDERRUN_WAIT_TICKS };
-                }
+                Period::Wait { ticks: UNDERRUN_WAIT_TICKS }
             }
         }
     }
@@ -284,14 +281,10 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// rate, and where a direction changes, at least the pulse width plus the direction setup.
     fn step_ticks(&mut self, cmd: StepCmd) -> u32 {
         let mut ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
-        for axis in Axis::ALL {
-            if let Some(high) = self.sign_for(cmd, axis) {
-                let i = axis.index();
-                if self.sign_preloaded[i] != Some(high) {
-                    ticks = ticks.max(self.timing.dir_change_ticks);
-                    self.sign_preloaded[i] = Some(high);
-                }
-            }
+        let (moving, high) = step_bits(cmd, self.timing.invert_mask);
+        if self.sign_preloaded.changes(moving, high) != 0 {
+            ticks = ticks.max(self.timing.dir_change_ticks);
+            self.sign_preloaded.set(moving, high);
         }
         ticks
     }
@@ -365,8 +358,18 @@ mod tests {
         }
     }
 
-    fn step(x: i8, y: i8, interval_ticks: u32) -> PulseCmd {
-        PulseCmd::Step(StepCmd { step: Step::new(x, y), interval_ticks })
+    fn step(x: i8, y: i8, interval_ticks: u32) -> StepCmd {
+        StepCmd { step: Step::new(x, y), interval_ticks }
+    }
+
+    /// Publishes `cmds`, then a rest if `rest`.
+    fn queue(p: &mut StepProducer<'_>, cmds: &[StepCmd], rest: bool) {
+        let slots = p.free_slots();
+        slots[..cmds.len()].copy_from_slice(cmds);
+        p.publish(cmds.len());
+        if rest {
+            p.rest();
+        }
     }
 
     #[test]
@@ -374,9 +377,7 @@ mod tests {
         let machine = Machine::new(Settings::default()); // 5 µs pulses, 10 µs direction setup
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for cmd in [step(1, 0, 100), step(1, 1, 60), step(0, 1, 60), PulseCmd::Rest] {
-            p.enqueue(cmd).unwrap();
-        }
+        queue(&mut p, &[step(1, 0, 100), step(1, 1, 60), step(0, 1, 60)], true);
         machine.set_queued(3, 220);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         run(&mut engine, &machine, 100, |_| {});
@@ -392,13 +393,11 @@ mod tests {
     }
 
     /// The ticks of the periods an engine with `settings` makes of `cmds`.
-    fn period_ticks(settings: Settings, cmds: &[PulseCmd]) -> Vec<u32> {
+    fn period_ticks(settings: Settings, cmds: &[StepCmd]) -> Vec<u32> {
         let machine = Machine::new(settings);
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for &cmd in cmds {
-            p.enqueue(cmd).unwrap();
-        }
+        queue(&mut p, cmds, true);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         run(&mut engine, &machine, 100, |_| {});
         engine.timer().periods.iter().map(|p| p.0).collect()
@@ -409,7 +408,7 @@ mod tests {
         // 5 µs pulses and 10 µs direction setup; at up to 100 kHz a reversal 10 µs after the
         // last pulse is stretched to 15 µs, the steps after it keep their 10 µs.
         let fast = Settings { max_pulse_rate_hz: 100_000.0, ..Settings::default() };
-        let cmds = [step(1, 0, 50), step(-1, 0, 10), step(-1, 0, 10), step(-1, 1, 10), PulseCmd::Rest];
+        let cmds = [step(1, 0, 50), step(-1, 0, 10), step(-1, 0, 10), step(-1, 1, 10)];
         assert_eq!(period_ticks(fast.clone(), &cmds)[..4], [50, 15, 10, 15]);
         // At the default 20 kHz the 50 µs floor of `$205` covers the setup.
         assert_eq!(period_ticks(Settings::default(), &cmds)[..4], [50, 50, 50, 50]);
@@ -417,9 +416,7 @@ mod tests {
         let machine = Machine::new(fast);
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for cmd in cmds {
-            p.enqueue(cmd).unwrap();
-        }
+        queue(&mut p, &cmds, true);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         run(&mut engine, &machine, 100, |_| {});
         let signs: Vec<[bool; 2]> = engine.timer().periods.iter().map(|p| p.2).collect();
@@ -431,9 +428,7 @@ mod tests {
         let machine = Machine::new(Settings::default());
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for cmd in [step(0, -1, 600_000), step(0, -1, 100), PulseCmd::Rest] {
-            p.enqueue(cmd).unwrap();
-        }
+        queue(&mut p, &[step(0, -1, 600_000), step(0, -1, 100)], true);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         run(&mut engine, &machine, 100, |_| {});
         let periods = &engine.timer().periods;
@@ -450,16 +445,12 @@ mod tests {
         let machine = Machine::new(Settings::default());
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for _ in 0..3 {
-            p.enqueue(step(1, 0, 100)).unwrap();
-        }
+        queue(&mut p, &[step(1, 0, 100); 3], false);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         // The motion task catches up only after the 10th period, then finishes.
         run(&mut engine, &machine, 1_000, |k| {
             if k == 10 {
-                p.enqueue(step(1, 0, 100)).unwrap();
-                p.enqueue(step(1, 0, 100)).unwrap();
-                p.enqueue(PulseCmd::Rest).unwrap();
+                queue(&mut p, &[step(1, 0, 100); 2], true);
             }
         });
         let periods = &engine.timer().periods;
@@ -484,25 +475,21 @@ mod tests {
         let machine = Machine::new(Settings::default());
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        for cmd in [step(1, 0, 100), PulseCmd::Rest] {
-            p.enqueue(cmd).unwrap();
-        }
+        queue(&mut p, &[step(1, 0, 100)], true);
         let mut engine = PulseEngine::new(MockTimer::default(), c);
-        let mut more = Some([step(0, 1, 2_000), PulseCmd::Rest]);
+        let mut more = Some(step(0, 1, 2_000));
         run(&mut engine, &machine, 100, |_| {
-            if let Some(cmds) = more.take() {
-                for cmd in cmds {
-                    p.enqueue(cmd).unwrap();
-                }
+            if let Some(cmd) = more.take() {
+                queue(&mut p, &[cmd], true);
             }
         });
         assert_eq!(machine.position(), Point::new(1, 1));
         assert_eq!(machine.underruns(), 0);
         assert!(!engine.is_running());
-        // A kick with nothing but a rest queued does not start the timer.
+        // A kick with nothing queued does not start the timer.
         let mut q = StepQueue::new();
         let (mut p, c) = q.split();
-        p.enqueue(PulseCmd::Rest).unwrap();
+        p.rest();
         let mut engine = PulseEngine::new(MockTimer::default(), c);
         engine.kick(&machine);
         assert!(!engine.is_running());

@@ -4,12 +4,16 @@
 #![no_std]
 #![no_main]
 
+mod pulse_path;
+mod task;
+
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use defmt_rtt as _;
 use servoplot::geom::Point;
 use servoplot::interp::{Curve, Interpolator, Method};
 use servoplot::job::{Feed, Job, Shape};
+
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::settings::Settings;
 
@@ -21,19 +25,31 @@ pub extern "C" fn cost_mark() {
     cortex_m::asm::nop();
 }
 
-/// Writes one result line: the runner pairs it with the last two marks.
-fn report(what: &str, case: &str, method: Method, steps: u64) {
-    let m = match method {
+/// Writes one result line: the runner pairs it with the last two marks, and adds up lines of
+/// the same measure, case and method.
+pub fn report_steps(what: &str, case: &str, method: &str, steps: u64) {
+    hprintln!("result {} {} {} {}", what, case, method, steps);
+}
+
+fn method_name(method: Method) -> &'static str {
+    match method {
         Method::Classic => "classic",
         Method::Diagonal => "diagonal",
-    };
-    hprintln!("result {} {} {} {}", what, case, m, steps);
+    }
+}
+
+fn report(what: &str, case: &str, method: Method, steps: u64) {
+    report_steps(what, case, method_name(method), steps);
 }
 
 const FEED: Feed = Feed::MmPerMin(3_000.0);
 
 /// Steps per `fill` call when an interpolator runs alone.
 const INTERP_BATCH_STEPS: usize = 16;
+
+/// Steps per `fill` call when the planner runs alone: half the step queue, as the motion task
+/// takes them.
+const PLANNER_BATCH_STEPS: usize = servoplot::pulse::STEP_QUEUE_LEN / 2;
 
 fn cases() -> [(&'static str, Shape); 10] {
     let f = |src: &str| match servoplot::expr::parse(src) {
@@ -109,11 +125,19 @@ fn with_planner(c: Curve, method: Method, limits: Limits) -> u64 {
     if p.push(c, FEED, method).is_err() {
         panic!("push");
     }
+    // In batches, as the motion task fills the step queue.
+    let mut buf =
+        [servoplot::geom::StepCmd { step: servoplot::geom::Step::NONE, interval_ticks: 0 }; PLANNER_BATCH_STEPS];
     let mut n = 0;
-    while let Some(Ok(_)) = p.next_cmd() {
-        n += 1;
+    loop {
+        let emitted = p.fill(&mut buf, u32::MAX);
+        n += emitted.steps as u64;
+        match emitted.end {
+            None => {}
+            Some(Ok(())) => return n,
+            Some(Err(_)) => panic!("curve failed in the planner"),
+        }
     }
-    n
 }
 
 /// The harness's command line (QEMU's `-semihosting-config arg=`): only cases whose name
@@ -155,17 +179,60 @@ fn main() -> ! {
             let n = with_planner(c, method, limits);
             cost_mark();
             report("planner", name, method, n);
+            let emitted = task::measure(name, method_name(method), Job::draw(shape.clone(), FEED), &settings);
+            if emitted != n {
+                panic!("the motion task emitted another number of steps");
+            }
         }
     }
+    if "pulse".contains(only) || only.is_empty() {
+        pulse_path_runs();
+    }
     debug::exit(debug::EXIT_SUCCESS);
-    loop {}
+    halt()
 }
 
+/// Semihosting has ended the run; should it ever return, stop here.
+fn halt() -> ! {
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// Steps of the pulse path's two runs: the difference of their costs is the cost of the steps
+/// between them.
+const PULSE_RUN_STEPS: [usize; 2] = [50, 250];
+
+/// The pulse path on a circle's steps (both axes, every direction), 100 µs apart.
+fn pulse_path_runs() {
+    let settings = Settings { method: Method::Diagonal, ..Settings::default() };
+    let circle = cases()[3].1.clone();
+    let mut c = curve(&circle, &settings);
+    let mut buf = [servoplot::geom::Step::NONE; PULSE_RUN_STEPS[1]];
+    let filled = c.fill(&mut buf);
+    if filled.steps < PULSE_RUN_STEPS[1] {
+        panic!("circle too short");
+    }
+    let cmds = buf.map(|step| servoplot::geom::StepCmd { step, interval_ticks: PULSE_INTERVAL_TICKS });
+    let machine = pulse_path::machine(settings);
+    for n in PULSE_RUN_STEPS {
+        pulse_path::measure(&cmds[..n], if n == PULSE_RUN_STEPS[0] { "short" } else { "long" }, machine);
+    }
+}
+
+/// Interval between pulses in the pulse path's runs, ticks: long enough that no interrupt of
+/// the model comes late.
+const PULSE_INTERVAL_TICKS: u32 = 100;
+
 /// The device's interrupt vectors (cortex-m-rt's `device` feature, enabled through the
-/// firmware's HAL, expects them).
+/// firmware's HAL, expects them): the model's timer 0 runs the pulse engine.
 #[unsafe(link_section = ".vector_table.interrupts")]
 #[unsafe(no_mangle)]
-pub static __INTERRUPTS: [unsafe extern "C" fn(); 32] = [default_irq; 32];
+pub static __INTERRUPTS: [unsafe extern "C" fn(); 32] = {
+    let mut table: [unsafe extern "C" fn(); 32] = [default_irq; 32];
+    table[pulse_path::TIMER0_IRQ as usize] = pulse_path::timer0_interrupt;
+    table
+};
 
 unsafe extern "C" fn default_irq() {
     hprintln!("unexpected interrupt");
@@ -176,12 +243,12 @@ unsafe extern "C" fn default_irq() {
 fn panic(info: &core::panic::PanicInfo) -> ! {
     hprintln!("panic: {}", info);
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    halt()
 }
 
 #[defmt::panic_handler]
 fn defmt_panic() -> ! {
     hprintln!("defmt panic");
     debug::exit(debug::EXIT_FAILURE);
-    loop {}
+    halt()
 }

@@ -149,6 +149,20 @@ impl<T: Copy + Default, const N: usize> CopyRing<T, N> {
         value
     }
 
+    /// Up to `max` elements from the front, as far as they lie in one piece (to the end of the
+    /// buffer); [`drop_front`](Self::drop_front) them once used.
+    pub fn front_slice(&self, max: usize) -> &[T] {
+        let start = (self.head & Self::MASK) as usize;
+        let n = self.len().min(N - start).min(max);
+        self.slots.get(start..start + n).unwrap_or(&[])
+    }
+
+    /// Drops `n` elements from the front.
+    pub fn drop_front(&mut self, n: usize) {
+        let n = n.min(self.len());
+        self.head = self.head.wrapping_add(n as u32);
+    }
+
     /// The free slots from the back up to the end of the buffer, at most `max` of them: write
     /// into them, then [`commit`](Self::commit) how many were written.
     pub fn free_slice(&mut self, max: usize) -> &mut [T] {

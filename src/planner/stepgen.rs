@@ -2,7 +2,7 @@
 //! per slice of steps (floating point, once per slice); each step of a slice then costs a
 //! ring read and an integer addition.
 
-use crate::geom::{StepCmd, TICK_HZ};
+use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator};
 use crate::math;
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
@@ -36,35 +36,100 @@ impl Slice {
     }
 }
 
+/// What [`Planner::fill`] wrote, and why it stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Emitted {
+    /// Step commands written, from the start of the buffer.
+    pub steps: usize,
+    /// The sum of their intervals, ticks.
+    pub ticks: u32,
+    /// Where they take the pen, relative to where it was before them.
+    pub moved: Point,
+    /// `None`: the buffer is full or the ticks asked for are written. `Some(Ok(()))`: nothing
+    /// more to emit now (the queue is empty, or a hold has stopped the motion).
+    /// `Some(Err(e))`: a curve fails after these steps (the machine is then at rest; the next
+    /// call goes on with the next segment).
+    pub end: Option<Result<(), CurveError>>,
+}
+
+/// What planning the next slice found.
+enum SliceStart {
+    Ready,
+    Empty,
+    Failed(CurveError),
+}
+
 impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// The next step command: `None` when there is nothing to emit now (queue empty, or stopped
     /// by a hold), `Some(Err(e))` where a curve fails (the machine is then at rest; the next call
     /// goes on with the next segment).
-    #[inline]
     pub fn next_cmd(&mut self) -> Option<Result<StepCmd, CurveError>> {
-        if self.slice.left > 0
-            && let Some(step) = self.steps.pop_front()
-        {
-            self.slice.left -= 1;
-            let (carry, whole) = self.carry.overflowing_add(self.slice.frac);
+        let mut cmd = [StepCmd { step: crate::geom::Step::NONE, interval_ticks: 0 }];
+        let emitted = self.fill(&mut cmd, u32::MAX);
+        match emitted.end {
+            _ if emitted.steps == 1 => Some(Ok(cmd[0])),
+            Some(Err(e)) => Some(Err(e)),
+            _ => None,
+        }
+    }
+
+    /// Writes the next step commands into `out`, until it is full, their intervals add up to
+    /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
+    /// step queue this way, one slice at a time in a tight loop.
+    pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
+        let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
+        let end = loop {
+            if written >= out.len() || ticks >= ticks_room {
+                break None;
+            }
+            if self.slice.left == 0 {
+                match self.next_slice() {
+                    SliceStart::Ready => {}
+                    SliceStart::Empty => break Some(Ok(())),
+                    SliceStart::Failed(e) => break Some(Err(e)),
+                }
+            }
+            let room = out.len() - written;
+            let steps = self.steps.front_slice((self.slice.left as usize).min(room));
+            let (mut carry, frac, whole) = (self.carry, self.slice.frac, self.slice.ticks);
+            let mut taken = 0;
+            for (slot, &step) in out[written..].iter_mut().zip(steps) {
+                let (c, over) = carry.overflowing_add(frac);
+                carry = c;
+                let interval_ticks = whole + u32::from(over);
+                *slot = StepCmd { step, interval_ticks };
+                ticks = ticks.wrapping_add(interval_ticks);
+                dx += i32::from(step.x);
+                dy += i32::from(step.y);
+                taken += 1;
+                if ticks >= ticks_room {
+                    break;
+                }
+            }
+            if taken == 0 {
+                // A slice is never longer than the steps scanned; only a bug gets here.
+                self.slice.cut();
+                continue;
+            }
             self.carry = carry;
-            let cmd = StepCmd { step, interval_ticks: self.slice.ticks + u32::from(whole) };
+            self.steps.drop_front(taken);
+            self.slice.left -= taken as u32;
+            written += taken;
             if self.slice.left == 0 {
                 self.retire_slice();
             }
-            return Some(Ok(cmd));
-        }
-        self.next_slice()
+        };
+        Emitted { steps: written, ticks, moved: Point::new(dx, dy), end }
     }
 
-    /// Plans the next slice and emits its first step; see [`next_cmd`](Self::next_cmd).
+    /// Plans the next slice.
     #[inline(never)]
-    fn next_slice(&mut self) -> Option<Result<StepCmd, CurveError>> {
+    fn next_slice(&mut self) -> SliceStart {
         self.slice.cut();
         self.retire_slice();
         self.apply_pending_if_idle();
         if self.request == Request::Hold && self.speed.is_none() {
-            return None;
+            return SliceStart::Empty;
         }
         // Keep the scan ahead: twice what was emitted since it last ran, and a chunk more.
         if self.steps.free() >= CHUNK_STEPS {
@@ -81,12 +146,12 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                     continue;
                 }
                 self.rest();
-                return None;
+                return SliceStart::Empty;
             };
             if let Some(e) = block.error {
                 self.finish_block();
                 self.rest();
-                return Some(Err(e));
+                return SliceStart::Failed(e);
             }
             if block.done_steps >= block.steps {
                 if block.open {
@@ -97,7 +162,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         continue;
                     }
                     self.rest();
-                    return None;
+                    return SliceStart::Empty;
                 }
                 self.finish_block();
                 continue;
@@ -105,17 +170,17 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let start = math::min(self.limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
             if self.request != Request::Run && self.speed.is_none_or(|w| w <= start) {
                 self.rest();
-                return None;
+                return SliceStart::Empty;
             }
             let Some(chunk) = self.chunks.front().copied() else {
                 // Every scanned step is in a chunk; only a bug gets here.
                 self.rest();
-                return None;
+                return SliceStart::Empty;
             };
             self.plan_slice(&block, &chunk, start);
-            return self.next_cmd();
+            return SliceStart::Ready;
         }
-        None
+        SliceStart::Empty
     }
 
     /// The speed and interval of the next slice, in `block` and `chunk` (the front ones), with

@@ -12,14 +12,13 @@
 
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
-use heapless::spsc::Producer;
 
 use crate::geom::Point;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
 use crate::planner::{Limits, PLANNER_SEGMENTS, Planner, PlannerState};
-use crate::pulse::PulseCmd;
+use crate::pulse::StepProducer;
 use crate::settings::Settings;
 use crate::status::RunState;
 
@@ -44,13 +43,13 @@ struct Queued {
     ticks: u32,
     /// Where the steps queued so far take the pen.
     end: Point,
-    /// A rest ends what was queued: the pulse engine stops when it is done.
+    /// A rest ends what was published: the pulse engine stops when it is done.
     resting: bool,
 }
 
 /// Runs the motion forever. `steps` is the producer end of the step queue; `kick` wakes the
-/// pulse engine after steps were queued.
-pub async fn run(machine: &Machine, mut steps: Producer<'_, PulseCmd>, mut kick: impl FnMut()) -> ! {
+/// pulse engine after steps were published.
+pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl FnMut()) -> ! {
     let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
     let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
     // Where the pen will be once everything planned so far has been emitted.
@@ -97,14 +96,13 @@ pub async fn run(machine: &Machine, mut steps: Producer<'_, PulseCmd>, mut kick:
             machine.set_fault(Some(MotionFault::Curve(e)));
             abort(machine, &mut planner);
         }
-        let mut rest_queued = false;
         if !matches!(filled, FillEnd::QueueFull) && planner.is_idle() && !queued.resting {
-            // The motion comes to rest after the steps queued (a slot is kept for this).
-            rest_queued = steps.enqueue(PulseCmd::Rest).is_ok();
-            queued.resting = rest_queued;
+            // The motion comes to rest after the steps queued.
+            steps.rest();
+            queued.resting = true;
         }
         machine.set_queued(queued.steps, queued.ticks);
-        if queued.steps != steps_before || rest_queued {
+        if queued.steps != steps_before {
             kick();
         }
         match filled {
@@ -140,44 +138,37 @@ pub async fn run(machine: &Machine, mut steps: Producer<'_, PulseCmd>, mut kick:
     }
 }
 
-/// Moves step commands from the planner into the step queue: as many as fit (one slot stays
-/// free for a rest), up to [`STEP_QUEUE_MAX_TICKS`] of motion queued.
+/// Moves step commands from the planner into the step queue: as many as fit, up to
+/// [`STEP_QUEUE_MAX_TICKS`] of motion queued.
+#[inline(never)]
 fn fill(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
-    steps: &mut Producer<'_, PulseCmd>,
+    steps: &mut StepProducer<'_>,
     queued: &mut Queued,
 ) -> FillEnd {
-    let room = steps.capacity().saturating_sub(steps.len() + 1);
-    let ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
-    let (mut n, mut ticks) = (0u32, 0u32);
-    let (mut x, mut y) = (queued.end.x, queued.end.y);
-    let filled = loop {
-        if n as usize >= room || ticks >= ticks_room {
-            break FillEnd::QueueFull;
+    let mut ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
+    loop {
+        // Two rounds at most: the free slots end where the ring wraps.
+        let slots = steps.free_slots();
+        if slots.is_empty() || ticks_room == 0 {
+            return FillEnd::QueueFull;
         }
-        match planner.next_cmd() {
-            Some(Ok(cmd)) => {
-                // `room` free slots were counted above, and only this task enqueues.
-                if steps.enqueue(PulseCmd::Step(cmd)).is_err() {
-                    break FillEnd::QueueFull;
-                }
-                n += 1;
-                ticks = ticks.wrapping_add(cmd.interval_ticks);
-                x += i32::from(cmd.step.x);
-                y += i32::from(cmd.step.y);
-            }
-            Some(Err(e)) => break FillEnd::CurveFailed(e),
-            None => break FillEnd::PlanEmpty,
+        let emitted = planner.fill(slots, ticks_room);
+        steps.publish(emitted.steps);
+        if emitted.steps > 0 {
+            queued.resting = false;
         }
-    };
-    if n > 0 {
-        queued.resting = false;
+        queued.steps = queued.steps.wrapping_add(emitted.steps as u32);
+        queued.ticks = queued.ticks.wrapping_add(emitted.ticks);
+        queued.end = Point::new(queued.end.x + emitted.moved.x, queued.end.y + emitted.moved.y);
+        ticks_room = ticks_room.saturating_sub(emitted.ticks);
+        match emitted.end {
+            None => {}
+            Some(Ok(())) => return FillEnd::PlanEmpty,
+            Some(Err(e)) => return FillEnd::CurveFailed(e),
+        }
     }
-    queued.steps = queued.steps.wrapping_add(n);
-    queued.ticks = queued.ticks.wrapping_add(ticks);
-    queued.end = Point::new(x, y);
-    filled
 }
 
 /// Turns `job` into a curve from `planned_end` and queues it in the planner; the kind of

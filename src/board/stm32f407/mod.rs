@@ -37,9 +37,8 @@ use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
 use embassy_stm32::{Config, bind_interrupts, interrupt};
 use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
-use heapless::spsc::Producer;
 use servoplot::machine::Machine;
-use servoplot::pulse::{PulseCmd, StepQueue};
+use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::settings::Settings;
 use servoplot::tasks::{self, lcd::St7920Lcd};
 use static_cell::StaticCell;
@@ -85,7 +84,7 @@ unsafe fn UART5() {
 type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, Delay>, Output<'static>, Delay>;
 
 #[embassy_executor::task]
-async fn motion(machine: &'static Machine, steps: Producer<'static, PulseCmd>) -> ! {
+async fn motion(machine: &'static Machine, steps: StepProducer<'static>) -> ! {
     tasks::motion::run(machine, steps, step_timer::kick).await
 }
 

@@ -19,7 +19,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use servoplot::geom::{Axis, TICK_HZ};
 use servoplot::machine::Machine;
-use servoplot::pulse::{PulseCmd, PulseEngine, StepTimer};
+use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
 
 /// A compare value the 16-bit counter never reaches (its periods end at 65_534): no pulse.
 const NO_PULSE: u16 = u16::MAX;
@@ -98,7 +98,7 @@ static PULSES: Mutex<CriticalSectionRawMutex, RefCell<Option<Pulses>>> = Mutex::
 /// Hands the engine to the interrupt and enables it at `priority`.
 pub fn start(
     timer: Tim1StepTimer,
-    steps: heapless::spsc::Consumer<'static, PulseCmd>,
+    steps: StepConsumer<'static>,
     machine: &'static Machine,
     priority: interrupt::Priority,
 ) {
