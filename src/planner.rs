@@ -24,8 +24,9 @@
 //!
 //! Every pushed curve is stepped exactly once, ahead of the motion, into a ring of steps
 //! ([`STEP_RING_LEN`]: the look-ahead horizon). The scan takes steps in chunks of
-//! [`CHUNK_STEPS`] (up to [`STRAIGHT_CHUNK_STEPS`] while the curve runs straight) and reads the
-//! curve's tangent only at chunk ends: from the tangents before and after a chunk it works out,
+//! [`CHUNK_STEPS`] ([`STRAIGHT_CHUNK_STEPS`] on a straight line) and reads the curve's tangent
+//! only at chunk ends (a chunk over which it does not change at all, a straight run, just
+//! extends the one before): from the tangents before and after a chunk it works out,
 //! once, the distance its steps advance along the ideal curve (`δ_mm`, the same for all its
 //! steps), their direction, the curve's bend over the chunk, and the speed and acceleration caps
 //! of those steps (below). Chunks with the same caps form a *block*: a straight line is one
@@ -129,7 +130,8 @@ pub const CHUNK_RING_LEN: usize = 256;
 /// closely.
 pub const CHUNK_STEPS: usize = 16;
 
-/// Steps per chunk while the curve runs straight (its tangent does not change over a chunk).
+/// Steps per chunk on a straight line ([`Interpolator::is_straight`]): its steps all have the
+/// same length and caps.
 pub const STRAIGHT_CHUNK_STEPS: usize = 256;
 
 /// Steps scanned by [`Planner::push`] at once: a short segment is planned in full at once.

@@ -111,6 +111,10 @@ impl Interpolator for LineInterp {
         self.tangent
     }
 
+    fn is_straight(&self) -> bool {
+        true
+    }
+
     /// A line never kinks: a tight loop of the same comparisons as `next_step`.
     fn fill(&mut self, out: &mut [Step]) -> Filled {
         let left = match self.method {

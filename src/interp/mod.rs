@@ -119,6 +119,12 @@ pub trait Interpolator {
     /// The unit tangent of the ideal curve at the current point, in the direction of travel.
     fn tangent(&self) -> Tangent;
 
+    /// True when the rest of the curve runs along one straight line (its tangent never changes
+    /// again): the planner then takes its steps in long chunks.
+    fn is_straight(&self) -> bool {
+        false
+    }
+
     /// Writes the next steps into `out`, exactly those `next_step` would hand out one by one,
     /// until `out` is full, the curve ends or fails, or a step reaches a kink: a point where the
     /// tangent jumps from the one before the step by more than [`KINK_CHORD`]. The planner takes
@@ -255,6 +261,10 @@ impl Interpolator for Curve {
             CurveKind::Sine(c) => c.tangent(),
             CurveKind::Function(c) => c.tangent(),
         }
+    }
+
+    fn is_straight(&self) -> bool {
+        matches!(self.kind, CurveKind::Line(_))
     }
 
     fn fill(&mut self, out: &mut [Step]) -> Filled {

@@ -30,8 +30,8 @@ pub(crate) struct ScanPoint {
     /// The tangent at the scan point, and the geometry of a step along it.
     tangent: Tangent,
     at: StepGeometry,
-    /// The last chunk ran straight (the tangent did not change over it): the next one may be
-    /// long, and extends it if it runs straight on.
+    /// The last chunk ran straight (the tangent did not change over it): the next one extends
+    /// it if it runs straight on.
     straight: bool,
     /// The last step scanned reached a kink from this direction (mm): the next step is a chunk
     /// and a block of its own, passed by the junction rule.
@@ -165,7 +165,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         }
         let want = if self.scan.kink_from_mm.is_some() {
             1
-        } else if self.scan.straight {
+        } else if segment.curve.is_straight() {
             STRAIGHT_CHUNK_STEPS
         } else {
             CHUNK_STEPS
