@@ -8,6 +8,8 @@ and turns the instruction counts between the harness's marks into per-step figur
     python3 count.py                    # every case: the table the README keeps
     python3 count.py --only circle      # cases whose name contains "circle"
     python3 count.py --only circle --profile   # and which functions the instructions went to
+    python3 count.py --check-model f407.txt    # fails if the simulator's model is out of date
+    python3 count.py --write-model f407.txt    # writes it anew from what is counted
 """
 import argparse
 import os
@@ -21,6 +23,30 @@ ELF = os.path.join(HERE, "..", "target", TARGET, "release", "servoplot-cost")
 PLUGIN_SRC = os.path.join(HERE, "plugin", "insn_count.c")
 PLUGIN = os.path.join(HERE, "..", "target", "cost", "insn_count.so")
 QEMU = "qemu-system-arm"
+
+# The processor the counts are turned into time for: the STM32F407 at 168 MHz, and an estimate
+# of its cycles per instruction running from flash through the ART accelerator.
+CLOCK_HZ = 168_000_000
+CYCLES_PER_INSTRUCTION = 1.3
+
+# The simulator's model (f407.txt): each kind of curve costs what its costliest case costs.
+MODEL_KINDS = {
+    "line": ["line0", "line30", "line45"],
+    "arc": ["circle", "arc"],
+    "ellipse": ["ellipse"],
+    "sine": ["sine"],
+    "function": ["gauss", "cubic", "sinx"],
+}
+MODEL_HEADER = """\
+# The motion path's cost on the board, for the simulator's CPU model (`cargo sim -- --cpu f407`).
+# Written by `python3 cost/count.py --write-model cost/f407.txt` from the instructions counted on
+# QEMU's Cortex-M4F (mps2-an386); `.ci/run` checks that it still matches what is counted.
+# Per step: the motion task all-in (interpolator, planner, task), the most costly case of each kind.
+# Per pulse: the step timer's interrupt. Cycles per instruction: an estimate for the STM32F407 at
+# 168 MHz running from flash through its ART accelerator (five wait states).
+"""
+# How far the model may be from what is counted before --check-model fails.
+MODEL_TOLERANCE = 0.05
 
 
 def build():
@@ -116,11 +142,51 @@ def print_profile(blocks, syms):
         print(f"{count:>12} {100 * count / total:5.1f}%  {name[:110]}")
 
 
+def model_from(measured, per_pulse):
+    """The simulator's model file from the counts, or None if a case is missing."""
+    lines = [MODEL_HEADER + f"clock_hz {CLOCK_HZ}", f"cycles_per_instruction {CYCLES_PER_INSTRUCTION}"]
+    if per_pulse is None:
+        return None
+    lines.append(f"pulse {round(per_pulse)}")
+    for kind, cases in MODEL_KINDS.items():
+        for method in ("classic", "diagonal"):
+            costs = [measured[(c, method, "task")] for c in cases if (c, method, "task") in measured]
+            if len(costs) != len(cases):
+                return None
+            lines.append(f"{kind} {method} {round(max(n / s for n, s in costs))}")
+    return "\n".join(lines) + "\n"
+
+
+def figures(text):
+    """The numbers of a model file, by name."""
+    out = {}
+    for line in text.splitlines():
+        words = line.split()
+        if words and not words[0].startswith("#"):
+            out[" ".join(words[:-1])] = float(words[-1])
+    return out
+
+
+def check_model(path, model):
+    if model is None:
+        sys.exit("--check-model needs every case: run without --only")
+    with open(path) as f:
+        kept = figures(f.read())
+    counted = figures(model)
+    stale = [f"{name}: {kept.get(name)} kept, {value:g} counted" for name, value in counted.items()
+             if name not in kept or abs(kept[name] - value) > MODEL_TOLERANCE * value]
+    if stale:
+        sys.exit(f"{path} is out of date (update it with --write-model):\n  " + "\n  ".join(stale))
+    print(f"\n{path} matches the counts (within {MODEL_TOLERANCE:.0%})")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only the cases whose name contains this text")
     parser.add_argument("--profile", action="store_true", help="also print instructions per function")
     parser.add_argument("--no-build", action="store_true", help="use the harness and plugin as built")
+    parser.add_argument("--write-model", metavar="FILE", help="write the simulator's CPU model from the counts")
+    parser.add_argument("--check-model", metavar="FILE", help="fail if the simulator's CPU model is out of date")
     args = parser.parse_args()
     if not args.no_build:
         build()
@@ -129,24 +195,42 @@ def main():
     for case, method, what in measured:
         if what != "pulse" and (case, method) not in cases:
             cases.append((case, method))
-    print("| curve | method | setup (instructions) | steps | interp (instr/step) | + planner (instr/step) "
-          "| + motion task (instr/step) |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+
+    def per_step(case, method, what):
+        if (case, method, what) not in measured:
+            return None
+        n, steps = measured[(case, method, what)]
+        return n / max(steps, 1)
+
+    short, long_ = measured.get(("short", "both", "pulse")), measured.get(("long", "both", "pulse"))
+    per_pulse = (long_[0] - short[0]) / (long_[1] - short[1]) if short and long_ else None
+
+    def khz(instructions):
+        return f"{CLOCK_HZ / (CYCLES_PER_INSTRUCTION * instructions) / 1000:.0f}"
+
+    print("Instructions on a Cortex-M4F; step rates at 168 MHz and 1.3 cycles per instruction.\n")
+    print("| curve | method | setup (instructions) | steps | interpolator (instr/step) | + planner (instr/step) "
+          "| + motion task (instr/step) | motion task alone tops out at (kHz) | with the pulses too (kHz) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
     for case, method in cases:
-        def per_step(what):
-            if (case, method, what) not in measured:
-                return ""
-            n, steps = measured[(case, method, what)]
-            return f"{n / max(steps, 1):.1f}"
+        fmt = lambda v: "" if v is None else f"{v:.1f}"
+        task = per_step(case, method, "task")
         setup = measured.get((case, method, "setup"), (0, 0))[0]
         steps = measured.get((case, method, "interp"), (0, 0))[1]
-        print(f"| {case} | {method} | {setup} | {steps} | {per_step('interp')} | {per_step('planner')} "
-              f"| {per_step('task')} |")
-    short, long_ = measured.get(("short", "both", "pulse")), measured.get(("long", "both", "pulse"))
-    if short and long_:
-        per_pulse = (long_[0] - short[0]) / (long_[1] - short[1])
-        print(f"\nPulse path: {per_pulse:.1f} instructions per pulse (step timer interrupt, entry to return, "
-              f"and the sleep loop around it)")
+        alone = khz(task) if task else ""
+        both = khz(task + per_pulse) if task and per_pulse else ""
+        print(f"| {case} | {method} | {setup} | {steps} | {fmt(per_step(case, method, 'interp'))} "
+              f"| {fmt(per_step(case, method, 'planner'))} | {fmt(task)} | {alone} | {both} |")
+    if per_pulse is not None:
+        print(f"\nPulse path: {per_pulse:.1f} instructions per pulse (the step timer's interrupt, entry to "
+              f"return, with the sleep around it); alone it tops out at {khz(per_pulse)} kHz.")
+    model = model_from(measured, per_pulse)
+    if args.write_model:
+        with open(args.write_model, "w") as f:
+            f.write(model)
+        print(f"\nwrote {args.write_model}")
+    if args.check_model:
+        check_model(args.check_model, model)
     if args.profile:
         print_profile(blocks, syms)
 

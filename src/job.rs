@@ -42,6 +42,34 @@ pub enum Shape {
     Function { expr: Expr, x0_mm: f32, x1_mm: f32 },
 }
 
+/// What a [`Shape`] is, without its parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum ShapeKind {
+    Line,
+    Arc,
+    Ellipse,
+    Sine,
+    Function,
+}
+
+impl ShapeKind {
+    pub const ALL: [ShapeKind; 5] =
+        [ShapeKind::Line, ShapeKind::Arc, ShapeKind::Ellipse, ShapeKind::Sine, ShapeKind::Function];
+}
+
+impl Shape {
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            Shape::Line { .. } => ShapeKind::Line,
+            Shape::Arc { .. } => ShapeKind::Arc,
+            Shape::Ellipse { .. } => ShapeKind::Ellipse,
+            Shape::Sine { .. } => ShapeKind::Sine,
+            Shape::Function { .. } => ShapeKind::Function,
+        }
+    }
+}
+
 /// Whether a job draws or jogs. A jog is reported as such and only a jog cancel stops it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]

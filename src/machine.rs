@@ -17,7 +17,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
-use crate::job::{Control, Job};
+use crate::job::{Control, Job, ShapeKind};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
@@ -66,6 +66,8 @@ pub struct Machine {
     /// Times the pulse engine found the queue empty while the motion was not at rest
     /// (written only by the pulse engine).
     underruns: AtomicU32,
+    /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
+    drawing: AtomicU8,
     settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
     fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
 }
@@ -90,6 +92,7 @@ impl Machine {
             emitted_steps: AtomicU32::new(0),
             emitted_ticks: AtomicU32::new(0),
             underruns: AtomicU32::new(0),
+            drawing: AtomicU8::new(0),
             settings: Mutex::new(RefCell::new(settings)),
             fault: Mutex::new(Cell::new(None)),
         }
@@ -154,6 +157,18 @@ impl Machine {
         warn!("step queue underrun: the motion task fell behind the pulses");
     }
 
+    /// The motion task took a job drawing `kind`. Only the motion task calls this.
+    pub fn set_drawing(&self, kind: ShapeKind) {
+        let code = ShapeKind::ALL.iter().position(|&k| k == kind).map_or(0, |i| i as u8 + 1);
+        self.drawing.store(code, Ordering::Relaxed);
+    }
+
+    /// The kind of the job the motion task took last, if any.
+    pub fn drawing(&self) -> Option<ShapeKind> {
+        let code = self.drawing.load(Ordering::Relaxed);
+        ShapeKind::ALL.get(usize::from(code).checked_sub(1)?).copied()
+    }
+
     /// Step-queue underruns since power-on.
     pub fn underruns(&self) -> u32 {
         self.underruns.load(Ordering::Relaxed)
@@ -201,6 +216,7 @@ impl Machine {
             position: self.position(),
             queued_jobs: self.jobs.len() as u8,
             fault: self.fault(),
+            underruns: self.underruns(),
         }
     }
 

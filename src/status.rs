@@ -41,4 +41,7 @@ pub struct Status {
     pub queued_jobs: u8,
     /// Why the last job stopped early, until the next one starts.
     pub fault: Option<MotionFault>,
+    /// Times the pulses had to wait for the motion task since power-on (step-queue underruns):
+    /// where the machine could not keep up with the speeds it planned.
+    pub underruns: u32,
 }

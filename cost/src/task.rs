@@ -60,7 +60,7 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let machine = Machine::new(settings.clone());
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
-    let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}));
+    let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}, servoplot::tasks::motion::RealTime));
     if machine.jobs.try_send(job).is_err() {
         panic!("job queue");
     }

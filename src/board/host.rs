@@ -14,7 +14,7 @@ const DEMO_KEYS: &str = include_str!("../../demo/demo.keys");
 const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
-usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--out DIR]
+usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--out DIR]
 
 Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
@@ -24,6 +24,8 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
   --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
                   with --serial it starts once the serial drawing is done
   --keys-text S   the keypad script given inline
+  --cpu f407      let the firmware's work take the time it takes on the STM32F407 (as counted
+                  on a Cortex-M4F); the summary then tells whether the pulses ever had to wait
   --out DIR       where the pictures go
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
@@ -63,11 +65,12 @@ fn init_log() {
 struct Args {
     serial: Option<String>,
     keys: Option<String>,
+    cpu: Option<sim::cpu::CpuModel>,
     out: PathBuf,
 }
 
 fn parse_args() -> Result<Args, String> {
-    let mut args = Args { serial: None, keys: None, out: PathBuf::from("out") };
+    let mut args = Args { serial: None, keys: None, cpu: None, out: PathBuf::from("out") };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
@@ -78,6 +81,10 @@ fn parse_args() -> Result<Args, String> {
                 args.keys = Some(std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?);
             }
             "--keys-text" => args.keys = Some(value()?),
+            "--cpu" => match value()?.as_str() {
+                "f407" => args.cpu = Some(sim::cpu::CpuModel::f407()?),
+                other => return Err(format!("unknown processor `{other}` (there is: f407)")),
+            },
             "--out" => args.out = PathBuf::from(value()?),
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
@@ -127,7 +134,17 @@ pub fn main() -> ExitCode {
     // person at the terminal, at once.
     let keys_start =
         if has_serial && args.serial.as_deref() != Some("-") { KeysStart::AfterSerial } else { KeysStart::AtOnce };
-    let report = sim::run(SimConfig { serial: serial.echo_to_stdout(), keys, keys_start, ..SimConfig::default() });
+    let with_cpu = args.cpu.is_some();
+    let report = sim::run(SimConfig {
+        serial: serial.echo_to_stdout(),
+        keys,
+        keys_start,
+        cpu: args.cpu,
+        ..SimConfig::default()
+    });
+    if with_cpu {
+        eprintln!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
+    }
     match write_pictures(&report, &args.out) {
         Ok(()) => {}
         Err(e) => {

@@ -67,7 +67,9 @@ pub fn alarm(out: &mut impl Write, code: u8) -> fmt::Result {
 
 /// The status report for `?`: `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `feed_mm_per_min` is the
 /// speed now (0 when stopped); `work_offset_mm`, when given, adds GRBL's `|WCO:x,y,0.000` field
-/// (GRBL sends it every 10 to 30 reports and after the offset changes).
+/// (GRBL sends it every 10 to 30 reports and after the offset changes). Once the pulses have had
+/// to wait for the motion task, `|Un:N` counts those step-queue underruns (not a GRBL field;
+/// senders skip fields they do not know).
 pub fn status(
     out: &mut impl Write,
     status: &Status,
@@ -91,6 +93,9 @@ pub fn status(
     if let Some([x, y]) = work_offset_mm {
         out.write_str("|WCO:")?;
         xyz(out, x as f64, y as f64)?;
+    }
+    if status.underruns > 0 {
+        write!(out, "|Un:{}", status.underruns)?;
     }
     out.write_str(">\r\n")
 }
@@ -212,7 +217,7 @@ mod tests {
     }
 
     fn st(state: RunState, x: i32, y: i32) -> Status {
-        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None }
+        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None, underruns: 0 }
     }
 
     #[test]
@@ -232,6 +237,9 @@ mod tests {
         );
         assert!(text(|o| status(o, &st(RunState::Jog, 0, 0), &s, 600.0, None)).starts_with("<Jog|"));
         assert!(text(|o| status(o, &st(RunState::Alarm, 0, 0), &s, 0.0, None)).starts_with("<Alarm|"));
+        // Once the pulses have had to wait for the motion task, the count follows.
+        let late = Status { underruns: 3, ..st(RunState::Run, 0, 0) };
+        assert_eq!(text(|o| status(o, &late, &s, 6000.0, None)), "<Run|MPos:0.000,0.000,0.000|FS:6000,0|Un:3>\r\n");
     }
 
     #[test]

@@ -7,6 +7,7 @@
 //! machine has come to rest.
 
 pub mod clock;
+pub mod cpu;
 pub mod keys;
 pub mod lcd;
 pub mod picture;
@@ -32,6 +33,7 @@ use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::tasks::{self, lcd::St7920Lcd};
 use clock::FreeDelay;
+use cpu::{CpuModel, SimCpu};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 use keys::{KeyMatrix, KeyScript};
@@ -65,6 +67,9 @@ pub struct SimConfig {
     pub serial: SimSerial,
     pub keys: KeyScript,
     pub keys_start: KeysStart,
+    /// The board's processor: its work takes time, and the pulses may have to wait for it.
+    /// `None`: the firmware's work takes no time.
+    pub cpu: Option<CpuModel>,
 }
 
 /// What a simulation produced.
@@ -82,6 +87,8 @@ pub struct SimReport {
     pub end_us: u64,
     /// True if the run hit `SIM_MAX_VIRTUAL_US` before coming to rest.
     pub timed_out: bool,
+    /// Times the pulses had to wait for the motion task.
+    pub underruns: u32,
 }
 
 impl SimReport {
@@ -126,12 +133,13 @@ pub fn run(config: SimConfig) -> SimReport {
     let columns = [0, 1, 2, 3].map(|c| matrix.column(c));
     let rows = [0, 1, 2, 3].map(|r| matrix.row(r));
     let serial = config.serial;
+    let cpu = config.cpu;
     let spi = SimSpi::default();
     let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
 
     let firmware = join5(
         step_timer::run(&machine, &mut engine, &kicks),
-        tasks::motion::run(&machine, steps, || kicks.signal(())),
+        tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
         tasks::keypad::run(&machine, columns, rows),
         tasks::serial::run(&machine, serial.clone(), serial.clone()),
         tasks::lcd::run(&machine, lcd),
@@ -193,12 +201,13 @@ pub fn run(config: SimConfig) -> SimReport {
         }
     }
     let position = machine.position();
+    let underruns = machine.underruns();
     let settings = machine.settings();
     let end_us = clock::now_ticks();
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
-    SimReport { trace, frames, serial_out: serial.output(), position, settings, end_us, timed_out }
+    SimReport { trace, frames, serial_out: serial.output(), position, settings, end_us, timed_out, underruns }
 }
 
 /// Runs a serial transcript (and nothing on the keypad) with default settings.

@@ -17,7 +17,7 @@ use crate::geom::Point;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
-use crate::planner::{Limits, PLANNER_SEGMENTS, Planner, PlannerState};
+use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner, PlannerState};
 use crate::pulse::StepProducer;
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -47,9 +47,27 @@ struct Queued {
     resting: bool,
 }
 
+/// The time the motion task's work takes. On the board it is the time the work really takes,
+/// and there is nothing to do ([`RealTime`]); the simulator's virtual time stands still while
+/// code runs, and a model of the board's CPU spends it here.
+pub trait WorkTime {
+    /// `emitted` was computed: the future ends once the processor would have done so.
+    fn took(&mut self, emitted: &Emitted) -> impl Future<Output = ()>;
+}
+
+/// The board's [`WorkTime`]: the work took its time already.
+pub struct RealTime;
+
+impl WorkTime for RealTime {
+    fn took(&mut self, _emitted: &Emitted) -> impl Future<Output = ()> {
+        core::future::ready(())
+    }
+}
+
 /// Runs the motion forever. `steps` is the producer end of the step queue; `kick` wakes the
-/// pulse engine after steps were published.
-pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl FnMut()) -> ! {
+/// pulse engine after steps were published; `work` lets the time of the work pass (see
+/// [`WorkTime`]).
+pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl FnMut(), mut work: impl WorkTime) -> ! {
     let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
     let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
     // Where the pen will be once everything planned so far has been emitted.
@@ -83,7 +101,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             }
         }
         let steps_before = queued.steps;
-        let filled = fill(machine, &mut planner, &mut steps, &mut queued);
+        let filled = fill(machine, &mut planner, &mut steps, &mut queued, &mut work).await;
         if queued.steps != steps_before {
             machine.set_plan_empty(false);
             machine.set_run_state(moving);
@@ -140,12 +158,12 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
 
 /// Moves step commands from the planner into the step queue: as many as fit, up to
 /// [`STEP_QUEUE_MAX_TICKS`] of motion queued.
-#[inline(never)]
-fn fill(
+async fn fill(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     steps: &mut StepProducer<'_>,
     queued: &mut Queued,
+    work: &mut impl WorkTime,
 ) -> FillEnd {
     let mut ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
     loop {
@@ -155,6 +173,7 @@ fn fill(
             return FillEnd::QueueFull;
         }
         let emitted = planner.fill(slots, ticks_room);
+        work.took(&emitted).await;
         steps.publish(emitted.steps);
         if emitted.steps > 0 {
             queued.resting = false;
@@ -184,6 +203,7 @@ fn plan(
         Ok(curve) => {
             *planned_end = curve.end();
             info!("job planned to ({}, {}) steps", planned_end.x, planned_end.y);
+            machine.set_drawing(job.shape.kind());
             machine.set_fault(None);
             if planner.push(curve, job.feed, settings.method).is_err() {
                 // is_full() was false just now and nothing else pushes.

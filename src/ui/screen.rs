@@ -513,6 +513,7 @@ mod tests {
             queued_jobs: 255,
             position: crate::geom::Point::new(-50_000, -50_000),
             fault: None,
+            underruns: u32::MAX,
         };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
             let mut m = Menu::new();

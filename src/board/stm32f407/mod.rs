@@ -85,7 +85,7 @@ type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, 
 
 #[embassy_executor::task]
 async fn motion(machine: &'static Machine, steps: StepProducer<'static>) -> ! {
-    tasks::motion::run(machine, steps, step_timer::kick).await
+    tasks::motion::run(machine, steps, step_timer::kick, tasks::motion::RealTime).await
 }
 
 #[embassy_executor::task]
