@@ -18,6 +18,9 @@
 //! callgrind (`--only list` lists the cases). The workload runs inside `only_workload`, so
 //! `--toggle-collect='*only_workload*'` counts just the stepping.
 
+#[path = "motion/rates.rs"]
+mod rates;
+
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -785,6 +788,10 @@ fn run_only(name: &str) -> Result<(), String> {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--rates") {
+        rates::table();
+        return;
+    }
     if let Some(i) = args.iter().position(|a| a == "--only") {
         let Some(name) = args.get(i + 1) else {
             eprintln!("--only needs a case name; `--only list` lists them");
@@ -818,5 +825,6 @@ fn main() {
     println!();
     curve_tables();
     polyline_table();
+    rates::table();
     eprintln!("benchmark took {:.1} s", started.elapsed().as_secs_f64());
 }

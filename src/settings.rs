@@ -26,10 +26,9 @@ pub struct SettingInfo {
     pub max: f32,
 }
 
-/// Highest pulse rate the firmware drives per axis. The drivers take 200 kHz, but the pulse task
-/// wakes once per pulse and busy-waits the pulse width, so rates are kept where that is a small
-/// share of the CPU.
-pub const MAX_PULSE_RATE_HZ: f32 = 50_000.0;
+/// Highest pulse rate the firmware drives: the drivers' own limit (EP3L class, open collector:
+/// 200 kpps, a period of at least 5 µs).
+pub const MAX_PULSE_RATE_HZ: f32 = 200_000.0;
 
 /// Every setting, in `$$` listing order.
 pub const SETTING_INFO: &[SettingInfo] = &[
