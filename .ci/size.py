@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Prints the flash and static RAM a firmware ELF image uses, from its section headers."""
+"""Prints the flash and static RAM a firmware ELF image uses, from its section headers; with
+--max-flash-kib N, fails when the flash used is above N KiB."""
 import struct
 import sys
 
@@ -36,6 +37,11 @@ def main():
                 flash += size
     print(f"flash: {flash} bytes ({flash / FLASH[1]:.1%} of {FLASH[1] // 1024} KiB)")
     print(f"static RAM: {ram} bytes ({ram / RAM[1]:.1%} of {RAM[1] // 1024} KiB)")
+    if len(sys.argv) == 4 and sys.argv[2] == "--max-flash-kib":
+        limit = int(sys.argv[3]) * 1024
+        if flash > limit:
+            sys.exit(f"flash {flash} bytes is above the {limit // 1024} KiB budget")
+        print(f"flash within the {limit // 1024} KiB budget")
 
 
 if __name__ == "__main__":

@@ -48,6 +48,12 @@ MODEL_HEADER = """\
 # How far the model may be from what is counted before --check-model fails.
 MODEL_TOLERANCE = 0.05
 
+# The budgets (--check-budgets): instructions per step of the motion task all-in, by kind of
+# curve, and per pulse. Together they let both axes run at 100 kHz on any curve with at most
+# half of the processor.
+STEP_BUDGETS = {"line": 250, "arc": 250, "ellipse": 250, "sine": 600, "function": 600}
+PULSE_BUDGET = 300
+
 
 def build():
     os.makedirs(os.path.dirname(PLUGIN), exist_ok=True)
@@ -180,6 +186,23 @@ def check_model(path, model):
     print(f"\n{path} matches the counts (within {MODEL_TOLERANCE:.0%})")
 
 
+def check_budgets(measured, per_pulse):
+    over = []
+    for kind, cases in MODEL_KINDS.items():
+        for case in cases:
+            for method in ("classic", "diagonal"):
+                if (case, method, "task") not in measured:
+                    continue
+                n, steps = measured[(case, method, "task")]
+                if n / steps > STEP_BUDGETS[kind]:
+                    over.append(f"{case} {method}: {n / steps:.1f} instructions per step, budget {STEP_BUDGETS[kind]}")
+    if per_pulse is not None and per_pulse > PULSE_BUDGET:
+        over.append(f"pulse path: {per_pulse:.1f} instructions per pulse, budget {PULSE_BUDGET}")
+    if over:
+        sys.exit("over budget:\n  " + "\n  ".join(over))
+    print(f"\nevery case within its budget (per step: {STEP_BUDGETS}; per pulse: {PULSE_BUDGET})")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only the cases whose name contains this text")
@@ -187,6 +210,7 @@ def main():
     parser.add_argument("--no-build", action="store_true", help="use the harness and plugin as built")
     parser.add_argument("--write-model", metavar="FILE", help="write the simulator's CPU model from the counts")
     parser.add_argument("--check-model", metavar="FILE", help="fail if the simulator's CPU model is out of date")
+    parser.add_argument("--check-budgets", action="store_true", help="fail if a case is over its budget")
     args = parser.parse_args()
     if not args.no_build:
         build()
@@ -231,6 +255,8 @@ def main():
         print(f"\nwrote {args.write_model}")
     if args.check_model:
         check_model(args.check_model, model)
+    if args.check_budgets:
+        check_budgets(measured, per_pulse)
     if args.profile:
         print_profile(blocks, syms)
 
