@@ -1,0 +1,548 @@
+//! The conic tracer: circles and axis-aligned ellipses by point-by-point comparison (逐点比较法).
+//! [`crate::interp::arc`] and [`crate::interp::ellipse`] set a trace up (check the points, find
+//! where it ends); this module owns the stepping, from the first step to the end point.
+//!
+//! A circle and an axis-aligned ellipse are both the zero set of
+//! `F(x, y) = wx·x² + wy·y² − c` around their centre (circle: `wx = wy = 1`, `c = R²`; ellipse:
+//! `wx = b²`, `wy = a²`, `c = a²b²`). The tracer walks it with integer steps and keeps `F` up to
+//! date by additions only (`F(x ± 1, y) = F ± wx·(±2x) + wx`), in `i64` for circles and `i128`
+//! for ellipses.
+//!
+//! At every point the tangent of the curve gives the two forward moves, one along each axis:
+//! the one that brings the point nearer the centre on its axis ("inward") and the other
+//! ("outward"). An axis whose tangent component is zero (the point lies on an axis) moves
+//! inward. This reproduces the textbook tables for all four quadrants and both directions:
+//!
+//! - `classic`: one axis per step; `F >= 0` steps inward, `F < 0` outward (first quadrant,
+//!   counter-clockwise: `F >= 0` → −X, `F < 0` → +Y). Error <= 1 step; a full circle of radius
+//!   `R` started on an axis takes exactly `8R` steps, a quarter `2R`.
+//! - `diagonal`: the candidates are the inward, outward and diagonal (both) moves. If the
+//!   diagonal point is outside the curve the curve passes between it and the inward point,
+//!   otherwise between it and the outward point; the midpoint between those two (evaluated as
+//!   `4·F` in integers) picks the nearer. Every point is then within half a step of the curve
+//!   along a row or a column, hence within half a step of it.
+//!
+//! Clockwise travel is traced as counter-clockwise travel in a frame with Y mirrored (both
+//! curves are symmetric about the X axis), so one set of rules serves both directions.
+//!
+//! Thin tips: where an ellipse is narrower than a step or two about its long axis (`b > a²`,
+//! roughly), a trace reaches that axis before the tip. The literal tables would then leave the
+//! axis at once and cut the tip off; the tracer instead climbs the axis while the tip lies
+//! more than half a step farther out, turns there and comes back, so tips are drawn (a pen
+//! stroke up the tip and back). Everywhere else the classic steps are exactly the tables'.
+//!
+//! The end: the tracer counts the quadrant boundaries it crosses (a climb toward a tip still
+//! belongs to the quadrant before the tip) and, in the end's quadrant, stops where its path
+//! passes the line normal to the curve through the curve point nearest the end (for a circle:
+//! the ray from the centre through the end). If that point is not the end (an integer end point
+//! is rarely exactly on a real curve), it finishes with a few straight steps that stay as
+//! close to the curve as they can. Every step moves forward in angle or along a radius, a step
+//! budget caps the curve part, and the straight finish shortens the distance to the end with
+//! every step, so a trace always ends, exactly on its end point.
+
+use core::ops::{Add, Mul, Sub};
+
+use crate::geom::{Rotation, Step};
+use crate::interp::arc::round;
+use crate::interp::{Method, Tangent};
+
+#[cfg(test)]
+pub(crate) mod test_support;
+
+/// Extra steps per quadrant in the curve budget, beyond the semi-axes, for starts off the curve.
+const QUARTER_SLACK_STEPS: i64 = 8;
+
+/// How a tracer finds its end.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Plan {
+    /// To the end point given as a lattice point: the curve part stops at the [`Gate`] through
+    /// `near`, the point of the curve nearest to the end (machine frame, relative to the
+    /// centre). An end on the start's own ray (the start itself included) takes one full turn.
+    ToEnd { near: (f64, f64) },
+    /// Along the ideal arc from its point `from` to its point `to` (machine frame, relative to
+    /// the centre), `long` when it sweeps half a turn or more; the lattice start and end are
+    /// these points rounded, and may lie on either side of them.
+    Between { from: (f64, f64), to: (f64, f64), long: bool },
+    /// No steps: the end is the start.
+    Empty,
+}
+
+impl Plan {
+    /// The plan of an ideal arc from `from` to `to` sweeping `sweep` radians (less than a
+    /// turn), whose end rounds onto the start when `same_point`: nothing to draw for a short
+    /// sweep, which is shorter than the rounding.
+    pub(crate) fn between(from: (f64, f64), to: (f64, f64), sweep: f64, same_point: bool) -> Plan {
+        let long = libm::fabs(sweep) >= core::f64::consts::PI;
+        if same_point && !long { Plan::Empty } else { Plan::Between { from, to, long } }
+    }
+}
+
+/// Integer type of a discriminant: `i64` for circles, `i128` for ellipses.
+pub(crate) trait Discriminant:
+    Copy + Ord + core::fmt::Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + From<i64>
+{
+    fn to_f32(self) -> f32;
+}
+
+impl Discriminant for i64 {
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+}
+
+impl Discriminant for i128 {
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// Following the curve.
+    Curve,
+    /// Straight finish to the end point.
+    Tail,
+    /// At the end.
+    Done,
+}
+
+/// The quadrant of `(x, y)`, counted counter-clockwise from +X; each quadrant includes the
+/// half-axis where it begins, so a counter-clockwise path enters quadrants in order 0, 1, 2, 3.
+fn quadrant(x: i64, y: i64) -> u8 {
+    if x > 0 && y >= 0 {
+        0
+    } else if x <= 0 && y > 0 {
+        1
+    } else if x < 0 && y <= 0 {
+        2
+    } else {
+        3
+    }
+}
+
+/// Scale of [`Gate`] coordinates: a fractional curve point is kept to 1/1024 step.
+const GATE_SCALE: f64 = 1024.0;
+
+/// Scale of [`Gate`]'s unit direction.
+const GATE_DIRECTION_SCALE: f64 = 1_048_576.0;
+
+/// Where the curve part of a trace ends: the line through a point of the curve, normal to the
+/// curve there. A trace in the end's quadrant is past it when it has moved beyond that line
+/// in the direction of travel. (The normal line, not the ray from the centre: on a flat
+/// ellipse the ray meets the band of lattice points around the curve over many steps.)
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Gate {
+    /// The curve point, scaled by [`GATE_SCALE`].
+    point: (i64, i64),
+    /// The unit tangent there in the direction of travel, scaled by [`GATE_DIRECTION_SCALE`].
+    along: (i64, i64),
+}
+
+impl Gate {
+    /// The gate at curve point `p` (frame coordinates) of `wx·x² + wy·y² = c`, travelling
+    /// counter-clockwise, with `p` first moved into `quadrant` (the end point's) should it lie
+    /// just across an axis.
+    fn new(p: (f64, f64), quadrant: u8, weights: (i64, i64)) -> Self {
+        const NUDGE: f64 = 1.0 / GATE_SCALE;
+        let (mut x, mut y) = p;
+        match quadrant {
+            0 => (x, y) = (x.max(NUDGE), y.max(0.0)),
+            1 => (x, y) = (x.min(0.0), y.max(NUDGE)),
+            2 => (x, y) = (x.min(-NUDGE), y.min(0.0)),
+            _ => (x, y) = (x.max(0.0), y.min(-NUDGE)),
+        }
+        let (tx, ty) = (-(weights.1 as f64) * y, weights.0 as f64 * x);
+        let len = libm::hypot(tx, ty);
+        let along = if len > 0.0 {
+            (round(tx / len * GATE_DIRECTION_SCALE), round(ty / len * GATE_DIRECTION_SCALE))
+        } else {
+            (0, 0)
+        };
+        Gate { point: (round(x * GATE_SCALE), round(y * GATE_SCALE)), along }
+    }
+
+    /// True when lattice point `n` lies strictly beyond the gate.
+    fn passed_by(&self, n: (i64, i64)) -> bool {
+        let dx = n.0 * GATE_SCALE as i64 - self.point.0;
+        let dy = n.1 * GATE_SCALE as i64 - self.point.1;
+        dx * self.along.0 + dy * self.along.1 > 0
+    }
+}
+
+/// On an axis, inside the curve, with the curve's crossing of that axis more than half a step
+/// farther out (the tip of an ellipse narrower than a step, or a start inside the curve): the
+/// move out along the axis. Not right after moving in along the same axis (`last`), so that a
+/// trace turns at a tip instead of climbing it again.
+fn climb_move<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> Option<(i64, i64)> {
+    if f >= D::from(0) {
+        return None;
+    }
+    let (m, w, c) = if p.0 == 0 {
+        ((0, p.1.signum()), weights.1, p.1)
+    } else if p.1 == 0 {
+        ((p.0.signum(), 0), weights.0, p.0)
+    } else {
+        return None;
+    };
+    if m == (0, 0) || last == (-m.0, -m.1) {
+        return None;
+    }
+    // 4·F half a step out: 4F + w·(4·|c| + 1).
+    let mid = D::from(4) * f + D::from(w) * D::from(4 * c.abs() + 1);
+    if mid < D::from(0) { Some(m) } else { None }
+}
+
+/// See [`Tracer::progress_quadrant`].
+fn progress_quadrant<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> u8 {
+    let q = quadrant(p.0, p.1);
+    if climb_move(p, f, last, weights).is_some() { (q + 3) % 4 } else { q }
+}
+
+/// [`quadrant`] of a fractional point.
+fn quadrant_f(p: (f64, f64)) -> u8 {
+    let (x, y) = p;
+    if x > 0.0 && y >= 0.0 {
+        0
+    } else if x <= 0.0 && y > 0.0 {
+        1
+    } else if x < 0.0 && y <= 0.0 {
+        2
+    } else {
+        3
+    }
+}
+
+/// `a × b`: positive when `b` lies counter-clockwise of `a` (within half a turn).
+pub(crate) fn cross(a: (i64, i64), b: (i64, i64)) -> i64 {
+    a.0 * b.1 - a.1 * b.0
+}
+
+/// Walks `F(x, y) = wx·x² + wy·y² − c = 0`; see the module documentation.
+///
+/// All coordinates are relative to the centre, in a frame where travel is counter-clockwise
+/// (Y mirrored for clockwise travel).
+#[derive(Clone, Debug)]
+pub(crate) struct Tracer<D> {
+    x: i64,
+    y: i64,
+    ex: i64,
+    ey: i64,
+    /// Where the curve part ends, in the end's quadrant.
+    gate: Gate,
+    wx: i64,
+    wy: i64,
+    /// `F` at the current point.
+    f: D,
+    mirror: bool,
+    method: Method,
+    phase: Phase,
+    /// Quadrant of the current point.
+    quadrant: u8,
+    /// Quadrant boundaries crossed so far, and how many lie before the end's quadrant.
+    crossed: u8,
+    needed: u8,
+    /// Curve steps left before the tracer gives up following the curve (never reached by a
+    /// correct trace; a guarantee of termination).
+    budget: u64,
+    /// The previous move (frame coordinates).
+    last: (i64, i64),
+    /// Steps taken by the straight finish so far.
+    tail_steps: u32,
+}
+
+impl<D: Discriminant> Tracer<D> {
+    /// `start` and `end` relative to the centre (the caller checks them), `weights` = `(wx,
+    /// wy)`, `half_axes` = ceilings of the semi-axes along X and Y.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        start: (i64, i64),
+        end: (i64, i64),
+        plan: Plan,
+        weights: (i64, i64),
+        c: D,
+        half_axes: (i64, i64),
+        rotation: Rotation,
+        method: Method,
+    ) -> Self {
+        let mirror = rotation == Rotation::Clockwise;
+        let (x, y) = (start.0, if mirror { -start.1 } else { start.1 });
+        let (ex, ey) = (end.0, if mirror { -end.1 } else { end.1 });
+        let (wx, wy) = weights;
+        let f = D::from(wx) * D::from(x) * D::from(x) + D::from(wy) * D::from(y) * D::from(y) - c;
+        let frame = |p: (f64, f64)| (p.0, if mirror { -p.1 } else { p.1 });
+        // A start on an axis counts as having just come in along it, so that it does not climb
+        // to a tip: whether the tip lies ahead or behind is unknown, and it is taken to be
+        // behind (at the start's own angle). Unless the ideal start is known to lie before
+        // the axis.
+        let on_axis_in = if x == 0 {
+            (0, -y.signum())
+        } else if y == 0 {
+            (-x.signum(), 0)
+        } else {
+            (0, 0)
+        };
+        let before_axis = match plan {
+            Plan::Between { from, .. } => quadrant(x, y) == (quadrant_f(frame(from)) + 1) % 4,
+            _ => false,
+        };
+        let last = if before_axis { (0, 0) } else { on_axis_in };
+        let q = progress_quadrant((x, y), f, last, weights);
+        let (needed, crossed, gate, phase) = match plan {
+            Plan::ToEnd { near } => {
+                // An end inside a tip, on its axis, is met on the way up to the tip: it counts in
+                // the quadrant before.
+                let fe = D::from(wx) * D::from(ex) * D::from(ex) + D::from(wy) * D::from(ey) * D::from(ey) - c;
+                let eq = if (ex, ey) == (x, y) { q } else { progress_quadrant((ex, ey), fe, (0, 0), weights) };
+                let mut needed = (eq + 4 - q) % 4;
+                let ahead = cross((x, y), (ex, ey));
+                if ahead == 0 && x * ex + y * ey > 0 {
+                    // On the start's own ray: one full turn (less one quadrant if the end is met
+                    // on the way up a tip the start has left behind).
+                    needed = if needed == 3 { 3 } else { needed + 4 };
+                } else if needed == 0 && ahead < 0 {
+                    // Same quadrant, behind the start.
+                    needed = 4;
+                }
+                // Back to the start itself; else to the curve point nearest the end.
+                let target = if (x, y) == (ex, ey) { (x as f64, y as f64) } else { frame(near) };
+                (needed, 0, Gate::new(target, eq, weights), Phase::Curve)
+            }
+            Plan::Between { from, to, long } => {
+                let (from, to) = (frame(from), frame(to));
+                let (qf, qt) = (quadrant_f(from), quadrant_f(to));
+                let mut needed = (qt + 4 - qf) % 4;
+                if needed == 0 && long {
+                    needed = 4;
+                }
+                // The lattice start may have been rounded across an axis.
+                let (needed, crossed) = match (q + 4 - qf) % 4 {
+                    1 => (needed, 1),
+                    3 => (needed + 1, 0),
+                    _ => (needed, 0),
+                };
+                (needed, crossed, Gate::new(to, qt, weights), Phase::Curve)
+            }
+            Plan::Empty => {
+                let gate = Gate::new((ex as f64, ey as f64), quadrant(ex, ey), weights);
+                (0, 0, gate, if (x, y) == (ex, ey) { Phase::Done } else { Phase::Tail })
+            }
+        };
+        let quarter = (half_axes.0 + half_axes.1 + QUARTER_SLACK_STEPS) as u64;
+        Tracer {
+            x,
+            y,
+            ex,
+            ey,
+            gate,
+            wx,
+            wy,
+            f,
+            mirror,
+            method,
+            phase,
+            quadrant: q,
+            crossed,
+            needed,
+            budget: 4 * (needed as u64 + 1) * quarter,
+            last,
+            tail_steps: 0,
+        }
+    }
+
+    /// The next step in machine coordinates, `None` at the end.
+    pub(crate) fn next(&mut self) -> Option<Step> {
+        match self.phase {
+            Phase::Done => None,
+            Phase::Tail => self.tail_step(),
+            Phase::Curve => {
+                if self.budget == 0 {
+                    warn!("curve step budget exhausted; finishing straight");
+                    self.phase = Phase::Tail;
+                    return self.tail_step();
+                }
+                self.budget -= 1;
+                self.curve_step()
+            }
+        }
+    }
+
+    /// Unit tangent of the ideal curve at the current point in the direction of travel; the
+    /// direction to the end point during the straight finish.
+    pub(crate) fn tangent(&self) -> Tangent {
+        let (tx, ty) = match self.phase {
+            Phase::Tail => ((self.ex - self.x) as f32, (self.ey - self.y) as f32),
+            Phase::Curve | Phase::Done => (-(self.wy as f32) * self.y as f32, self.wx as f32 * self.x as f32),
+        };
+        let ty = if self.mirror { -ty } else { ty };
+        // Scale first: products of large weights and coordinates square beyond f32.
+        let m = libm::fmaxf(libm::fabsf(tx), libm::fabsf(ty));
+        if m > 0.0 { Tangent::along(tx / m, ty / m) } else { Tangent::along(0.0, 0.0) }
+    }
+
+    /// `F` at the current point.
+    #[cfg(test)]
+    pub(crate) fn discriminant(&self) -> D {
+        self.f
+    }
+
+    /// Steps taken by the straight finish so far.
+    #[cfg(test)]
+    pub(crate) fn tail_steps(&self) -> u32 {
+        self.tail_steps
+    }
+
+    /// Change of `F` for a step `sx` along X (and `sy` along Y) from the current point.
+    fn df_x(&self, sx: i64) -> D {
+        D::from(self.wx) * D::from(2 * sx * self.x + 1)
+    }
+
+    fn df_y(&self, sy: i64) -> D {
+        D::from(self.wy) * D::from(2 * sy * self.y + 1)
+    }
+
+    fn df(&self, m: (i64, i64)) -> D {
+        let zero = D::from(0);
+        (if m.0 != 0 { self.df_x(m.0) } else { zero }) + (if m.1 != 0 { self.df_y(m.1) } else { zero })
+    }
+
+    fn climb(&self) -> Option<(i64, i64)> {
+        climb_move((self.x, self.y), self.f, self.last, (self.wx, self.wy))
+    }
+
+    /// The quadrant the trace counts point `p` (with discriminant `f`, reached by move `last`)
+    /// in: its own, except while it climbs an axis toward a tip, which still belongs to the
+    /// quadrant before the tip.
+    fn progress_quadrant(&self, p: (i64, i64), f: D, last: (i64, i64)) -> u8 {
+        progress_quadrant(p, f, last, (self.wx, self.wy))
+    }
+
+    /// The move the curve rule chooses at the current point.
+    fn curve_move(&self) -> (i64, i64) {
+        if let Some(m) = self.climb() {
+            return m;
+        }
+        let zero = D::from(0);
+        // Forward directions: along the tangent (−wy·y, wx·x); a zero component moves inward.
+        let sx = if self.y != 0 { -self.y.signum() } else { -self.x.signum() };
+        let sy = if self.x != 0 { self.x.signum() } else { -self.y.signum() };
+        let x_inward = sx * self.x < 0;
+        let (inward, outward) = if x_inward { ((sx, 0), (0, sy)) } else { ((0, sy), (sx, 0)) };
+        let diagonal = (sx, sy);
+        let chosen = match self.method {
+            Method::Classic => {
+                if self.f >= zero {
+                    inward
+                } else {
+                    outward
+                }
+            }
+            Method::Diagonal => {
+                let four = D::from(4);
+                let fd = self.f + self.df(diagonal);
+                if fd == zero {
+                    diagonal
+                } else if fd > zero {
+                    // The curve passes between the inward point and the diagonal point: compare
+                    // with their midpoint, half a step outward from the inward point.
+                    let f_in = self.f + self.df(inward);
+                    let (w, s, c) = if x_inward { (self.wy, sy, self.y) } else { (self.wx, sx, self.x) };
+                    let mid = four * f_in + D::from(w) * D::from(4 * s * c + 1);
+                    if mid > zero { inward } else { diagonal }
+                } else {
+                    // Between the outward point and the diagonal point.
+                    let f_out = self.f + self.df(outward);
+                    let (w, s, c) = if x_inward { (self.wx, sx, self.x) } else { (self.wy, sy, self.y) };
+                    let mid = four * f_out + D::from(w) * D::from(4 * s * c + 1);
+                    if mid < zero { outward } else { diagonal }
+                }
+            }
+        };
+        // Never onto the centre (only a classic circle of radius 1 would go there); the outward
+        // move never leads there.
+        if self.x + chosen.0 == 0 && self.y + chosen.1 == 0 { outward } else { chosen }
+    }
+
+    fn curve_step(&mut self) -> Option<Step> {
+        let m = self.curve_move();
+        let n = (self.x + m.0, self.y + m.1);
+        let nq = self.progress_quadrant(n, self.f + self.df(m), m);
+        let crossed = self.crossed.saturating_add((nq != self.quadrant) as u8);
+        let end = (self.ex, self.ey);
+        let reached = crossed > self.needed || (crossed == self.needed && (n == end || self.gate.passed_by(n)));
+        if reached && n != end && self.distance_to_end(n) >= self.distance_to_end((self.x, self.y)) {
+            // Stepping past the gate would lead away from the end: finish from here.
+            self.phase = Phase::Tail;
+            return self.tail_step();
+        }
+        self.quadrant = nq;
+        self.crossed = crossed;
+        let step = self.apply(m);
+        if reached {
+            self.phase = if n == end { Phase::Done } else { Phase::Tail };
+        }
+        Some(step)
+    }
+
+    /// Distance to the end in steps of the method (one axis or both axes per step).
+    fn distance_to_end(&self, p: (i64, i64)) -> i64 {
+        let (dx, dy) = ((self.ex - p.0).abs(), (self.ey - p.1).abs());
+        match self.method {
+            Method::Classic => dx + dy,
+            Method::Diagonal => dx.max(dy),
+        }
+    }
+
+    /// One straight step toward the end: among the moves that shorten the distance, the one
+    /// that lands nearest the curve (`|F| / |∇F|`).
+    fn tail_step(&mut self) -> Option<Step> {
+        let (rx, ry) = (self.ex - self.x, self.ey - self.y);
+        if rx == 0 && ry == 0 {
+            self.phase = Phase::Done;
+            return None;
+        }
+        let (sx, sy) = (rx.signum(), ry.signum());
+        let candidates = match self.method {
+            Method::Classic => [(sx, 0), (0, sy)],
+            Method::Diagonal if rx.abs() > ry.abs() => [(sx, 0), (sx, sy)],
+            Method::Diagonal if ry.abs() > rx.abs() => [(0, sy), (sx, sy)],
+            Method::Diagonal => [(sx, sy), (sx, sy)],
+        };
+        let mut best: Option<((i64, i64), f32)> = None;
+        for m in candidates {
+            if m == (0, 0) {
+                continue;
+            }
+            let score = self.off_curve(m);
+            if best.is_none_or(|(_, s)| score < s) {
+                best = Some((m, score));
+            }
+        }
+        let m = best.map_or((sx, sy), |(m, _)| m);
+        let step = self.apply(m);
+        self.tail_steps = self.tail_steps.saturating_add(1);
+        if self.x == self.ex && self.y == self.ey {
+            self.phase = Phase::Done;
+        }
+        Some(step)
+    }
+
+    /// First-order distance from the curve after move `m`.
+    fn off_curve(&self, m: (i64, i64)) -> f32 {
+        let f = (self.f + self.df(m)).to_f32();
+        let (x, y) = ((self.x + m.0) as f32, (self.y + m.1) as f32);
+        let gx = 2.0 * self.wx as f32 * x;
+        let gy = 2.0 * self.wy as f32 * y;
+        let g = libm::fmaxf(libm::hypotf(gx, gy), 1.0);
+        libm::fabsf(f) / g
+    }
+
+    /// Takes move `m` (frame coordinates) and returns it as a machine step.
+    fn apply(&mut self, m: (i64, i64)) -> Step {
+        self.f = self.f + self.df(m);
+        self.x += m.0;
+        self.y += m.1;
+        self.last = m;
+        let dy = if self.mirror { -m.1 } else { m.1 };
+        Step::new(m.0 as i8, dy as i8)
+    }
+}
