@@ -5,8 +5,7 @@
 //! A circle and an axis-aligned ellipse are both the zero set of
 //! `F(x, y) = wx·x² + wy·y² − c` around their centre (circle: `wx = wy = 1`, `c = R²`; ellipse:
 //! `wx = b²`, `wy = a²`, `c = a²b²`). The tracer walks it with integer steps and keeps `F` up to
-//! date by additions only (`F(x ± 1, y) = F ± wx·(±2x) + wx`), in `i64` for circles and `i128`
-//! for ellipses.
+//! date by additions only (`F(x ± 1, y) = F + wx·(±2x + 1)`).
 //!
 //! At every point the tangent of the curve gives the two forward moves, one along each axis:
 //! the one that brings the point nearer the centre on its axis ("inward") and the other
@@ -33,36 +32,73 @@
 //!
 //! The end: the tracer counts the quadrant boundaries it crosses (a climb toward a tip still
 //! belongs to the quadrant before the tip) and, in the end's quadrant, stops where its path
-//! passes the line normal to the curve through the curve point nearest the end (for a circle:
-//! the ray from the centre through the end). If that point is not the end (an integer end point
-//! is rarely exactly on a real curve), it finishes with a few straight steps that stay as
-//! close to the curve as they can. Every step moves forward in angle or along a radius, a step
-//! budget caps the curve part, and the straight finish shortens the distance to the end with
-//! every step, so a trace always ends, exactly on its end point.
-
-use core::ops::{Add, Mul, Sub};
+//! passes the line normal to the curve through the curve point nearest the end (the [`Gate`];
+//! for a circle: the ray from the centre through the end). If that point is not the end (an
+//! integer end point is rarely exactly on a real curve), it finishes with a few straight steps
+//! that stay as close to the curve as they can. Every step moves forward in angle or along a
+//! radius, a step budget caps the curve part, and the straight finish shortens the distance to
+//! the end with every step, so a trace always ends, exactly on its end point.
+//!
+//! # Arithmetic
+//!
+//! Everything the tracer keeps per step is `i64`; no step needs wider arithmetic. The bound:
+//! every point the tracer visits, and every point it evaluates `F` at (candidate moves,
+//! midpoints), lies within `d <= 8` steps of the curve (start and end within
+//! [`ARC_END_TOLERANCE_STEPS`](crate::interp::arc::ARC_END_TOLERANCE_STEPS), curve points within
+//! a step, candidates a step farther, the straight finish between a curve point and the end).
+//! There `|F| <= |∇F|·d + W·d²` with `W = max(wx, wy)` and `|∇F| <= 2·W·S` on the curve, `S` the
+//! largest semi-axis:
+//!
+//! - circles (`W = 1`, `S <= √2·MAX_RADIUS_STEPS < 2²¹`): `|F| < 2²⁶`, every quantity below
+//!   `2³⁰`;
+//! - ellipses (`W <= 2³⁶`, `S <= MAX_ELLIPSE_AXIS_STEPS = 2¹⁸`): `|F| <= 2⁵⁵·8 + 2³⁶·64 < 2^58.01`,
+//!   `4F` (the midpoint tests) `< 2^60.02`, the terms `w·(4c + 1)` added to it `< 2^56.01`: all
+//!   well inside `i64` (`2⁶³`).
+//!
+//! `c = a²b²` itself does not fit (up to `2⁷²`): it is kept modulo `2⁶⁴`, and `F` at the start
+//! and at the end (the only places it is computed from scratch) is evaluated with wrapping
+//! arithmetic, which is exact because the true value lies within the bound. A [`Gate`] value is
+//! at most `GATE_SCALE·2²² · 2²⁰ = 2⁵²` per axis. Should the budget ever run out (it never does
+//! on a correct trace) the straight finish may start far from the curve; it updates `F` with
+//! wrapping arithmetic, so the worst that can happen there is a less well chosen finishing step.
 
 use crate::geom::{Rotation, Step};
-use crate::interp::arc::round;
 use crate::interp::{Method, Tangent};
+use crate::math;
 
 #[cfg(test)]
 pub(crate) mod test_support;
 
 /// Extra steps per quadrant in the curve budget, beyond the semi-axes, for starts off the curve.
-const QUARTER_SLACK_STEPS: i64 = 8;
+const QUARTER_SLACK_STEPS: u32 = 8;
+
+/// [`Gate`] points are kept in 1/`GATE_SCALE` step.
+pub(crate) const GATE_SCALE: i64 = 1024;
+
+/// Scale of [`Gate`]'s unit direction.
+const GATE_DIRECTION_SCALE: f32 = 1_048_576.0;
+
+/// A point in 1/[`GATE_SCALE`] step, relative to the centre.
+pub(crate) type Fine = (i64, i64);
+
+/// `p` (in steps) in 1/[`GATE_SCALE`] step, rounded.
+pub(crate) fn fine(p: (f32, f32)) -> Fine {
+    let scale = GATE_SCALE as f32;
+    (math::round(p.0 * scale) as i64, math::round(p.1 * scale) as i64)
+}
 
 /// How a tracer finds its end.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Plan {
     /// To the end point given as a lattice point: the curve part stops at the [`Gate`] through
-    /// `near`, the point of the curve nearest to the end (machine frame, relative to the
-    /// centre). An end on the start's own ray (the start itself included) takes one full turn.
-    ToEnd { near: (f64, f64) },
+    /// `near`, the point of the curve nearest to the end (machine frame, relative to the centre,
+    /// in 1/[`GATE_SCALE`] step). An end on the start's own ray (the start itself included)
+    /// takes one full turn.
+    ToEnd { near: Fine },
     /// Along the ideal arc from its point `from` to its point `to` (machine frame, relative to
-    /// the centre), `long` when it sweeps half a turn or more; the lattice start and end are
-    /// these points rounded, and may lie on either side of them.
-    Between { from: (f64, f64), to: (f64, f64), long: bool },
+    /// the centre, in steps), `long` when it sweeps half a turn or more; the lattice start and
+    /// end are these points rounded, and may lie on either side of them.
+    Between { from: (f32, f32), to: (f32, f32), long: bool },
     /// No steps: the end is the start.
     Empty,
 }
@@ -71,33 +107,14 @@ impl Plan {
     /// The plan of an ideal arc from `from` to `to` sweeping `sweep` radians (less than a
     /// turn), whose end rounds onto the start when `same_point`: nothing to draw for a short
     /// sweep, which is shorter than the rounding.
-    pub(crate) fn between(from: (f64, f64), to: (f64, f64), sweep: f64, same_point: bool) -> Plan {
-        let long = libm::fabs(sweep) >= core::f64::consts::PI;
+    pub(crate) fn between(from: (f32, f32), to: (f32, f32), sweep: f32, same_point: bool) -> Plan {
+        let long = sweep.abs() >= core::f32::consts::PI;
         if same_point && !long { Plan::Empty } else { Plan::Between { from, to, long } }
     }
 }
 
-/// Integer type of a discriminant: `i64` for circles, `i128` for ellipses.
-pub(crate) trait Discriminant:
-    Copy + Ord + core::fmt::Debug + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + From<i64>
-{
-    fn to_f32(self) -> f32;
-}
-
-impl Discriminant for i64 {
-    fn to_f32(self) -> f32 {
-        self as f32
-    }
-}
-
-impl Discriminant for i128 {
-    fn to_f32(self) -> f32 {
-        self as f32
-    }
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Phase {
+enum Phase {
     /// Following the curve.
     Curve,
     /// Straight finish to the end point.
@@ -108,7 +125,7 @@ pub(crate) enum Phase {
 
 /// The quadrant of `(x, y)`, counted counter-clockwise from +X; each quadrant includes the
 /// half-axis where it begins, so a counter-clockwise path enters quadrants in order 0, 1, 2, 3.
-fn quadrant(x: i64, y: i64) -> u8 {
+fn quadrant(x: i32, y: i32) -> u8 {
     if x > 0 && y >= 0 {
         0
     } else if x <= 0 && y > 0 {
@@ -120,86 +137,8 @@ fn quadrant(x: i64, y: i64) -> u8 {
     }
 }
 
-/// Scale of [`Gate`] coordinates: a fractional curve point is kept to 1/1024 step.
-const GATE_SCALE: f64 = 1024.0;
-
-/// Scale of [`Gate`]'s unit direction.
-const GATE_DIRECTION_SCALE: f64 = 1_048_576.0;
-
-/// Where the curve part of a trace ends: the line through a point of the curve, normal to the
-/// curve there. A trace in the end's quadrant is past it when it has moved beyond that line
-/// in the direction of travel. (The normal line, not the ray from the centre: on a flat
-/// ellipse the ray meets the band of lattice points around the curve over many steps.)
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Gate {
-    /// The curve point, scaled by [`GATE_SCALE`].
-    point: (i64, i64),
-    /// The unit tangent there in the direction of travel, scaled by [`GATE_DIRECTION_SCALE`].
-    along: (i64, i64),
-}
-
-impl Gate {
-    /// The gate at curve point `p` (frame coordinates) of `wx·x² + wy·y² = c`, travelling
-    /// counter-clockwise, with `p` first moved into `quadrant` (the end point's) should it lie
-    /// just across an axis.
-    fn new(p: (f64, f64), quadrant: u8, weights: (i64, i64)) -> Self {
-        const NUDGE: f64 = 1.0 / GATE_SCALE;
-        let (mut x, mut y) = p;
-        match quadrant {
-            0 => (x, y) = (x.max(NUDGE), y.max(0.0)),
-            1 => (x, y) = (x.min(0.0), y.max(NUDGE)),
-            2 => (x, y) = (x.min(-NUDGE), y.min(0.0)),
-            _ => (x, y) = (x.max(0.0), y.min(-NUDGE)),
-        }
-        let (tx, ty) = (-(weights.1 as f64) * y, weights.0 as f64 * x);
-        let len = libm::hypot(tx, ty);
-        let along = if len > 0.0 {
-            (round(tx / len * GATE_DIRECTION_SCALE), round(ty / len * GATE_DIRECTION_SCALE))
-        } else {
-            (0, 0)
-        };
-        Gate { point: (round(x * GATE_SCALE), round(y * GATE_SCALE)), along }
-    }
-
-    /// True when lattice point `n` lies strictly beyond the gate.
-    fn passed_by(&self, n: (i64, i64)) -> bool {
-        let dx = n.0 * GATE_SCALE as i64 - self.point.0;
-        let dy = n.1 * GATE_SCALE as i64 - self.point.1;
-        dx * self.along.0 + dy * self.along.1 > 0
-    }
-}
-
-/// On an axis, inside the curve, with the curve's crossing of that axis more than half a step
-/// farther out (the tip of an ellipse narrower than a step, or a start inside the curve): the
-/// move out along the axis. Not right after moving in along the same axis (`last`), so that a
-/// trace turns at a tip instead of climbing it again.
-fn climb_move<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> Option<(i64, i64)> {
-    if f >= D::from(0) {
-        return None;
-    }
-    let (m, w, c) = if p.0 == 0 {
-        ((0, p.1.signum()), weights.1, p.1)
-    } else if p.1 == 0 {
-        ((p.0.signum(), 0), weights.0, p.0)
-    } else {
-        return None;
-    };
-    if m == (0, 0) || last == (-m.0, -m.1) {
-        return None;
-    }
-    // 4·F half a step out: 4F + w·(4·|c| + 1).
-    let mid = D::from(4) * f + D::from(w) * D::from(4 * c.abs() + 1);
-    if mid < D::from(0) { Some(m) } else { None }
-}
-
-/// See [`Tracer::progress_quadrant`].
-fn progress_quadrant<D: Discriminant>(p: (i64, i64), f: D, last: (i64, i64), weights: (i64, i64)) -> u8 {
-    let q = quadrant(p.0, p.1);
-    if climb_move(p, f, last, weights).is_some() { (q + 3) % 4 } else { q }
-}
-
 /// [`quadrant`] of a fractional point.
-fn quadrant_f(p: (f64, f64)) -> u8 {
+fn quadrant_f(p: (f32, f32)) -> u8 {
     let (x, y) = p;
     if x > 0.0 && y >= 0.0 {
         0
@@ -217,22 +156,116 @@ pub(crate) fn cross(a: (i64, i64), b: (i64, i64)) -> i64 {
     a.0 * b.1 - a.1 * b.0
 }
 
+/// `wx·x² + wy·y² − c`, modulo 2⁶⁴: exact wherever the true value fits in `i64`, which it does
+/// within [`ARC_END_TOLERANCE_STEPS`](crate::interp::arc::ARC_END_TOLERANCE_STEPS) of the
+/// curve (see the module documentation).
+fn discriminant_at(p: (i32, i32), weights: (i64, i64), c: i64) -> i64 {
+    let (x, y) = (p.0 as i64, p.1 as i64);
+    weights.0.wrapping_mul(x * x).wrapping_add(weights.1.wrapping_mul(y * y)).wrapping_sub(c)
+}
+
+/// Where the curve part of a trace ends: the line through a point of the curve, normal to the
+/// curve there. A trace in the end's quadrant is past it when it has moved beyond that line
+/// in the direction of travel. (The normal line, not the ray from the centre: on a flat
+/// ellipse the ray meets the band of lattice points around the curve over many steps.)
+#[derive(Clone, Copy, Debug)]
+struct Gate {
+    /// The curve point, in 1/[`GATE_SCALE`] step.
+    point: Fine,
+    /// The unit tangent there in the direction of travel, scaled by [`GATE_DIRECTION_SCALE`].
+    along: (i32, i32),
+}
+
+impl Gate {
+    /// The gate at curve point `p` (frame coordinates, 1/[`GATE_SCALE`] step) of a curve with
+    /// weights proportional to `tw`, travelling counter-clockwise, with `p` first moved into
+    /// `quadrant` (the end point's) should it lie just across an axis.
+    fn new(p: Fine, quadrant: u8, tw: (f32, f32)) -> Self {
+        let (x, y) = match quadrant {
+            0 => (p.0.max(1), p.1.max(0)),
+            1 => (p.0.min(0), p.1.max(1)),
+            2 => (p.0.min(-1), p.1.min(0)),
+            _ => (p.0.max(0), p.1.min(-1)),
+        };
+        let (tx, ty) = (-tw.1 * y as f32, tw.0 * x as f32);
+        let len = math::hypot(tx, ty);
+        let along = if len > 0.0 {
+            let k = GATE_DIRECTION_SCALE / len;
+            (math::round(tx * k) as i32, math::round(ty * k) as i32)
+        } else {
+            (0, 0)
+        };
+        Gate { point: (x, y), along }
+    }
+
+    /// How far lattice point `n` lies beyond the gate (positive) or before it, in units of
+    /// 1/(`GATE_SCALE`·`GATE_DIRECTION_SCALE`) step.
+    fn value(&self, n: (i32, i32)) -> i64 {
+        let dx = n.0 as i64 * GATE_SCALE - self.point.0;
+        let dy = n.1 as i64 * GATE_SCALE - self.point.1;
+        dx * self.along.0 as i64 + dy * self.along.1 as i64
+    }
+
+    /// True when lattice point `n` lies strictly beyond the gate.
+    fn passed_by(&self, n: (i32, i32)) -> bool {
+        self.value(n) > 0
+    }
+}
+
+/// On an axis, inside the curve, with the curve's crossing of that axis more than half a step
+/// farther out (the tip of an ellipse narrower than a step, or a start inside the curve): the
+/// move out along the axis. Not right after moving in along the same axis (`last`), so that a
+/// trace turns at a tip instead of climbing it again.
+fn climb_move(p: (i32, i32), f: i64, last: (i32, i32), weights: (i64, i64)) -> Option<(i32, i32)> {
+    if f >= 0 {
+        return None;
+    }
+    let (m, w, c) = if p.0 == 0 {
+        ((0, p.1.signum()), weights.1, p.1)
+    } else if p.1 == 0 {
+        ((p.0.signum(), 0), weights.0, p.0)
+    } else {
+        return None;
+    };
+    if m == (0, 0) || last == (-m.0, -m.1) {
+        return None;
+    }
+    // 4·F half a step out: 4F + w·(4·|c| + 1).
+    let mid = 4 * f + w * (4 * c.unsigned_abs() as i64 + 1);
+    if mid < 0 { Some(m) } else { None }
+}
+
+/// See [`Tracer::progress_quadrant`].
+fn progress_quadrant(p: (i32, i32), f: i64, last: (i32, i32), weights: (i64, i64)) -> u8 {
+    let q = quadrant(p.0, p.1);
+    if climb_move(p, f, last, weights).is_some() { (q + 3) % 4 } else { q }
+}
+
+/// The unit vector along `(x, y)`; `(1, 0)` for a zero vector.
+/// (Inputs are at most a few million: their squares stay finite.)
+fn unit(x: f32, y: f32) -> Tangent {
+    let len = math::sqrt(x * x + y * y);
+    if len > 0.0 { Tangent { x: x / len, y: y / len } } else { Tangent { x: 1.0, y: 0.0 } }
+}
+
 /// Walks `F(x, y) = wx·x² + wy·y² − c = 0`; see the module documentation.
 ///
 /// All coordinates are relative to the centre, in a frame where travel is counter-clockwise
 /// (Y mirrored for clockwise travel).
 #[derive(Clone, Debug)]
-pub(crate) struct Tracer<D> {
-    x: i64,
-    y: i64,
-    ex: i64,
-    ey: i64,
+pub(crate) struct Tracer {
+    x: i32,
+    y: i32,
+    ex: i32,
+    ey: i32,
     /// Where the curve part ends, in the end's quadrant.
     gate: Gate,
     wx: i64,
     wy: i64,
+    /// The weights divided by the larger one, for directions.
+    tw: (f32, f32),
     /// `F` at the current point.
-    f: D,
+    f: i64,
     mirror: bool,
     method: Method,
     phase: Phase,
@@ -243,24 +276,26 @@ pub(crate) struct Tracer<D> {
     needed: u8,
     /// Curve steps left before the tracer gives up following the curve (never reached by a
     /// correct trace; a guarantee of termination).
-    budget: u64,
+    budget: u32,
     /// The previous move (frame coordinates).
-    last: (i64, i64),
+    last: (i32, i32),
     /// Steps taken by the straight finish so far.
     tail_steps: u32,
 }
 
-impl<D: Discriminant> Tracer<D> {
-    /// `start` and `end` relative to the centre (the caller checks them), `weights` = `(wx,
-    /// wy)`, `half_axes` = ceilings of the semi-axes along X and Y.
+impl Tracer {
+    /// `start` and `end` relative to the centre (the caller checks them: within
+    /// [`ARC_END_TOLERANCE_STEPS`](crate::interp::arc::ARC_END_TOLERANCE_STEPS) of the curve),
+    /// `weights` = `(wx, wy)`, `c` modulo 2⁶⁴, `half_axes` = ceilings of the semi-axes along X
+    /// and Y.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
-        start: (i64, i64),
-        end: (i64, i64),
+        start: (i32, i32),
+        end: (i32, i32),
         plan: Plan,
         weights: (i64, i64),
-        c: D,
-        half_axes: (i64, i64),
+        c: i64,
+        half_axes: (i32, i32),
         rotation: Rotation,
         method: Method,
     ) -> Self {
@@ -268,8 +303,10 @@ impl<D: Discriminant> Tracer<D> {
         let (x, y) = (start.0, if mirror { -start.1 } else { start.1 });
         let (ex, ey) = (end.0, if mirror { -end.1 } else { end.1 });
         let (wx, wy) = weights;
-        let f = D::from(wx) * D::from(x) * D::from(x) + D::from(wy) * D::from(y) * D::from(y) - c;
-        let frame = |p: (f64, f64)| (p.0, if mirror { -p.1 } else { p.1 });
+        let big = wx.max(wy) as f32;
+        let tw = (wx as f32 / big, wy as f32 / big);
+        let f = discriminant_at((x, y), weights, c);
+        let frame = |p: (f32, f32)| (p.0, if mirror { -p.1 } else { p.1 });
         // A start on an axis counts as having just come in along it, so that it does not climb
         // to a tip: whether the tip lies ahead or behind is unknown, and it is taken to be
         // behind (at the start's own angle). Unless the ideal start is known to lie before
@@ -291,11 +328,12 @@ impl<D: Discriminant> Tracer<D> {
             Plan::ToEnd { near } => {
                 // An end inside a tip, on its axis, is met on the way up to the tip: it counts in
                 // the quadrant before.
-                let fe = D::from(wx) * D::from(ex) * D::from(ex) + D::from(wy) * D::from(ey) * D::from(ey) - c;
+                let fe = discriminant_at((ex, ey), weights, c);
                 let eq = if (ex, ey) == (x, y) { q } else { progress_quadrant((ex, ey), fe, (0, 0), weights) };
                 let mut needed = (eq + 4 - q) % 4;
-                let ahead = cross((x, y), (ex, ey));
-                if ahead == 0 && x * ex + y * ey > 0 {
+                let (s, e) = ((x as i64, y as i64), (ex as i64, ey as i64));
+                let ahead = cross(s, e);
+                if ahead == 0 && s.0 * e.0 + s.1 * e.1 > 0 {
                     // On the start's own ray: one full turn (less one quadrant if the end is met
                     // on the way up a tip the start has left behind).
                     needed = if needed == 3 { 3 } else { needed + 4 };
@@ -304,8 +342,12 @@ impl<D: Discriminant> Tracer<D> {
                     needed = 4;
                 }
                 // Back to the start itself; else to the curve point nearest the end.
-                let target = if (x, y) == (ex, ey) { (x as f64, y as f64) } else { frame(near) };
-                (needed, 0, Gate::new(target, eq, weights), Phase::Curve)
+                let target = if (x, y) == (ex, ey) {
+                    (x as i64 * GATE_SCALE, y as i64 * GATE_SCALE)
+                } else {
+                    (near.0, if mirror { -near.1 } else { near.1 })
+                };
+                (needed, 0, Gate::new(target, eq, tw), Phase::Curve)
             }
             Plan::Between { from, to, long } => {
                 let (from, to) = (frame(from), frame(to));
@@ -320,14 +362,14 @@ impl<D: Discriminant> Tracer<D> {
                     3 => (needed + 1, 0),
                     _ => (needed, 0),
                 };
-                (needed, crossed, Gate::new(to, qt, weights), Phase::Curve)
+                (needed, crossed, Gate::new(fine(to), qt, tw), Phase::Curve)
             }
             Plan::Empty => {
-                let gate = Gate::new((ex as f64, ey as f64), quadrant(ex, ey), weights);
+                let gate = Gate::new((ex as i64 * GATE_SCALE, ey as i64 * GATE_SCALE), quadrant(ex, ey), tw);
                 (0, 0, gate, if (x, y) == (ex, ey) { Phase::Done } else { Phase::Tail })
             }
         };
-        let quarter = (half_axes.0 + half_axes.1 + QUARTER_SLACK_STEPS) as u64;
+        let quarter = half_axes.0 as u32 + half_axes.1 as u32 + QUARTER_SLACK_STEPS;
         Tracer {
             x,
             y,
@@ -336,6 +378,7 @@ impl<D: Discriminant> Tracer<D> {
             gate,
             wx,
             wy,
+            tw,
             f,
             mirror,
             method,
@@ -343,7 +386,7 @@ impl<D: Discriminant> Tracer<D> {
             quadrant: q,
             crossed,
             needed,
-            budget: 4 * (needed as u64 + 1) * quarter,
+            budget: 4 * (needed as u32 + 1) * quarter,
             last,
             tail_steps: 0,
         }
@@ -371,17 +414,14 @@ impl<D: Discriminant> Tracer<D> {
     pub(crate) fn tangent(&self) -> Tangent {
         let (tx, ty) = match self.phase {
             Phase::Tail => ((self.ex - self.x) as f32, (self.ey - self.y) as f32),
-            Phase::Curve | Phase::Done => (-(self.wy as f32) * self.y as f32, self.wx as f32 * self.x as f32),
+            Phase::Curve | Phase::Done => (-self.tw.1 * self.y as f32, self.tw.0 * self.x as f32),
         };
-        let ty = if self.mirror { -ty } else { ty };
-        // Scale first: products of large weights and coordinates square beyond f32.
-        let m = libm::fmaxf(libm::fabsf(tx), libm::fabsf(ty));
-        if m > 0.0 { Tangent::along(tx / m, ty / m) } else { Tangent::along(0.0, 0.0) }
+        unit(tx, if self.mirror { -ty } else { ty })
     }
 
     /// `F` at the current point.
     #[cfg(test)]
-    pub(crate) fn discriminant(&self) -> D {
+    pub(crate) fn discriminant(&self) -> i64 {
         self.f
     }
 
@@ -392,36 +432,34 @@ impl<D: Discriminant> Tracer<D> {
     }
 
     /// Change of `F` for a step `sx` along X (and `sy` along Y) from the current point.
-    fn df_x(&self, sx: i64) -> D {
-        D::from(self.wx) * D::from(2 * sx * self.x + 1)
+    fn df_x(&self, sx: i32) -> i64 {
+        self.wx * (2 * sx as i64 * self.x as i64 + 1)
     }
 
-    fn df_y(&self, sy: i64) -> D {
-        D::from(self.wy) * D::from(2 * sy * self.y + 1)
+    fn df_y(&self, sy: i32) -> i64 {
+        self.wy * (2 * sy as i64 * self.y as i64 + 1)
     }
 
-    fn df(&self, m: (i64, i64)) -> D {
-        let zero = D::from(0);
-        (if m.0 != 0 { self.df_x(m.0) } else { zero }) + (if m.1 != 0 { self.df_y(m.1) } else { zero })
+    fn df(&self, m: (i32, i32)) -> i64 {
+        (if m.0 != 0 { self.df_x(m.0) } else { 0 }) + (if m.1 != 0 { self.df_y(m.1) } else { 0 })
     }
 
-    fn climb(&self) -> Option<(i64, i64)> {
+    fn climb(&self) -> Option<(i32, i32)> {
         climb_move((self.x, self.y), self.f, self.last, (self.wx, self.wy))
     }
 
     /// The quadrant the trace counts point `p` (with discriminant `f`, reached by move `last`)
     /// in: its own, except while it climbs an axis toward a tip, which still belongs to the
     /// quadrant before the tip.
-    fn progress_quadrant(&self, p: (i64, i64), f: D, last: (i64, i64)) -> u8 {
+    fn progress_quadrant(&self, p: (i32, i32), f: i64, last: (i32, i32)) -> u8 {
         progress_quadrant(p, f, last, (self.wx, self.wy))
     }
 
     /// The move the curve rule chooses at the current point.
-    fn curve_move(&self) -> (i64, i64) {
+    fn curve_move(&self) -> (i32, i32) {
         if let Some(m) = self.climb() {
             return m;
         }
-        let zero = D::from(0);
         // Forward directions: along the tangent (−wy·y, wx·x); a zero component moves inward.
         let sx = if self.y != 0 { -self.y.signum() } else { -self.x.signum() };
         let sy = if self.x != 0 { self.x.signum() } else { -self.y.signum() };
@@ -430,30 +468,29 @@ impl<D: Discriminant> Tracer<D> {
         let diagonal = (sx, sy);
         let chosen = match self.method {
             Method::Classic => {
-                if self.f >= zero {
+                if self.f >= 0 {
                     inward
                 } else {
                     outward
                 }
             }
             Method::Diagonal => {
-                let four = D::from(4);
                 let fd = self.f + self.df(diagonal);
-                if fd == zero {
+                if fd == 0 {
                     diagonal
-                } else if fd > zero {
+                } else if fd > 0 {
                     // The curve passes between the inward point and the diagonal point: compare
                     // with their midpoint, half a step outward from the inward point.
                     let f_in = self.f + self.df(inward);
                     let (w, s, c) = if x_inward { (self.wy, sy, self.y) } else { (self.wx, sx, self.x) };
-                    let mid = four * f_in + D::from(w) * D::from(4 * s * c + 1);
-                    if mid > zero { inward } else { diagonal }
+                    let mid = 4 * f_in + w * (4 * (s * c) as i64 + 1);
+                    if mid > 0 { inward } else { diagonal }
                 } else {
                     // Between the outward point and the diagonal point.
                     let f_out = self.f + self.df(outward);
                     let (w, s, c) = if x_inward { (self.wx, sx, self.x) } else { (self.wy, sy, self.y) };
-                    let mid = four * f_out + D::from(w) * D::from(4 * s * c + 1);
-                    if mid < zero { outward } else { diagonal }
+                    let mid = 4 * f_out + w * (4 * (s * c) as i64 + 1);
+                    if mid < 0 { outward } else { diagonal }
                 }
             }
         };
@@ -476,7 +513,7 @@ impl<D: Discriminant> Tracer<D> {
         }
         self.quadrant = nq;
         self.crossed = crossed;
-        let step = self.apply(m);
+        let step = self.apply(m, self.f + self.df(m));
         if reached {
             self.phase = if n == end { Phase::Done } else { Phase::Tail };
         }
@@ -484,8 +521,8 @@ impl<D: Discriminant> Tracer<D> {
     }
 
     /// Distance to the end in steps of the method (one axis or both axes per step).
-    fn distance_to_end(&self, p: (i64, i64)) -> i64 {
-        let (dx, dy) = ((self.ex - p.0).abs(), (self.ey - p.1).abs());
+    fn distance_to_end(&self, p: (i32, i32)) -> u32 {
+        let (dx, dy) = ((self.ex - p.0).unsigned_abs(), (self.ey - p.1).unsigned_abs());
         match self.method {
             Method::Classic => dx + dy,
             Method::Diagonal => dx.max(dy),
@@ -507,7 +544,7 @@ impl<D: Discriminant> Tracer<D> {
             Method::Diagonal if ry.abs() > rx.abs() => [(0, sy), (sx, sy)],
             Method::Diagonal => [(sx, sy), (sx, sy)],
         };
-        let mut best: Option<((i64, i64), f32)> = None;
+        let mut best: Option<((i32, i32), f32)> = None;
         for m in candidates {
             if m == (0, 0) {
                 continue;
@@ -518,7 +555,7 @@ impl<D: Discriminant> Tracer<D> {
             }
         }
         let m = best.map_or((sx, sy), |(m, _)| m);
-        let step = self.apply(m);
+        let step = self.apply(m, self.f.wrapping_add(self.df(m)));
         self.tail_steps = self.tail_steps.saturating_add(1);
         if self.x == self.ex && self.y == self.ey {
             self.phase = Phase::Done;
@@ -527,18 +564,19 @@ impl<D: Discriminant> Tracer<D> {
     }
 
     /// First-order distance from the curve after move `m`.
-    fn off_curve(&self, m: (i64, i64)) -> f32 {
-        let f = (self.f + self.df(m)).to_f32();
+    fn off_curve(&self, m: (i32, i32)) -> f32 {
+        let f = self.f.wrapping_add(self.df(m)) as f32;
         let (x, y) = ((self.x + m.0) as f32, (self.y + m.1) as f32);
         let gx = 2.0 * self.wx as f32 * x;
         let gy = 2.0 * self.wy as f32 * y;
-        let g = libm::fmaxf(libm::hypotf(gx, gy), 1.0);
-        libm::fabsf(f) / g
+        let g = math::max(math::hypot(gx, gy), 1.0);
+        f.abs() / g
     }
 
-    /// Takes move `m` (frame coordinates) and returns it as a machine step.
-    fn apply(&mut self, m: (i64, i64)) -> Step {
-        self.f = self.f + self.df(m);
+    /// Takes move `m` (frame coordinates), after which `F` is `f`, and returns it as a machine
+    /// step.
+    fn apply(&mut self, m: (i32, i32), f: i64) -> Step {
+        self.f = f;
         self.x += m.0;
         self.y += m.1;
         self.last = m;

@@ -1,33 +1,56 @@
-//! Axis-aligned ellipses and elliptic arcs by point-by-point comparison (逐点比较法).
+//! Axis-aligned ellipses and elliptic arcs: their setup (centre, semi-axes, how far the start
+//! and end lie from the curve, where the trace ends) and the nearest point of an ellipse. The
+//! stepping is the conic tracer's ([`crate::interp::conic`]).
 //!
 //! The ellipse with semi-axis `a` along X and `b` along Y is the zero set of
-//! `F = b²x² + a²y² − a²b²` around its centre. It is traced by the same rules as circles (see
-//! [`crate::interp::conic`]): `classic` steps one axis at a time, inward when `F >= 0` and
-//! outward otherwise (error <= 1 step, a full ellipse started on an axis takes `4(a + b)`
-//! steps); `diagonal` picks between the inward, outward and diagonal moves by a midpoint test
-//! (error <= 0.5 step, about `4·√(a² + b²)` steps for a full ellipse). `F` is kept in `i128`:
-//! `a²b²` reaches 10²⁴ at [`MAX_RADIUS_STEPS`]. Tips narrower than a step are climbed and
-//! come back along the axis instead of being cut off (see [`crate::interp::conic`]).
+//! `F = b²x² + a²y² − a²b²` around its centre. It is traced by the same rules as circles:
+//! `classic` steps one axis at a time, inward when `F >= 0` and outward otherwise (error <= 1
+//! step, a full ellipse started on an axis takes `4(a + b)` steps); `diagonal` picks between
+//! the inward, outward and diagonal moves by a midpoint test (error <= 0.5 step, about
+//! `4·√(a² + b²)` steps for a full ellipse). Tips narrower than a step are climbed and come
+//! back along the axis instead of being cut off. `F` grows with the cube of the ellipse's size,
+//! hence [`MAX_ELLIPSE_AXIS_STEPS`], which keeps every value of a trace inside `i64`.
 //!
 //! Start and end points are lattice points and so lie slightly off the ideal ellipse; both may
 //! be up to [`ARC_END_TOLERANCE_STEPS`] away (measured as the true Euclidean distance, see
-//! [`distance_to_ellipse`]). The trace ends exactly on the end point.
+//! [`foot`]). The trace ends exactly on the end point.
+//!
+//! Setup is `f32` and integer arithmetic only. The nearest point is found without the
+//! cancellation that `f32` would suffer near the curve (where `F` is a small difference of
+//! numbers up to 2⁷²): `F` itself is computed exactly in integers and the equation for the
+//! nearest point is written in terms of it, so the offset to the curve comes out to `f32`'s
+//! relative precision (about 10⁻⁶ step) for any size of ellipse.
 
 use crate::geom::{Point, Rotation, Step};
-use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, MAX_RADIUS_STEPS, offset, point_at, round};
-use crate::interp::conic::{Plan, Tracer};
+use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset, point_at, round};
+use crate::interp::conic::{GATE_SCALE, Plan, Tracer};
 use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::math;
 
 #[cfg(test)]
 mod tests;
 
-/// Bisection rounds of [`distance_to_ellipse`]; enough to exhaust `f64` precision.
-const DISTANCE_ITERATIONS: u32 = 200;
+/// Largest semi-axis of an ellipse, in steps: 2¹⁸ = 262_144, 1.3 m at 200 steps/mm, more than
+/// the machine's diagonal. `F` and its changes grow with the cube of the ellipse's size: at this
+/// limit every value a trace computes stays below 2⁶¹ (see [`crate::interp::conic`]); twice the
+/// limit would take them to the edge of `i64`. Circles of any radius up to
+/// [`MAX_RADIUS_STEPS`](crate::interp::arc::MAX_RADIUS_STEPS) are arcs, not ellipses.
+pub const MAX_ELLIPSE_AXIS_STEPS: i32 = 1 << 18;
+
+/// Most Newton steps of [`foot`]'s root search. Points near the curve take two to four; only
+/// points far inside a flat ellipse, near its long axis, take more.
+const ROOT_ITERATIONS_MAX: u32 = 64;
+
+/// `|F|` of a point within twice the semi-axes, as `f32`, up to which `F` is computed exactly:
+/// the `f32` estimate is then within 2⁵⁴ of `F`, so `|F| < 2⁶²` and its `i64` value, computed
+/// modulo 2⁶⁴, is exact. Farther from the curve the estimate is used (it has no cancellation
+/// there).
+const EXACT_RESIDUAL_MAX: f32 = 2_305_843_009_213_693_952.0; // 2⁶¹
 
 /// An ellipse or elliptic arc; see the module documentation.
 #[derive(Clone, Debug)]
 pub struct EllipseInterp {
-    tracer: Tracer<i128>,
+    tracer: Tracer,
     center: Point,
     end: Point,
     rotation: Rotation,
@@ -52,7 +75,7 @@ impl EllipseInterp {
         if a <= 0 || b <= 0 {
             return Err(ArcError::ZeroRadius);
         }
-        if a > MAX_RADIUS_STEPS || b > MAX_RADIUS_STEPS {
+        if a > MAX_ELLIPSE_AXIS_STEPS || b > MAX_ELLIPSE_AXIS_STEPS {
             return Err(ArcError::TooLarge);
         }
         let s = offset(start, center);
@@ -60,16 +83,16 @@ impl EllipseInterp {
         if s == (0, 0) {
             return Err(ArcError::ZeroRadius);
         }
-        let tol = ARC_END_TOLERANCE_STEPS as f64;
-        let (af, bf) = (a as f64, b as f64);
-        if distance_to_ellipse(af, bf, s.0 as f64, s.1 as f64) > tol {
+        if foot_within_tolerance(a, b, s).is_none() {
             return Err(ArcError::StartOffCurve);
         }
-        if e == (0, 0) || distance_to_ellipse(af, bf, e.0 as f64, e.1 as f64) > tol {
+        let Some(d) = foot_within_tolerance(a, b, e).filter(|_| e != (0, 0)) else {
             return Err(ArcError::EndOffCurve);
-        }
-        let plan = Plan::ToEnd { near: nearest_on_ellipse(af, bf, e.0 as f64, e.1 as f64) };
-        Ok(Self::build(s, e, a, b, center, end, rotation, method, plan))
+        };
+        let scale = GATE_SCALE as f32;
+        let near =
+            (e.0 * GATE_SCALE + math::round(d.0 * scale) as i64, e.1 * GATE_SCALE + math::round(d.1 * scale) as i64);
+        Ok(Self::build(narrow(s), narrow(e), a, b, center, end, rotation, method, Plan::ToEnd { near }))
     }
 
     /// An elliptic arc that starts at the pen point `start`, which lies at parametric angle
@@ -96,26 +119,27 @@ impl EllipseInterp {
         if a <= 0 || b <= 0 {
             return Err(ArcError::ZeroRadius);
         }
-        if a > MAX_RADIUS_STEPS || b > MAX_RADIUS_STEPS {
+        if a > MAX_ELLIPSE_AXIS_STEPS || b > MAX_ELLIPSE_AXIS_STEPS {
             return Err(ArcError::TooLarge);
         }
-        let (t, sweep, af, bf) = (start_angle_rad as f64, sweep_rad as f64, a as f64, b as f64);
-        let s = (round(af * libm::cos(t)), round(bf * libm::sin(t)));
+        let (af, bf) = (a as f32, b as f32);
+        let (sin, cos) = math::sin_cos(start_angle_rad);
+        let from = (af * cos, bf * sin);
+        let s = (round(from.0), round(from.1));
         if s == (0, 0) {
             return Err(ArcError::ZeroRadius);
         }
         let center = point_at(start, (-s.0, -s.1))?;
-        let rotation = if sweep < 0.0 { Rotation::Clockwise } else { Rotation::CounterClockwise };
-        let (e, plan) = if libm::fabs(sweep) >= core::f64::consts::TAU {
-            (s, Plan::ToEnd { near: (s.0 as f64, s.1 as f64) })
+        let rotation = if sweep_rad < 0.0 { Rotation::Clockwise } else { Rotation::CounterClockwise };
+        let (e, plan) = if sweep_rad.abs() >= core::f32::consts::TAU {
+            (s, Plan::ToEnd { near: (s.0 as i64 * GATE_SCALE, s.1 as i64 * GATE_SCALE) })
         } else {
             // The ideal arc, between the requested parametric angles; the lattice start and
             // end are its ends rounded.
-            let from = (af * libm::cos(t), bf * libm::sin(t));
-            let end_param = t + sweep;
-            let to = (af * libm::cos(end_param), bf * libm::sin(end_param));
+            let (sin, cos) = math::sin_cos(start_angle_rad + sweep_rad);
+            let to = (af * cos, bf * sin);
             let e = (round(to.0), round(to.1));
-            (e, Plan::between(from, to, sweep, e == s))
+            (e, Plan::between(from, to, sweep_rad, e == s))
         };
         if e == (0, 0) {
             // Cannot happen with semi-axes of a step or more (one of |a·cos|, |b·sin| is at
@@ -128,8 +152,8 @@ impl EllipseInterp {
 
     #[allow(clippy::too_many_arguments)]
     fn build(
-        s: (i64, i64),
-        e: (i64, i64),
+        s: (i32, i32),
+        e: (i32, i32),
         a: i32,
         b: i32,
         center: Point,
@@ -139,8 +163,9 @@ impl EllipseInterp {
         plan: Plan,
     ) -> Self {
         let (a2, b2) = (a as i64 * a as i64, b as i64 * b as i64);
-        let c = a2 as i128 * b2 as i128;
-        let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a as i64, b as i64), rotation, method);
+        // a²b² modulo 2⁶⁴; the tracer only ever needs F near the curve, which fits.
+        let c = a2.wrapping_mul(b2);
+        let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a, b), rotation, method);
         EllipseInterp { tracer, center, end, rotation }
     }
 
@@ -170,71 +195,146 @@ impl Interpolator for EllipseInterp {
     }
 }
 
-/// Euclidean distance from `(x, y)` (relative to the centre) to the ellipse with semi-axes
-/// `a` along X and `b` along Y (both > 0).
-pub fn distance_to_ellipse(a: f64, b: f64, x: f64, y: f64) -> f64 {
-    let (px, py) = nearest_on_ellipse(a, b, x, y);
-    libm::hypot(px - x, py - y)
+/// [`foot`] of `p`, if `p` lies within [`ARC_END_TOLERANCE_STEPS`] of the ellipse.
+fn foot_within_tolerance(a: i32, b: i32, p: (i64, i64)) -> Option<(f32, f32)> {
+    let tol = ARC_END_TOLERANCE_STEPS as i64;
+    // The ellipse lies within |x| <= a, |y| <= b.
+    if p.0.abs() > a as i64 + tol || p.1.abs() > b as i64 + tol {
+        return None;
+    }
+    let d = foot(a, b, p);
+    if math::hypot(d.0, d.1) <= ARC_END_TOLERANCE_STEPS as f32 { Some(d) } else { None }
 }
 
-/// The point of the ellipse with semi-axes `a` along X and `b` along Y (both > 0) nearest to
-/// `(x, y)` (relative to the centre); in the same closed quadrant (a zero coordinate counts as
-/// positive where the nearest point leaves the axis).
+/// Euclidean distance from lattice point `p` (relative to the centre) to the ellipse with
+/// semi-axes `a` along X and `b` along Y (both > 0): the length of [`foot`].
+pub fn distance_to_ellipse(a: i32, b: i32, p: (i64, i64)) -> f32 {
+    let d = foot(a, b, p);
+    math::hypot(d.0, d.1)
+}
+
+/// From lattice point `p` (relative to the centre) to the point of the ellipse with semi-axes
+/// `a` along X and `b` along Y (both > 0) nearest to it: `nearest − p`. The nearest point lies
+/// in the same closed quadrant as `p` (a zero coordinate counts as positive where the nearest
+/// point leaves the axis).
 ///
-/// The nearest point `p` satisfies `p = (a²x/(t + a²), b²y/(t + b²))` for the root `t` of a
-/// monotone function, found by bisection (D. Eberly, "Distance from a Point to an Ellipse").
-pub fn nearest_on_ellipse(a: f64, b: f64, x: f64, y: f64) -> (f64, f64) {
+/// The nearest point is `(x/(1 + λb²), y/(1 + λa²))` for the root `λ` of a monotone function
+/// (D. Eberly, "Distance from a Point to an Ellipse", with `s = λ·a²` for `a >= b`), found by
+/// Newton's method. Written as `F(p)/(a²b²)` less terms that vanish at `λ = 0`, the function has
+/// no cancellation near the curve. To `f32`'s relative precision for points within twice the
+/// semi-axes; a few `f32` roundings of the coordinates beyond.
+pub fn foot(a: i32, b: i32, p: (i64, i64)) -> (f32, f32) {
     // Work in the first quadrant with the major axis first.
     let swap = a < b;
-    let (e0, e1, y0, y1) =
-        if swap { (b, a, libm::fabs(y), libm::fabs(x)) } else { (a, b, libm::fabs(x), libm::fabs(y)) };
-    let (x0, x1) = if y1 > 0.0 {
-        if y0 > 0.0 {
-            let (z0, z1) = (y0 / e0, y1 / e1);
-            let g = z0 * z0 + z1 * z1 - 1.0;
-            if g == 0.0 {
-                (y0, y1)
-            } else {
-                let r0 = (e0 / e1) * (e0 / e1);
-                let s = root(r0, z0, z1, g);
-                (r0 * y0 / (s + r0), y1 / (s + 1.0))
-            }
+    let (e0, e1) = if swap { (b as i64, a as i64) } else { (a as i64, b as i64) };
+    let (y0, y1) = if swap { (p.1.abs(), p.0.abs()) } else { (p.0.abs(), p.1.abs()) };
+    let (d0, d1) = if y1 > 0 {
+        if y0 > 0 {
+            foot_off_axes(e0, e1, y0, y1)
         } else {
-            (0.0, e1)
+            // On the minor axis: the minor vertex.
+            (0.0, (e1 - y1) as f32)
         }
     } else {
+        // On the major axis: off it toward (e0·ξ, e1·√(1 − ξ²)) when inside the evolute,
+        // else the major vertex.
         let (numer, denom) = (e0 * y0, e0 * e0 - e1 * e1);
         if numer < denom {
-            let xde0 = numer / denom;
-            (e0 * xde0, e1 * libm::sqrt(1.0 - xde0 * xde0))
+            let xi = numer as f32 / denom as f32;
+            let one_less_xi = (denom - numer) as f32 / denom as f32;
+            (y0 as f32 * (e1 * e1) as f32 / denom as f32, e1 as f32 * math::sqrt(one_less_xi * (1.0 + xi)))
         } else {
-            (e0, 0.0)
+            ((e0 - y0) as f32, 0.0)
         }
     };
-    let (px, py) = if swap { (x1, x0) } else { (x0, x1) };
-    (libm::copysign(px, if x < 0.0 { -1.0 } else { 1.0 }), libm::copysign(py, if y < 0.0 { -1.0 } else { 1.0 }))
+    let (dx, dy) = if swap { (d1, d0) } else { (d0, d1) };
+    (if p.0 < 0 { -dx } else { dx }, if p.1 < 0 { -dy } else { dy })
 }
 
-/// The root `s` of `(r0·z0/(s + r0))² + (z1/(s + 1))² = 1` by bisection.
-fn root(r0: f64, z0: f64, z1: f64, g: f64) -> f64 {
-    let n0 = r0 * z0;
-    let mut s0 = z1 - 1.0;
-    let mut s1 = if g < 0.0 { 0.0 } else { libm::hypot(n0, z1) - 1.0 };
-    let mut s = 0.0;
-    for _ in 0..DISTANCE_ITERATIONS {
-        s = 0.5 * (s0 + s1);
-        if s == s0 || s == s1 {
+/// [`foot`] of `(y0, y1)`, both positive, for the ellipse with semi-axes `e0 >= e1` along them.
+fn foot_off_axes(e0: i64, e1: i64, y0: i64, y1: i64) -> (f32, f32) {
+    let (e0f, e1f, y0f, y1f) = (e0 as f32, e1 as f32, y0 as f32, y1 as f32);
+    let (z0, z1) = (y0f / e0f, y1f / e1f);
+    let r0 = (e0f / e1f) * (e0f / e1f);
+    // z0² + z1² − 1, z0² − 1 and z1² − 1, each from exact integers.
+    let sums = Sums {
+        both: residual(e0, e1, y0, y1) / ((e0f * e1f) * (e0f * e1f)),
+        first: (y0 - e0) as f32 * (y0 + e0) as f32 / (e0f * e0f),
+        second: (y1 - e1) as f32 * (y1 + e1) as f32 / (e1f * e1f),
+    };
+    let s = root(r0, z0, z1, &sums, e0 as f32 * (y0 - e0) as f32 / (e1f * e1f));
+    let u0 = s / r0;
+    (-y0f * u0 / (1.0 + u0), -y1f * s / (1.0 + s))
+}
+
+/// `F = e1²·y0² + e0²·y1² − e0²e1²` as `f32`: computed exactly in integers near the curve
+/// (see [`EXACT_RESIDUAL_MAX`]), estimated in `f32` farther out.
+fn residual(e0: i64, e1: i64, y0: i64, y1: i64) -> f32 {
+    let (e0s, e1s) = (e0 * e0, e1 * e1);
+    let (y0f, y1f) = (y0 as f32, y1 as f32);
+    let estimate = e1s as f32 * (y0f * y0f) + e0s as f32 * (y1f * y1f) - e0s as f32 * e1s as f32;
+    if y0 <= 2 * e0 && y1 <= 2 * e1 && estimate.abs() <= EXACT_RESIDUAL_MAX {
+        let f = e1s.wrapping_mul(y0 * y0).wrapping_add(e0s.wrapping_mul(y1 * y1)).wrapping_sub(e0s.wrapping_mul(e1s));
+        f as f32
+    } else {
+        estimate
+    }
+}
+
+/// The constant parts of [`root`]'s function: `z0² + z1² − 1`, `z0² − 1`, `z1² − 1`.
+struct Sums {
+    both: f32,
+    first: f32,
+    second: f32,
+}
+
+/// Below this `u`, `φ(u) = 1 − 1/(1 + u)²` is smaller than `1/(1 + u)²` (`√2 − 1`).
+const PHI_SMALLER_BELOW: f32 = core::f32::consts::SQRT_2 - 1.0;
+
+/// The root `s > −1` of `G(s) = z0²·w0² + z1²·w1² − 1` with `w0 = 1/(1 + s/r0)`,
+/// `w1 = 1/(1 + s)` (`z1 > 0`, `r0 >= 1`): Eberly's function. Near `s = 0` its terms nearly
+/// cancel, so each term is written in the smaller of its two forms, `z²·w²` or
+/// `z² − z²·φ(u)` with `φ(u) = 1 − w² = u·(2 + u)·w²`, and the `z²` of the second forms are
+/// summed with the −1 beforehand, exactly ([`Sums`]). Every piece is then no larger than `G`'s
+/// own scale and `f32` rounding moves the root by a relative `10⁻⁷`.
+///
+/// `G` falls and is convex on `(−1, ∞)`, so Newton's method from a point left of the root
+/// climbs to it without overshooting. The root lies right of `r0·(z0 − 1)` (`bound0`, passed in
+/// from exact integers) and of `z1 − 1` (each term of `G` is at most 1 at the root), and right of
+/// 0 when `G(0) >= 0`; when `G(0) < 0` the Newton step from 0 lands left of it (convexity).
+// Written `!(value > 0.0)` on purpose: a NaN must stop the search.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn root(r0: f32, z0: f32, z1: f32, sums: &Sums, bound0: f32) -> f32 {
+    let (a0, a1) = (z0 * z0, z1 * z1);
+    let eval = |s: f32| {
+        let u = s / r0;
+        let (w0, w1) = (1.0 / (1.0 + u), 1.0 / (1.0 + s));
+        let (t0, phi0) =
+            if u < PHI_SMALLER_BELOW { (-a0 * u * (2.0 + u) * w0 * w0, true) } else { (a0 * w0 * w0, false) };
+        let (t1, phi1) =
+            if s < PHI_SMALLER_BELOW { (-a1 * s * (2.0 + s) * w1 * w1, true) } else { (a1 * w1 * w1, false) };
+        let k = match (phi0, phi1) {
+            (true, true) => sums.both,
+            (true, false) => sums.first,
+            (false, true) => sums.second,
+            (false, false) => -1.0,
+        };
+        let slope = -2.0 * (a0 * w0 * w0 * w0 / r0 + a1 * w1 * w1 * w1);
+        (k + t0 + t1, slope)
+    };
+    let g = sums.both;
+    let from_zero = if g >= 0.0 { 0.0 } else { g / (2.0 * (a0 / r0 + a1)) };
+    let mut s = math::max(math::max(from_zero, bound0), sums.second / (z1 + 1.0));
+    for _ in 0..ROOT_ITERATIONS_MAX {
+        let (value, slope) = eval(s);
+        if !(value > 0.0) {
             break;
         }
-        let (ratio0, ratio1) = (n0 / (s + r0), z1 / (s + 1.0));
-        let g = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
-        if g > 0.0 {
-            s0 = s;
-        } else if g < 0.0 {
-            s1 = s;
-        } else {
+        let next = s - value / slope;
+        if !(next > s) {
             break;
         }
+        s = next;
     }
     s
 }

@@ -451,7 +451,7 @@ proptest! {
         let (c, method, rotation) = (Point::new(cx, cy), if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
         let start = Point::new(cx + sx, cy + sy);
         let r = libm::sqrt((sx * sx + sy * sy) as f64);
-        let end = Point::new(cx + round(r * libm::cos(end_angle)) as i32, cy + round(r * libm::sin(end_angle)) as i32);
+        let end = Point::new(cx + libm::round(r * libm::cos(end_angle)) as i32, cy + libm::round(r * libm::sin(end_angle)) as i32);
         let mut arc = ArcInterp::new(start, c, end, rotation, method).unwrap();
         let w = trace(&mut arc, start, method);
         check_arc(&w, start, c, end, rotation, method);

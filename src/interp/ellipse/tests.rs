@@ -1,12 +1,91 @@
 extern crate std;
 use super::*;
 use crate::interp::arc::ArcInterp;
+use crate::interp::arc::offset;
 use crate::interp::conic::test_support::*;
 use Method::{Classic, Diagonal};
 use Rotation::{Clockwise as Cw, CounterClockwise as Ccw};
 use core::f64::consts::{FRAC_PI_2, PI, TAU};
 use proptest::prelude::*;
+use reference::{distance_to_ellipse, nearest_on_ellipse};
 use std::vec::Vec;
+
+/// The distance and nearest point in `f64` (as the firmware computed them before it went
+/// single precision): the tests' measure of how far a point lies from an ellipse, itself
+/// checked against brute force below.
+mod reference {
+    /// Bisection rounds of [`root`]; enough to exhaust `f64` precision.
+    const DISTANCE_ITERATIONS: u32 = 200;
+
+    /// Euclidean distance from `(x, y)` (relative to the centre) to the ellipse with semi-axes
+    /// `a` along X and `b` along Y (both > 0).
+    pub(super) fn distance_to_ellipse(a: f64, b: f64, x: f64, y: f64) -> f64 {
+        let (px, py) = nearest_on_ellipse(a, b, x, y);
+        libm::hypot(px - x, py - y)
+    }
+
+    /// The point of the ellipse with semi-axes `a` along X and `b` along Y (both > 0) nearest to
+    /// `(x, y)` (relative to the centre); in the same closed quadrant (a zero coordinate counts as
+    /// positive where the nearest point leaves the axis).
+    ///
+    /// The nearest point `p` satisfies `p = (a²x/(t + a²), b²y/(t + b²))` for the root `t` of a
+    /// monotone function, found by bisection (D. Eberly, "Distance from a Point to an Ellipse").
+    pub(super) fn nearest_on_ellipse(a: f64, b: f64, x: f64, y: f64) -> (f64, f64) {
+        // Work in the first quadrant with the major axis first.
+        let swap = a < b;
+        let (e0, e1, y0, y1) =
+            if swap { (b, a, libm::fabs(y), libm::fabs(x)) } else { (a, b, libm::fabs(x), libm::fabs(y)) };
+        let (x0, x1) = if y1 > 0.0 {
+            if y0 > 0.0 {
+                let (z0, z1) = (y0 / e0, y1 / e1);
+                let g = z0 * z0 + z1 * z1 - 1.0;
+                if g == 0.0 {
+                    (y0, y1)
+                } else {
+                    let r0 = (e0 / e1) * (e0 / e1);
+                    let s = root(r0, z0, z1, g);
+                    (r0 * y0 / (s + r0), y1 / (s + 1.0))
+                }
+            } else {
+                (0.0, e1)
+            }
+        } else {
+            let (numer, denom) = (e0 * y0, e0 * e0 - e1 * e1);
+            if numer < denom {
+                let xde0 = numer / denom;
+                (e0 * xde0, e1 * libm::sqrt(1.0 - xde0 * xde0))
+            } else {
+                (e0, 0.0)
+            }
+        };
+        let (px, py) = if swap { (x1, x0) } else { (x0, x1) };
+        (libm::copysign(px, if x < 0.0 { -1.0 } else { 1.0 }), libm::copysign(py, if y < 0.0 { -1.0 } else { 1.0 }))
+    }
+
+    /// The root `s` of `(r0·z0/(s + r0))² + (z1/(s + 1))² = 1` by bisection.
+    fn root(r0: f64, z0: f64, z1: f64, g: f64) -> f64 {
+        let n0 = r0 * z0;
+        let mut s0 = z1 - 1.0;
+        let mut s1 = if g < 0.0 { 0.0 } else { libm::hypot(n0, z1) - 1.0 };
+        let mut s = 0.0;
+        for _ in 0..DISTANCE_ITERATIONS {
+            s = 0.5 * (s0 + s1);
+            if s == s0 || s == s1 {
+                break;
+            }
+            let (ratio0, ratio1) = (n0 / (s + r0), z1 / (s + 1.0));
+            let g = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
+            if g > 0.0 {
+                s0 = s;
+            } else if g < 0.0 {
+                s1 = s;
+            } else {
+                break;
+            }
+        }
+        s
+    }
+}
 
 impl EllipseInterp {
     fn tail_steps(&self) -> u32 {
@@ -149,20 +228,28 @@ fn check(
     );
 }
 
+/// The distance to an ellipse by brute force: a fine parametric sampling refined by ternary
+/// search.
+fn brute_distance(a: f64, b: f64, x: f64, y: f64) -> f64 {
+    let d = |t: f64| libm::hypot(a * libm::cos(t) - x, b * libm::sin(t) - y);
+    let n = 20_000;
+    let k = (0..n).min_by(|i, j| d(TAU * *i as f64 / n as f64).total_cmp(&d(TAU * *j as f64 / n as f64))).unwrap();
+    let (mut lo, mut hi) = (TAU * (k as f64 - 1.0) / n as f64, TAU * (k as f64 + 1.0) / n as f64);
+    for _ in 0..200 {
+        let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+        if d(m1) < d(m2) { hi = m2 } else { lo = m1 }
+    }
+    d(0.5 * (lo + hi))
+}
+
+/// How far the firmware's `f32` distance may be from the true one: `f32`'s relative precision
+/// on the distance itself, whatever the size of the ellipse.
+fn f32_distance_tolerance(want: f64) -> f64 {
+    2e-6 * want.max(1.0)
+}
+
 #[test]
 fn the_distance_to_an_ellipse_is_the_true_euclidean_distance() {
-    // Against a brute-force minimum over a fine parametric sampling, refined by ternary search.
-    let brute = |a: f64, b: f64, x: f64, y: f64| {
-        let d = |t: f64| libm::hypot(a * libm::cos(t) - x, b * libm::sin(t) - y);
-        let n = 20_000;
-        let k = (0..n).min_by(|i, j| d(TAU * *i as f64 / n as f64).total_cmp(&d(TAU * *j as f64 / n as f64))).unwrap();
-        let (mut lo, mut hi) = (TAU * (k as f64 - 1.0) / n as f64, TAU * (k as f64 + 1.0) / n as f64);
-        for _ in 0..200 {
-            let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-            if d(m1) < d(m2) { hi = m2 } else { lo = m1 }
-        }
-        d(0.5 * (lo + hi))
-    };
     let cases = [
         (5.0, 3.0, 6.0, 1.0),
         (5.0, 3.0, 0.0, 0.0),
@@ -177,8 +264,65 @@ fn the_distance_to_an_ellipse_is_the_true_euclidean_distance() {
         (2.0, 1.0, 1.0, 0.0),
     ];
     for (a, b, x, y) in cases {
-        let (got, want) = (distance_to_ellipse(a, b, x, y), brute(a, b, x, y));
+        let (got, want) = (distance_to_ellipse(a, b, x, y), brute_distance(a, b, x, y));
         assert!((got - want).abs() <= 1e-6 * want.max(1.0), "a {a} b {b} ({x}, {y}): {got} vs {want}");
+    }
+    // The firmware's, at lattice points: the cases above (scaled to the lattice where they were
+    // fractional), points off the axes, on them, inside thin ellipses and far away, and points
+    // near the largest ellipses, where `f32` coordinates are coarse (1/64 step) but the
+    // distance must not be.
+    let m = MAX_ELLIPSE_AXIS_STEPS;
+    let lattice: [(i32, i32, i64, i64); 22] = [
+        (5, 3, 6, 1),
+        (5, 3, 0, 0),
+        (5, 3, 4, 0),
+        (10, 6, 0, -5),
+        (3, 5, 1, 4),
+        (100, 1, 99, 1),
+        (1000, 10, -500, 3),
+        (10, 1000, 2, -990),
+        (7, 7, 3, 4),
+        (200_000, 100_000, 150_001, 66_143),
+        (2, 1, 1, 0),
+        (300, 2, 0, 0),
+        (300, 2, -299, 0),
+        (300, 2, 290, 1),
+        (5, 3, 60, -70),
+        (5, 3, 1 << 31, -(1 << 31)),
+        (m, m, m as i64 + 2, 0),
+        (m, m - 1, 185_363, -185_363),
+        (m, m / 2, 185_364, 92_682),
+        (m, 7, -m as i64 + 1, 1),
+        (1, m, 1, m as i64 - 3),
+        (m, 100_000, 0, -100_001),
+    ];
+    for (a, b, x, y) in lattice {
+        let want = brute_distance(a as f64, b as f64, x as f64, y as f64);
+        let got = super::distance_to_ellipse(a, b, (x, y)) as f64;
+        assert!((got - want).abs() <= f32_distance_tolerance(want), "a {a} b {b} ({x}, {y}): {got} vs {want}");
+    }
+}
+
+#[test]
+fn the_nearest_point_is_exact_near_the_largest_ellipses() {
+    // Every lattice point within two steps of sampled points of large ellipses: the offset to the
+    // nearest point against the `f64` reference.
+    let m = MAX_ELLIPSE_AXIS_STEPS;
+    for (a, b) in [(m, m), (m, m - 1), (m, m / 3), (m / 3, m), (m, 1), (3, m), (150_001, 149_999)] {
+        for k in 0..97 {
+            let t = TAU * k as f64 / 97.0 + 0.001;
+            let (cx, cy) = (libm::round(a as f64 * libm::cos(t)) as i64, libm::round(b as f64 * libm::sin(t)) as i64);
+            for dx in -2..=2 {
+                for dy in -2..=2 {
+                    let (x, y) = (cx + dx, cy + dy);
+                    let (nx, ny) = nearest_on_ellipse(a as f64, b as f64, x as f64, y as f64);
+                    let want = (nx - x as f64, ny - y as f64);
+                    let got = foot(a, b, (x, y));
+                    let err = libm::hypot(got.0 as f64 - want.0, got.1 as f64 - want.1);
+                    assert!(err <= 1e-5, "a {a} b {b} ({x}, {y}): {got:?} vs {want:?}");
+                }
+            }
+        }
     }
 }
 
@@ -340,7 +484,7 @@ fn bad_ellipses_are_refused() {
     assert_eq!(EllipseInterp::new(s, c, 10, 5, Point::new(0, 8), Ccw, Classic).err(), Some(ArcError::EndOffCurve));
     assert_eq!(EllipseInterp::new(s, c, 10, 5, Point::new(0, 7), Cw, Diagonal).map(|e| e.end()), Ok(Point::new(0, 7)));
     assert_eq!(EllipseInterp::new(Point::new(2, 0), c, 2, 1, c, Ccw, Classic).err(), Some(ArcError::EndOffCurve));
-    let far = MAX_RADIUS_STEPS + 1;
+    let far = MAX_ELLIPSE_AXIS_STEPS + 1;
     assert_eq!(EllipseInterp::new(Point::new(far, 0), c, far, 5, s, Ccw, Classic).err(), Some(ArcError::TooLarge));
     let corner = Point::new(i32::MIN, i32::MAX);
     assert_eq!(
@@ -415,10 +559,10 @@ fn the_largest_ellipses_do_not_overflow() {
         (100_000, 200_000, Point::new(-100_000, -100_000), Point::new(-100_000, -100_000), Cw),
         (200_000, 1, Point::new(100_000, 100_000), Point::new(-300_000, 100_000), Cw),
         (
-            MAX_RADIUS_STEPS,
-            MAX_RADIUS_STEPS / 2,
-            Point::new(c.x + MAX_RADIUS_STEPS, c.y),
-            Point::new(c.x, c.y + MAX_RADIUS_STEPS / 2),
+            MAX_ELLIPSE_AXIS_STEPS,
+            MAX_ELLIPSE_AXIS_STEPS / 2,
+            Point::new(c.x + MAX_ELLIPSE_AXIS_STEPS, c.y),
+            Point::new(c.x, c.y + MAX_ELLIPSE_AXIS_STEPS / 2),
             Ccw,
         ),
     ];
@@ -439,7 +583,7 @@ fn the_largest_ellipses_do_not_overflow() {
 }
 
 fn rounded(c: Point, a: i32, b: i32, t: f64) -> Point {
-    Point::new(c.x + round(a as f64 * libm::cos(t)) as i32, c.y + round(b as f64 * libm::sin(t)) as i32)
+    Point::new(c.x + libm::round(a as f64 * libm::cos(t)) as i32, c.y + libm::round(b as f64 * libm::sin(t)) as i32)
 }
 
 proptest! {
