@@ -11,7 +11,7 @@
 
 use crate::geom::{Point, Rotation, Step};
 use crate::interp::conic::{GATE_SCALE, Plan, Tracer};
-use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
 use crate::math;
 
 #[cfg(test)]
@@ -178,15 +178,25 @@ impl ArcInterp {
     pub fn rotation(&self) -> Rotation {
         self.rotation
     }
+
+    /// The tracer, for tests that step it by the rules alone.
+    #[cfg(test)]
+    pub(crate) fn tracer(&self) -> &Tracer {
+        &self.tracer
+    }
 }
 
 impl Interpolator for ArcInterp {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
-        Ok(self.tracer.next())
+        Ok(self.tracer.next_step())
     }
 
     fn tangent(&self) -> Tangent {
         self.tracer.tangent()
+    }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        self.tracer.fill(out)
     }
 }
 

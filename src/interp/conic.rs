@@ -39,6 +39,31 @@
 //! radius, a step budget caps the curve part, and the straight finish shortens the distance to
 //! the end with every step, so a trace always ends, exactly on its end point.
 //!
+//! # Batches
+//!
+//! [`Tracer::step`] takes one step by the rules above, checking everything at every step.
+//! [`Tracer::fill`] takes the very same steps, most of them in a tight loop, and
+//! [`Tracer::next_step`] is `fill` with a buffer of one. Strictly inside a
+//! quadrant (off both axes) only the curve rule matters, and it is the same in every quadrant
+//! once the quadrant is turned onto the first one: in that quadrant's own frame `(u, v)`
+//! (`u > 0`, `v >= 0`, travel counter-clockwise, weights `wu`, `wv`) the inward move is always
+//! −u, the outward one +v. With `du = wu·(1 − 2u)` and `dv = wv·(2v + 1)`, the changes of `F`
+//! for those moves, classic steps −u when `F >= 0`, else +v. Diagonal, with `D = 4·(F + du + dv)`
+//! (four times `F` at the diagonal point), steps −u when `D > 2dv + wv`, +v when
+//! `D < 2du + wu`, and both otherwise: the midpoint tests above, rearranged. `D` and both
+//! thresholds change by additions of constants, so a step is two comparisons and a few
+//! additions.
+//!
+//! The loop runs only where nothing else can happen, for a count of "quiet" steps worked out
+//! before it starts: fewer than `u − 1` steps cannot reach the next axis, fewer than the
+//! Chebyshev distance to the end point cannot land on it, a step moves a point's [`Gate`] value
+//! by at most `GATE_SCALE·(|along.x| + |along.y|)` so a point well behind the gate cannot pass
+//! it within the next few steps, and the budget is counted down. Such a run (`Run`: the point
+//! in the quadrant's frame, `F` or `D`, the two changes or thresholds) lasts across batches
+//! until its count is used up, so a batch only loads it, loops and stores it back. Everything
+//! else (points on an axis, climbing a tip, crossing into the next quadrant, the last steps
+//! before the gate, the straight finish) goes through [`Tracer::step`].
+//!
 //! # Arithmetic
 //!
 //! Everything the tracer keeps per step is `i64`; no step needs wider arithmetic. The bound:
@@ -52,8 +77,13 @@
 //! - circles (`W = 1`, `S <= √2·MAX_RADIUS_STEPS < 2²¹`): `|F| < 2²⁶`, every quantity below
 //!   `2³⁰`;
 //! - ellipses (`W <= 2³⁶`, `S <= MAX_ELLIPSE_AXIS_STEPS = 2¹⁸`): `|F| <= 2⁵⁵·8 + 2³⁶·64 < 2^58.01`,
-//!   `4F` (the midpoint tests) `< 2^60.02`, the terms `w·(4c + 1)` added to it `< 2^56.01`: all
-//!   well inside `i64` (`2⁶³`).
+//!   `D = 4F < 2^60.02`, the thresholds `w·(4c + 3) < 2^56.01`, the changes of `D`
+//!   (`2·threshold + 6w`) `< 2^57.1`: all well inside `i64` (`2⁶³`).
+//!
+//! A quiet run's values (`F` or `D`, the changes, the thresholds and the sums the loop forms)
+//! stay below `396·W·S` in magnitude, so where `W·S <= 2²²` ([`run::NARROW_SIZE_MAX`]: every
+//! circle, ellipses up to about 160 steps) the loop computes in `i32`, which the Cortex-M4 does
+//! in one instruction per operation and with half the registers.
 //!
 //! `c = a²b²` itself does not fit (up to `2⁷²`): it is kept modulo `2⁶⁴`, and `F` at the start
 //! and at the end (the only places it is computed from scratch) is evaluated with wrapping
@@ -63,11 +93,14 @@
 //! wrapping arithmetic, so the worst that can happen there is a less well chosen finishing step.
 
 use crate::geom::{Rotation, Step};
-use crate::interp::{Method, Tangent};
+use crate::interp::{Filled, Method, Tangent};
 use crate::math;
 
+mod run;
 #[cfg(test)]
 pub(crate) mod test_support;
+#[cfg(test)]
+mod tests;
 
 /// Extra steps per quadrant in the curve budget, beyond the semi-axes, for starts off the curve.
 const QUARTER_SLACK_STEPS: u32 = 8;
@@ -77,6 +110,11 @@ pub(crate) const GATE_SCALE: i64 = 1024;
 
 /// Scale of [`Gate`]'s unit direction.
 const GATE_DIRECTION_SCALE: f32 = 1_048_576.0;
+
+/// One step changes a [`Gate`] value by at most `GATE_SCALE·(|along.x| + |along.y|)`, less than
+/// `2^GATE_STEP_SHIFT` (`|along.x| + |along.y| <= √2·GATE_DIRECTION_SCALE + 1 < 2²¹`): a value
+/// of `−g` is at least `g >> GATE_STEP_SHIFT` steps behind the gate.
+const GATE_STEP_SHIFT: u32 = 31;
 
 /// A point in 1/[`GATE_SCALE`] step, relative to the centre.
 pub(crate) type Fine = (i64, i64);
@@ -148,6 +186,27 @@ fn quadrant_f(p: (f32, f32)) -> u8 {
         2
     } else {
         3
+    }
+}
+
+/// `(x, y)` in the own frame `(u, v)` of quadrant `q`: the quadrant turned onto the first one,
+/// so that its points have `u > 0`, `v >= 0`.
+fn to_local(q: u8, x: i32, y: i32) -> (i32, i32) {
+    match q {
+        0 => (x, y),
+        1 => (y, -x),
+        2 => (-x, -y),
+        _ => (-y, x),
+    }
+}
+
+/// The inverse of [`to_local`].
+fn from_local(q: u8, u: i32, v: i32) -> (i32, i32) {
+    match q {
+        0 => (u, v),
+        1 => (-v, u),
+        2 => (-u, -v),
+        _ => (v, -u),
     }
 }
 
@@ -277,10 +336,17 @@ pub(crate) struct Tracer {
     /// Curve steps left before the tracer gives up following the curve (never reached by a
     /// correct trace; a guarantee of termination).
     budget: u32,
-    /// The previous move (frame coordinates).
+    /// The previous move (frame coordinates); during a quiet run brought up to date only when
+    /// the run ends (it only matters on an axis, and a run neither starts nor ends on one).
     last: (i32, i32),
     /// Steps taken by the straight finish so far.
     tail_steps: u32,
+    /// Quiet steps left in the run under way (see the module documentation); 0 outside runs.
+    /// During a run `f` is not kept: `run` holds the state.
+    quiet: u32,
+    run: run::Run,
+    /// Quiet runs compute in `i32` (see [`run::NARROW_SIZE_MAX`]).
+    narrow: bool,
 }
 
 impl Tracer {
@@ -389,11 +455,48 @@ impl Tracer {
             budget: 4 * (needed as u32 + 1) * quarter,
             last,
             tail_steps: 0,
+            quiet: 0,
+            run: run::Run::default(),
+            narrow: wx.max(wy) * half_axes.0.max(half_axes.1) as i64 <= run::NARROW_SIZE_MAX,
         }
     }
 
-    /// The next step in machine coordinates, `None` at the end.
-    pub(crate) fn next(&mut self) -> Option<Step> {
+    /// The next step in machine coordinates, `None` at the end: [`fill`](Self::fill) with a
+    /// buffer of one.
+    pub(crate) fn next_step(&mut self) -> Option<Step> {
+        let mut one = [Step::NONE];
+        if self.fill(&mut one).steps == 1 { Some(one[0]) } else { None }
+    }
+
+    /// Writes the next steps into `out`, exactly those [`step`](Self::step) would take one by
+    /// one, until `out` is full or the trace ends.
+    pub(crate) fn fill(&mut self, out: &mut [Step]) -> Filled {
+        let mut i = 0;
+        while i < out.len() {
+            if self.quiet == 0 {
+                self.quiet = self.begin_run();
+            }
+            if self.quiet > 0 {
+                let n = (self.quiet as usize).min(out.len() - i);
+                self.run(&mut out[i..i + n]);
+                i += n;
+            } else {
+                match self.step() {
+                    Some(step) => {
+                        out[i] = step;
+                        i += 1;
+                    }
+                    None => return Filled { steps: i, end: Some(Ok(())) },
+                }
+            }
+        }
+        Filled { steps: i, end: if self.phase == Phase::Done { Some(Ok(())) } else { None } }
+    }
+
+    /// One step by the rules, checking everything: the reference the quiet runs follow. Never
+    /// during a run.
+    pub(crate) fn step(&mut self) -> Option<Step> {
+        debug_assert_eq!(self.quiet, 0, "a step by the rules during a quiet run");
         match self.phase {
             Phase::Done => None,
             Phase::Tail => self.tail_step(),
@@ -422,7 +525,7 @@ impl Tracer {
     /// `F` at the current point.
     #[cfg(test)]
     pub(crate) fn discriminant(&self) -> i64 {
-        self.f
+        if self.quiet > 0 { self.run_discriminant() } else { self.f }
     }
 
     /// Steps taken by the straight finish so far.

@@ -24,7 +24,7 @@
 use crate::geom::{Point, Rotation, Step};
 use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset, point_at, round};
 use crate::interp::conic::{GATE_SCALE, Plan, Tracer};
-use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
 use crate::math;
 
 #[cfg(test)]
@@ -183,15 +183,25 @@ impl EllipseInterp {
     pub fn rotation(&self) -> Rotation {
         self.rotation
     }
+
+    /// The tracer, for tests that step it by the rules alone.
+    #[cfg(test)]
+    pub(crate) fn tracer(&self) -> &Tracer {
+        &self.tracer
+    }
 }
 
 impl Interpolator for EllipseInterp {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
-        Ok(self.tracer.next())
+        Ok(self.tracer.next_step())
     }
 
     fn tangent(&self) -> Tangent {
         self.tracer.tangent()
+    }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        self.tracer.fill(out)
     }
 }
 
