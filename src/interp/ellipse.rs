@@ -1,29 +1,56 @@
-//! Axis-aligned ellipses and elliptic arcs by point-by-point comparison (逐点比较法).
+//! Axis-aligned ellipses and elliptic arcs: their setup (centre, semi-axes, how far the start
+//! and end lie from the curve, where the trace ends) and the nearest point of an ellipse. The
+//! stepping is the conic tracer's ([`crate::interp::conic`]).
 //!
 //! The ellipse with semi-axis `a` along X and `b` along Y is the zero set of
-//! `F = b²x² + a²y² − a²b²` around its centre. It is traced by the same rules as circles (see
-//! [`crate::interp::arc`]): `classic` steps one axis at a time, inward when `F >= 0` and
-//! outward otherwise (error <= 1 step, a full ellipse started on an axis takes `4(a + b)`
-//! steps); `diagonal` picks between the inward, outward and diagonal moves by a midpoint test
-//! (error <= 0.5 step, about `4·√(a² + b²)` steps for a full ellipse). `F` is kept in `i128`:
-//! `a²b²` reaches 10²⁴ at [`MAX_RADIUS_STEPS`]. Tips narrower than a step are climbed and
-//! come back along the axis instead of being cut off (see [`crate::interp::arc`]).
+//! `F = b²x² + a²y² − a²b²` around its centre. It is traced by the same rules as circles:
+//! `classic` steps one axis at a time, inward when `F >= 0` and outward otherwise (error <= 1
+//! step, a full ellipse started on an axis takes `4(a + b)` steps); `diagonal` picks between
+//! the inward, outward and diagonal moves by a midpoint test (error <= 0.5 step, about
+//! `4·√(a² + b²)` steps for a full ellipse). Tips narrower than a step are climbed and come
+//! back along the axis instead of being cut off. `F` grows with the cube of the ellipse's size,
+//! hence [`MAX_ELLIPSE_AXIS_STEPS`], which keeps every value of a trace inside `i64`.
 //!
 //! Start and end points are lattice points and so lie slightly off the ideal ellipse; both may
 //! be up to [`ARC_END_TOLERANCE_STEPS`] away (measured as the true Euclidean distance, see
-//! [`distance_to_ellipse`]). The trace ends exactly on the end point.
+//! [`foot`]). The trace ends exactly on the end point.
+//!
+//! Setup is `f32` and integer arithmetic only. The nearest point is found without the
+//! cancellation that `f32` would suffer near the curve (where `F` is a small difference of
+//! numbers up to 2⁷²): `F` itself is computed exactly in integers and the equation for the
+//! nearest point is written in terms of it, so the offset to the curve comes out to `f32`'s
+//! relative precision (about 10⁻⁶ step) for any size of ellipse.
 
 use crate::geom::{Point, Rotation, Step};
-use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, MAX_RADIUS_STEPS, Plan, Tracer, offset, point_at, round};
-use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset, point_at, round};
+use crate::interp::conic::{GATE_SCALE, Plan, Tracer};
+use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
+use crate::math;
 
-/// Bisection rounds of [`distance_to_ellipse`]; enough to exhaust `f64` precision.
-const DISTANCE_ITERATIONS: u32 = 200;
+#[cfg(test)]
+mod tests;
+
+/// Largest semi-axis of an ellipse, in steps: 2¹⁸ = 262_144, 1.3 m at 200 steps/mm, more than
+/// the machine's diagonal. `F` and its changes grow with the cube of the ellipse's size: at this
+/// limit every value a trace computes stays below 2⁶¹ (see [`crate::interp::conic`]); twice the
+/// limit would take them to the edge of `i64`. Circles of any radius up to
+/// [`MAX_RADIUS_STEPS`](crate::interp::arc::MAX_RADIUS_STEPS) are arcs, not ellipses.
+pub const MAX_ELLIPSE_AXIS_STEPS: i32 = 1 << 18;
+
+/// Most Newton steps of [`foot`]'s root search. Points near the curve take two to four; only
+/// points far inside a flat ellipse, near its long axis, take more.
+const ROOT_ITERATIONS_MAX: u32 = 64;
+
+/// `|F|` of a point within twice the semi-axes, as `f32`, up to which `F` is computed exactly:
+/// the `f32` estimate is then within 2⁵⁴ of `F`, so `|F| < 2⁶²` and its `i64` value, computed
+/// modulo 2⁶⁴, is exact. Farther from the curve the estimate is used (it has no cancellation
+/// there).
+const EXACT_RESIDUAL_MAX: f32 = 2_305_843_009_213_693_952.0; // 2⁶¹
 
 /// An ellipse or elliptic arc; see the module documentation.
 #[derive(Clone, Debug)]
 pub struct EllipseInterp {
-    tracer: Tracer<i128>,
+    tracer: Tracer,
     center: Point,
     end: Point,
     rotation: Rotation,
@@ -48,7 +75,7 @@ impl EllipseInterp {
         if a <= 0 || b <= 0 {
             return Err(ArcError::ZeroRadius);
         }
-        if a > MAX_RADIUS_STEPS || b > MAX_RADIUS_STEPS {
+        if a > MAX_ELLIPSE_AXIS_STEPS || b > MAX_ELLIPSE_AXIS_STEPS {
             return Err(ArcError::TooLarge);
         }
         let s = offset(start, center);
@@ -56,16 +83,16 @@ impl EllipseInterp {
         if s == (0, 0) {
             return Err(ArcError::ZeroRadius);
         }
-        let tol = ARC_END_TOLERANCE_STEPS as f64;
-        let (af, bf) = (a as f64, b as f64);
-        if distance_to_ellipse(af, bf, s.0 as f64, s.1 as f64) > tol {
+        if foot_within_tolerance(a, b, s).is_none() {
             return Err(ArcError::StartOffCurve);
         }
-        if e == (0, 0) || distance_to_ellipse(af, bf, e.0 as f64, e.1 as f64) > tol {
+        let Some(d) = foot_within_tolerance(a, b, e).filter(|_| e != (0, 0)) else {
             return Err(ArcError::EndOffCurve);
-        }
-        let plan = Plan::ToEnd { near: nearest_on_ellipse(af, bf, e.0 as f64, e.1 as f64) };
-        Ok(Self::build(s, e, a, b, center, end, rotation, method, plan))
+        };
+        let scale = GATE_SCALE as f32;
+        let near =
+            (e.0 * GATE_SCALE + math::round(d.0 * scale) as i64, e.1 * GATE_SCALE + math::round(d.1 * scale) as i64);
+        Ok(Self::build(narrow(s), narrow(e), a, b, center, end, rotation, method, Plan::ToEnd { near }))
     }
 
     /// An elliptic arc that starts at the pen point `start`, which lies at parametric angle
@@ -92,26 +119,27 @@ impl EllipseInterp {
         if a <= 0 || b <= 0 {
             return Err(ArcError::ZeroRadius);
         }
-        if a > MAX_RADIUS_STEPS || b > MAX_RADIUS_STEPS {
+        if a > MAX_ELLIPSE_AXIS_STEPS || b > MAX_ELLIPSE_AXIS_STEPS {
             return Err(ArcError::TooLarge);
         }
-        let (t, sweep, af, bf) = (start_angle_rad as f64, sweep_rad as f64, a as f64, b as f64);
-        let s = (round(af * libm::cos(t)), round(bf * libm::sin(t)));
+        let (af, bf) = (a as f32, b as f32);
+        let (sin, cos) = math::sin_cos(start_angle_rad);
+        let from = (af * cos, bf * sin);
+        let s = (round(from.0), round(from.1));
         if s == (0, 0) {
             return Err(ArcError::ZeroRadius);
         }
         let center = point_at(start, (-s.0, -s.1))?;
-        let rotation = if sweep < 0.0 { Rotation::Clockwise } else { Rotation::CounterClockwise };
-        let (e, plan) = if libm::fabs(sweep) >= core::f64::consts::TAU {
-            (s, Plan::ToEnd { near: (s.0 as f64, s.1 as f64) })
+        let rotation = if sweep_rad < 0.0 { Rotation::Clockwise } else { Rotation::CounterClockwise };
+        let (e, plan) = if sweep_rad.abs() >= core::f32::consts::TAU {
+            (s, Plan::ToEnd { near: (s.0 as i64 * GATE_SCALE, s.1 as i64 * GATE_SCALE) })
         } else {
             // The ideal arc, between the requested parametric angles; the lattice start and
             // end are its ends rounded.
-            let from = (af * libm::cos(t), bf * libm::sin(t));
-            let end_param = t + sweep;
-            let to = (af * libm::cos(end_param), bf * libm::sin(end_param));
+            let (sin, cos) = math::sin_cos(start_angle_rad + sweep_rad);
+            let to = (af * cos, bf * sin);
             let e = (round(to.0), round(to.1));
-            (e, Plan::between(from, to, sweep, e == s))
+            (e, Plan::between(from, to, sweep_rad, e == s))
         };
         if e == (0, 0) {
             // Cannot happen with semi-axes of a step or more (one of |a·cos|, |b·sin| is at
@@ -124,8 +152,8 @@ impl EllipseInterp {
 
     #[allow(clippy::too_many_arguments)]
     fn build(
-        s: (i64, i64),
-        e: (i64, i64),
+        s: (i32, i32),
+        e: (i32, i32),
         a: i32,
         b: i32,
         center: Point,
@@ -135,8 +163,9 @@ impl EllipseInterp {
         plan: Plan,
     ) -> Self {
         let (a2, b2) = (a as i64 * a as i64, b as i64 * b as i64);
-        let c = a2 as i128 * b2 as i128;
-        let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a as i64, b as i64), rotation, method);
+        // a²b² modulo 2⁶⁴; the tracer only ever needs F near the curve, which fits.
+        let c = a2.wrapping_mul(b2);
+        let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a, b), rotation, method);
         EllipseInterp { tracer, center, end, rotation }
     }
 
@@ -154,634 +183,168 @@ impl EllipseInterp {
     pub fn rotation(&self) -> Rotation {
         self.rotation
     }
+
+    /// The tracer, for tests that step it by the rules alone.
+    #[cfg(test)]
+    pub(crate) fn tracer(&self) -> &Tracer {
+        &self.tracer
+    }
 }
 
 impl Interpolator for EllipseInterp {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
-        Ok(self.tracer.next())
+        Ok(self.tracer.next_step())
     }
 
     fn tangent(&self) -> Tangent {
         self.tracer.tangent()
     }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        self.tracer.fill(out)
+    }
 }
 
-/// Euclidean distance from `(x, y)` (relative to the centre) to the ellipse with semi-axes
-/// `a` along X and `b` along Y (both > 0).
-pub fn distance_to_ellipse(a: f64, b: f64, x: f64, y: f64) -> f64 {
-    let (px, py) = nearest_on_ellipse(a, b, x, y);
-    libm::hypot(px - x, py - y)
+/// [`foot`] of `p`, if `p` lies within [`ARC_END_TOLERANCE_STEPS`] of the ellipse.
+fn foot_within_tolerance(a: i32, b: i32, p: (i64, i64)) -> Option<(f32, f32)> {
+    let tol = ARC_END_TOLERANCE_STEPS as i64;
+    // The ellipse lies within |x| <= a, |y| <= b.
+    if p.0.abs() > a as i64 + tol || p.1.abs() > b as i64 + tol {
+        return None;
+    }
+    let d = foot(a, b, p);
+    if math::hypot(d.0, d.1) <= ARC_END_TOLERANCE_STEPS as f32 { Some(d) } else { None }
 }
 
-/// The point of the ellipse with semi-axes `a` along X and `b` along Y (both > 0) nearest to
-/// `(x, y)` (relative to the centre); in the same closed quadrant (a zero coordinate counts as
-/// positive where the nearest point leaves the axis).
+/// Euclidean distance from lattice point `p` (relative to the centre) to the ellipse with
+/// semi-axes `a` along X and `b` along Y (both > 0): the length of [`foot`].
+pub fn distance_to_ellipse(a: i32, b: i32, p: (i64, i64)) -> f32 {
+    let d = foot(a, b, p);
+    math::hypot(d.0, d.1)
+}
+
+/// From lattice point `p` (relative to the centre) to the point of the ellipse with semi-axes
+/// `a` along X and `b` along Y (both > 0) nearest to it: `nearest − p`. The nearest point lies
+/// in the same closed quadrant as `p` (a zero coordinate counts as positive where the nearest
+/// point leaves the axis).
 ///
-/// The nearest point `p` satisfies `p = (a²x/(t + a²), b²y/(t + b²))` for the root `t` of a
-/// monotone function, found by bisection (D. Eberly, "Distance from a Point to an Ellipse").
-pub fn nearest_on_ellipse(a: f64, b: f64, x: f64, y: f64) -> (f64, f64) {
+/// The nearest point is `(x/(1 + λb²), y/(1 + λa²))` for the root `λ` of a monotone function
+/// (D. Eberly, "Distance from a Point to an Ellipse", with `s = λ·a²` for `a >= b`), found by
+/// Newton's method. Written as `F(p)/(a²b²)` less terms that vanish at `λ = 0`, the function has
+/// no cancellation near the curve. To `f32`'s relative precision for points within twice the
+/// semi-axes; a few `f32` roundings of the coordinates beyond.
+pub fn foot(a: i32, b: i32, p: (i64, i64)) -> (f32, f32) {
     // Work in the first quadrant with the major axis first.
     let swap = a < b;
-    let (e0, e1, y0, y1) =
-        if swap { (b, a, libm::fabs(y), libm::fabs(x)) } else { (a, b, libm::fabs(x), libm::fabs(y)) };
-    let (x0, x1) = if y1 > 0.0 {
-        if y0 > 0.0 {
-            let (z0, z1) = (y0 / e0, y1 / e1);
-            let g = z0 * z0 + z1 * z1 - 1.0;
-            if g == 0.0 {
-                (y0, y1)
-            } else {
-                let r0 = (e0 / e1) * (e0 / e1);
-                let s = root(r0, z0, z1, g);
-                (r0 * y0 / (s + r0), y1 / (s + 1.0))
-            }
+    let (e0, e1) = if swap { (b as i64, a as i64) } else { (a as i64, b as i64) };
+    let (y0, y1) = if swap { (p.1.abs(), p.0.abs()) } else { (p.0.abs(), p.1.abs()) };
+    let (d0, d1) = if y1 > 0 {
+        if y0 > 0 {
+            foot_off_axes(e0, e1, y0, y1)
         } else {
-            (0.0, e1)
+            // On the minor axis: the minor vertex.
+            (0.0, (e1 - y1) as f32)
         }
     } else {
+        // On the major axis: off it toward (e0·ξ, e1·√(1 − ξ²)) when inside the evolute,
+        // else the major vertex.
         let (numer, denom) = (e0 * y0, e0 * e0 - e1 * e1);
         if numer < denom {
-            let xde0 = numer / denom;
-            (e0 * xde0, e1 * libm::sqrt(1.0 - xde0 * xde0))
+            let xi = numer as f32 / denom as f32;
+            let one_less_xi = (denom - numer) as f32 / denom as f32;
+            (y0 as f32 * (e1 * e1) as f32 / denom as f32, e1 as f32 * math::sqrt(one_less_xi * (1.0 + xi)))
         } else {
-            (e0, 0.0)
+            ((e0 - y0) as f32, 0.0)
         }
     };
-    let (px, py) = if swap { (x1, x0) } else { (x0, x1) };
-    (libm::copysign(px, if x < 0.0 { -1.0 } else { 1.0 }), libm::copysign(py, if y < 0.0 { -1.0 } else { 1.0 }))
+    let (dx, dy) = if swap { (d1, d0) } else { (d0, d1) };
+    (if p.0 < 0 { -dx } else { dx }, if p.1 < 0 { -dy } else { dy })
 }
 
-/// The root `s` of `(r0·z0/(s + r0))² + (z1/(s + 1))² = 1` by bisection.
-fn root(r0: f64, z0: f64, z1: f64, g: f64) -> f64 {
-    let n0 = r0 * z0;
-    let mut s0 = z1 - 1.0;
-    let mut s1 = if g < 0.0 { 0.0 } else { libm::hypot(n0, z1) - 1.0 };
-    let mut s = 0.0;
-    for _ in 0..DISTANCE_ITERATIONS {
-        s = 0.5 * (s0 + s1);
-        if s == s0 || s == s1 {
+/// [`foot`] of `(y0, y1)`, both positive, for the ellipse with semi-axes `e0 >= e1` along them.
+fn foot_off_axes(e0: i64, e1: i64, y0: i64, y1: i64) -> (f32, f32) {
+    let (e0f, e1f, y0f, y1f) = (e0 as f32, e1 as f32, y0 as f32, y1 as f32);
+    let (z0, z1) = (y0f / e0f, y1f / e1f);
+    let r0 = (e0f / e1f) * (e0f / e1f);
+    // z0² + z1² − 1, z0² − 1 and z1² − 1, each from exact integers.
+    let sums = Sums {
+        both: residual(e0, e1, y0, y1) / ((e0f * e1f) * (e0f * e1f)),
+        first: (y0 - e0) as f32 * (y0 + e0) as f32 / (e0f * e0f),
+        second: (y1 - e1) as f32 * (y1 + e1) as f32 / (e1f * e1f),
+    };
+    let s = root(r0, z0, z1, &sums, e0 as f32 * (y0 - e0) as f32 / (e1f * e1f));
+    let u0 = s / r0;
+    (-y0f * u0 / (1.0 + u0), -y1f * s / (1.0 + s))
+}
+
+/// `F = e1²·y0² + e0²·y1² − e0²e1²` as `f32`: computed exactly in integers near the curve
+/// (see [`EXACT_RESIDUAL_MAX`]), estimated in `f32` farther out.
+fn residual(e0: i64, e1: i64, y0: i64, y1: i64) -> f32 {
+    let (e0s, e1s) = (e0 * e0, e1 * e1);
+    let (y0f, y1f) = (y0 as f32, y1 as f32);
+    let estimate = e1s as f32 * (y0f * y0f) + e0s as f32 * (y1f * y1f) - e0s as f32 * e1s as f32;
+    if y0 <= 2 * e0 && y1 <= 2 * e1 && estimate.abs() <= EXACT_RESIDUAL_MAX {
+        let f = e1s.wrapping_mul(y0 * y0).wrapping_add(e0s.wrapping_mul(y1 * y1)).wrapping_sub(e0s.wrapping_mul(e1s));
+        f as f32
+    } else {
+        estimate
+    }
+}
+
+/// The constant parts of [`root`]'s function: `z0² + z1² − 1`, `z0² − 1`, `z1² − 1`.
+struct Sums {
+    both: f32,
+    first: f32,
+    second: f32,
+}
+
+/// Below this `u`, `φ(u) = 1 − 1/(1 + u)²` is smaller than `1/(1 + u)²` (`√2 − 1`).
+const PHI_SMALLER_BELOW: f32 = core::f32::consts::SQRT_2 - 1.0;
+
+/// The root `s > −1` of `G(s) = z0²·w0² + z1²·w1² − 1` with `w0 = 1/(1 + s/r0)`,
+/// `w1 = 1/(1 + s)` (`z1 > 0`, `r0 >= 1`): Eberly's function. Near `s = 0` its terms nearly
+/// cancel, so each term is written in the smaller of its two forms, `z²·w²` or
+/// `z² − z²·φ(u)` with `φ(u) = 1 − w² = u·(2 + u)·w²`, and the `z²` of the second forms are
+/// summed with the −1 beforehand, exactly ([`Sums`]). Every piece is then no larger than `G`'s
+/// own scale and `f32` rounding moves the root by a relative `10⁻⁷`.
+///
+/// `G` falls and is convex on `(−1, ∞)`, so Newton's method from a point left of the root
+/// climbs to it without overshooting. The root lies right of `r0·(z0 − 1)` (`bound0`, passed in
+/// from exact integers) and of `z1 − 1` (each term of `G` is at most 1 at the root), and right of
+/// 0 when `G(0) >= 0`; when `G(0) < 0` the Newton step from 0 lands left of it (convexity).
+// Written `!(value > 0.0)` on purpose: a NaN must stop the search.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn root(r0: f32, z0: f32, z1: f32, sums: &Sums, bound0: f32) -> f32 {
+    let (a0, a1) = (z0 * z0, z1 * z1);
+    let eval = |s: f32| {
+        let u = s / r0;
+        let (w0, w1) = (1.0 / (1.0 + u), 1.0 / (1.0 + s));
+        let (t0, phi0) =
+            if u < PHI_SMALLER_BELOW { (-a0 * u * (2.0 + u) * w0 * w0, true) } else { (a0 * w0 * w0, false) };
+        let (t1, phi1) =
+            if s < PHI_SMALLER_BELOW { (-a1 * s * (2.0 + s) * w1 * w1, true) } else { (a1 * w1 * w1, false) };
+        let k = match (phi0, phi1) {
+            (true, true) => sums.both,
+            (true, false) => sums.first,
+            (false, true) => sums.second,
+            (false, false) => -1.0,
+        };
+        let slope = -2.0 * (a0 * w0 * w0 * w0 / r0 + a1 * w1 * w1 * w1);
+        (k + t0 + t1, slope)
+    };
+    let g = sums.both;
+    let from_zero = if g >= 0.0 { 0.0 } else { g / (2.0 * (a0 / r0 + a1)) };
+    let mut s = math::max(math::max(from_zero, bound0), sums.second / (z1 + 1.0));
+    for _ in 0..ROOT_ITERATIONS_MAX {
+        let (value, slope) = eval(s);
+        if !(value > 0.0) {
             break;
         }
-        let (ratio0, ratio1) = (n0 / (s + r0), z1 / (s + 1.0));
-        let g = ratio0 * ratio0 + ratio1 * ratio1 - 1.0;
-        if g > 0.0 {
-            s0 = s;
-        } else if g < 0.0 {
-            s1 = s;
-        } else {
+        let next = s - value / slope;
+        if !(next > s) {
             break;
         }
+        s = next;
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    extern crate std;
-    use super::*;
-    use crate::interp::arc::ArcInterp;
-    use crate::interp::arc::test_support::*;
-    use Method::{Classic, Diagonal};
-    use Rotation::{Clockwise as Cw, CounterClockwise as Ccw};
-    use core::f64::consts::{FRAC_PI_2, PI, TAU};
-    use proptest::prelude::*;
-    use std::vec::Vec;
-
-    impl EllipseInterp {
-        fn tail_steps(&self) -> u32 {
-            self.tracer.tail_steps()
-        }
-    }
-
-    fn trace(e: &mut EllipseInterp, start: Point, a: i32, b: i32, method: Method) -> Walk {
-        walk(e, start, method == Classic, EllipseInterp::tail_steps, 16 * (a as usize + b as usize) + 64)
-    }
-
-    fn off(p: Point, c: Point, a: i32, b: i32) -> f64 {
-        let d = offset(p, c);
-        distance_to_ellipse(a as f64, b as f64, d.0 as f64, d.1 as f64)
-    }
-
-    /// True when `p` and `q` lie on one ray from `c`.
-    fn same_ray(p: Point, q: Point, c: Point) -> bool {
-        let (u, v) = (offset(p, c), offset(q, c));
-        u.0 * v.1 == u.1 * v.0 && u.0 * v.0 + u.1 * v.1 > 0
-    }
-
-    /// Parametric angle of the point of the ellipse nearest to `start`. A start on an axis
-    /// inside a thin tip is as near to both sides of the tip: the tip counts as behind it.
-    fn start_param(start: Point, c: Point, a: i32, b: i32, sign: f64) -> f64 {
-        let d = offset(start, c);
-        let (x, y) = nearest_on_ellipse(a as f64, b as f64, d.0 as f64, d.1 as f64);
-        let at = |x: f64, y: f64| libm::atan2(y / b as f64, x / a as f64);
-        let t = at(x, y);
-        let other = if d.0 == 0 && x != 0.0 {
-            at(-x, y)
-        } else if d.1 == 0 && y != 0.0 {
-            at(x, -y)
-        } else {
-            return t;
-        };
-        // The later of the two in the direction of travel.
-        if travel(t, other, sign) < PI { other } else { t }
-    }
-
-    /// Travel from parametric angle `t0` to the point of the ellipse nearest to `end`. An end
-    /// on an axis inside a thin tip is as near to both sides of the tip: the first one reached.
-    fn end_travel(t0: f64, end: Point, c: Point, a: i32, b: i32, sign: f64) -> f64 {
-        let d = offset(end, c);
-        let (x, y) = nearest_on_ellipse(a as f64, b as f64, d.0 as f64, d.1 as f64);
-        let at = |x: f64, y: f64| travel(t0, libm::atan2(y / b as f64, x / a as f64), sign);
-        let mut t = at(x, y);
-        if d.0 == 0 && x != 0.0 {
-            t = t.min(at(-x, y));
-        }
-        if d.1 == 0 && y != 0.0 {
-            t = t.min(at(x, -y));
-        }
-        t
-    }
-
-    /// Length along the long axis of the tips where the ellipse is narrower than a step on
-    /// either side of that axis.
-    fn tip_steps(a: i32, b: i32) -> f64 {
-        let (long, short) = (a.max(b) as f64, a.min(b) as f64);
-        long * (1.0 - libm::sqrt(1.0 - 1.0 / (short * short)))
-    }
-
-    fn bound(method: Method) -> f64 {
-        let b = if method == Classic { CLASSIC_BOUND_STEPS } else { DIAGONAL_BOUND_STEPS };
-        b + MEASURE_TOLERANCE_STEPS
-    }
-
-    /// Checks a finished trace: exact end; every point after the start (which may lie off the
-    /// ellipse) within the method's bound of the true ellipse, checking every `every`-th point;
-    /// the straight finish short and within the bound plus the end's own distance; and the step
-    /// count against the L1 / L∞ length of the ideal elliptic arc.
-    #[allow(clippy::too_many_arguments)]
-    fn check(
-        w: &Walk,
-        start: Point,
-        c: Point,
-        a: i32,
-        b: i32,
-        end: Point,
-        rotation: Rotation,
-        method: Method,
-        every: usize,
-    ) {
-        assert_eq!(w.last(), end, "did not end on the end point");
-        let bnd = bound(method);
-        let end_off = off(end, c, a, b);
-        for (i, (p, tail)) in w.points.iter().zip(&w.tail).enumerate().skip(1) {
-            if i % every != 0 && !tail && i + 1 != w.points.len() {
-                continue;
-            }
-            let d = off(*p, c, a, b);
-            if *tail {
-                assert!(d <= bnd + end_off, "finish point {p:?} is {d} off (end {end_off} off)");
-            } else {
-                assert!(d <= bnd, "point {i} {p:?} is {d} off the ellipse ({method:?}, a {a}, b {b})");
-            }
-        }
-        // Along a thin tip the geometric angle says little about progress: the end's ray can
-        // be reached early and the rest of the way is finished straight.
-        let tip = tip_steps(a, b);
-        let thin = tip >= 0.5;
-        if !thin {
-            assert!(w.tail_len() <= ARC_END_TOLERANCE_STEPS as usize + 2, "finish of {} steps", w.tail_len());
-        }
-        let sign = if rotation == Ccw { 1.0 } else { -1.0 };
-        let t0 = start_param(start, c, a, b, sign);
-        let sweep = if same_ray(start, end, c) { TAU } else { end_travel(t0, end, c, a, b, sign) };
-        let (af, bf) = (a as f64, b as f64);
-        let (l1, linf) = ideal_lengths(
-            |t| (af * libm::cos(t0 + sign * t), bf * libm::sin(t0 + sign * t)),
-            0.0,
-            sweep,
-            4096.max(8 * (a + b) as usize),
-        );
-        let analytic = if method == Classic { l1 } else { linf };
-        // Start and end each lie up to a step off the ideal curve.
-        let axes = axes_crossed(t0, sweep, sign);
-        let mut slack = count_slack(axes) + 2.0;
-        if thin {
-            // Tips are climbed and descended on the axis: up to twice their length each.
-            slack += 4.0 * (tip + 1.0) * (axes + 1.0);
-        }
-        assert!((w.len() as f64 - analytic).abs() <= slack, "{} steps, analytic {analytic} ± {slack}", w.len());
-        if w.len() > STRAY_CHECK_MAX_STEPS {
-            return;
-        }
-        let (cx, cy) = (c.x as f64, c.y as f64);
-        let h = curve_to_path(
-            &w.points,
-            |t| (cx + af * libm::cos(t0 + sign * t), cy + bf * libm::sin(t0 + sign * t)),
-            0.0,
-            sweep,
-            (4 * l1 as usize + 64).min(CURVE_SAMPLES_MAX),
-        );
-        let start_off = off(start, c, a, b);
-        assert!(
-            h <= path_bound(method) + end_off.max(start_off) + MEASURE_TOLERANCE_STEPS,
-            "the curve strays {h} from the path ({method:?}, a {a}, b {b})"
-        );
-    }
-
-    #[test]
-    fn the_distance_to_an_ellipse_is_the_true_euclidean_distance() {
-        // Against a brute-force minimum over a fine parametric sampling, refined by ternary search.
-        let brute = |a: f64, b: f64, x: f64, y: f64| {
-            let d = |t: f64| libm::hypot(a * libm::cos(t) - x, b * libm::sin(t) - y);
-            let n = 20_000;
-            let k =
-                (0..n).min_by(|i, j| d(TAU * *i as f64 / n as f64).total_cmp(&d(TAU * *j as f64 / n as f64))).unwrap();
-            let (mut lo, mut hi) = (TAU * (k as f64 - 1.0) / n as f64, TAU * (k as f64 + 1.0) / n as f64);
-            for _ in 0..200 {
-                let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
-                if d(m1) < d(m2) { hi = m2 } else { lo = m1 }
-            }
-            d(0.5 * (lo + hi))
-        };
-        let cases = [
-            (5.0, 3.0, 6.0, 1.0),
-            (5.0, 3.0, 0.0, 0.0),
-            (5.0, 3.0, 4.0, 0.0),
-            (5.0, 3.0, 0.0, -2.5),
-            (3.0, 5.0, 1.0, 4.0),
-            (100.0, 1.0, 99.0, 1.0),
-            (100.0, 1.0, -50.0, 0.3),
-            (1.0, 100.0, 0.2, -99.0),
-            (7.0, 7.0, 3.0, 4.0),
-            (200_000.0, 100_000.0, 150_001.0, 66_143.0),
-            (2.0, 1.0, 1.0, 0.0),
-        ];
-        for (a, b, x, y) in cases {
-            let (got, want) = (distance_to_ellipse(a, b, x, y), brute(a, b, x, y));
-            assert!((got - want).abs() <= 1e-6 * want.max(1.0), "a {a} b {b} ({x}, {y}): {got} vs {want}");
-        }
-    }
-
-    #[test]
-    fn classic_first_quadrant_follows_the_textbook() {
-        // a = 5, b = 3, F = 9x² + 25y² − 225 from (5, 0) to (0, 3): F >= 0 → −X, F < 0 → +Y.
-        let c = Point::new(-300, 40);
-        let at = |x, y| Point::new(c.x + x, c.y + y);
-        let mut e = EllipseInterp::new(at(5, 0), c, 5, 3, at(0, 3), Ccw, Classic).unwrap();
-        let (mut steps, mut fs) = (Vec::new(), Vec::new());
-        while let Some(s) = e.next_step().unwrap() {
-            steps.push(s);
-            fs.push(e.tracer.discriminant());
-        }
-        use Step as S;
-        assert_eq!(steps, [S::XN, S::YP, S::YP, S::XN, S::YP, S::XN, S::XN, S::XN]);
-        assert_eq!(fs, [-81, -56, 19, -44, 81, 36, 9, 0]);
-    }
-
-    /// The textbook ellipse tables, literally (F recomputed at every point).
-    fn table_walk(a: i64, b: i64, start: (i64, i64), end: (i64, i64), rotation: Rotation, full: bool) -> Vec<Step> {
-        use Step as S;
-        let (mut x, mut y) = start;
-        let mut steps = Vec::new();
-        loop {
-            let f = b * b * x * x + a * a * y * y - a * a * b * b;
-            let (ge, lt) = match rotation {
-                Ccw if x > 0 && y >= 0 => (S::XN, S::YP),
-                Ccw if x <= 0 && y > 0 => (S::YN, S::XN),
-                Ccw if x < 0 && y <= 0 => (S::XP, S::YN),
-                Ccw => (S::YP, S::XP),
-                Cw if x >= 0 && y > 0 => (S::YN, S::XP),
-                Cw if x < 0 && y >= 0 => (S::XP, S::YP),
-                Cw if x <= 0 && y < 0 => (S::YP, S::XN),
-                Cw => (S::XN, S::YN),
-            };
-            let s = if f >= 0 { ge } else { lt };
-            x += s.x as i64;
-            y += s.y as i64;
-            steps.push(s);
-            assert!(steps.len() <= 20 * (a + b) as usize, "table walk did not end");
-            if (x, y) == end && (!full || steps.len() > 4) {
-                return steps;
-            }
-        }
-    }
-
-    #[test]
-    fn classic_matches_the_tables_in_every_quadrant_and_direction() {
-        for a in 2..=12i64 {
-            for b in 2..=12i64 {
-                if tip_steps(a as i32, b as i32) >= 0.5 {
-                    continue; // the tables cut thin tips; see `thin_tips_are_drawn_not_cut`
-                }
-                let axes = [(a, 0), (0, b), (-a, 0), (0, -b)];
-                for rotation in [Ccw, Cw] {
-                    for (i, s) in axes.iter().enumerate() {
-                        for k in 1..=4 {
-                            let e = if rotation == Ccw { axes[(i + k) % 4] } else { axes[(i + 4 - k) % 4] };
-                            let (start, end) = (Point::new(s.0 as i32, s.1 as i32), Point::new(e.0 as i32, e.1 as i32));
-                            let mut el =
-                                EllipseInterp::new(start, Point::ORIGIN, a as i32, b as i32, end, rotation, Classic)
-                                    .unwrap();
-                            let w = trace(&mut el, start, a as i32, b as i32, Classic);
-                            assert_eq!(
-                                w.steps,
-                                table_walk(a, b, *s, e, rotation, k == 4),
-                                "a {a} b {b} from {s:?}, {k} quarters {rotation:?}"
-                            );
-                            assert_eq!(w.len() as i64, (a + b) * k as i64, "a + b per quarter");
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn thin_tips_are_drawn_not_cut() {
-        // a = 2, b = 50: the literal tables step onto the Y axis at y = 44 and leave it at once,
-        // cutting 6 steps off each tip; the trace climbs to the tip and comes back.
-        let (a, b) = (2, 50);
-        let s = Point::new(a, 0);
-        // The literal first and second quadrant tables, 60 steps from (2, 0).
-        let (mut x, mut y) = (a as i64, 0i64);
-        let mut table = Vec::new();
-        for _ in 0..60 {
-            let f = (b * b) as i64 * x * x + (a * a) as i64 * y * y - (a * a * b * b) as i64;
-            let (ge, lt) = if x > 0 { (Step::XN, Step::YP) } else { (Step::YN, Step::XN) };
-            let st = if f >= 0 { ge } else { lt };
-            (x, y) = (x + st.x as i64, y + st.y as i64);
-            table.push((x, y));
-        }
-        assert!(table.contains(&(0, 44)) && table.contains(&(-1, 44)), "{table:?}");
-        assert!(!table.contains(&(0, 47)), "the tables reach the tip after all");
-        for method in [Classic, Diagonal] {
-            let mut e = EllipseInterp::new(s, Point::ORIGIN, a, b, s, Ccw, method).unwrap();
-            let w = trace(&mut e, s, a, b, method);
-            assert!(
-                w.points.contains(&Point::new(0, b)) && w.points.contains(&Point::new(0, -b)),
-                "{method:?} cut a tip"
-            );
-            check(&w, s, Point::ORIGIN, a, b, s, Ccw, method, 1);
-        }
-    }
-
-    #[test]
-    fn full_ellipses_take_4_a_plus_b_classic_and_about_4_hypot_diagonal_steps() {
-        for (a, b) in [(1, 1), (1, 5), (5, 1), (10, 3), (3, 10), (40, 39), (100, 7), (250, 120), (1, 300), (300, 2)] {
-            for rotation in [Ccw, Cw] {
-                for s in [Point::new(a, 0), Point::new(0, -b)] {
-                    let c = Point::new(12, -7);
-                    let start = Point::new(c.x + s.x, c.y + s.y);
-                    for method in [Classic, Diagonal] {
-                        let mut e = EllipseInterp::new(start, c, a, b, start, rotation, method).unwrap();
-                        let w = trace(&mut e, start, a, b, method);
-                        assert_eq!(w.last(), start);
-                        check(&w, start, c, a, b, start, rotation, method, 1);
-                        if method == Classic {
-                            assert_eq!(w.len(), 4 * (a + b) as usize, "a {a} b {b}");
-                        } else {
-                            let analytic = 4.0 * libm::hypot(a as f64, b as f64);
-                            assert!((w.len() as f64 - analytic).abs() <= 4.0, "a {a} b {b}: {} vs {analytic}", w.len());
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn a_circle_is_an_ellipse_with_equal_axes() {
-        for (x, y) in [(9, 0), (0, -9), (3, 4), (-12, 5), (20, -21)] {
-            let s = Point::new(x, y);
-            let r = libm::sqrt((x * x + y * y) as f64) as i32;
-            for rotation in [Ccw, Cw] {
-                for method in [Classic, Diagonal] {
-                    let end = Point::new(-y, x);
-                    let mut arc = ArcInterp::new(s, Point::ORIGIN, end, rotation, method).unwrap();
-                    let mut el = EllipseInterp::new(s, Point::ORIGIN, r, r, end, rotation, method).unwrap();
-                    loop {
-                        let step = arc.next_step().unwrap();
-                        assert_eq!(step, el.next_step().unwrap());
-                        assert_eq!(arc.tangent(), el.tangent());
-                        if step.is_none() {
-                            break;
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn bad_ellipses_are_refused() {
-        let (s, c) = (Point::new(10, 0), Point::ORIGIN);
-        assert_eq!(EllipseInterp::new(s, c, 0, 5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(EllipseInterp::new(s, c, 10, -5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(EllipseInterp::new(c, c, 10, 5, s, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(
-            EllipseInterp::new(Point::new(13, 0), c, 10, 5, s, Ccw, Classic).err(),
-            Some(ArcError::StartOffCurve)
-        );
-        assert!(EllipseInterp::new(Point::new(12, 0), c, 10, 5, s, Ccw, Classic).is_ok());
-        assert_eq!(EllipseInterp::new(s, c, 10, 5, Point::new(0, 8), Ccw, Classic).err(), Some(ArcError::EndOffCurve));
-        assert_eq!(
-            EllipseInterp::new(s, c, 10, 5, Point::new(0, 7), Cw, Diagonal).map(|e| e.end()),
-            Ok(Point::new(0, 7))
-        );
-        assert_eq!(EllipseInterp::new(Point::new(2, 0), c, 2, 1, c, Ccw, Classic).err(), Some(ArcError::EndOffCurve));
-        let far = MAX_RADIUS_STEPS + 1;
-        assert_eq!(EllipseInterp::new(Point::new(far, 0), c, far, 5, s, Ccw, Classic).err(), Some(ArcError::TooLarge));
-        let corner = Point::new(i32::MIN, i32::MAX);
-        assert_eq!(
-            EllipseInterp::new(corner, Point::new(i32::MAX, 0), 100, 100, corner, Ccw, Classic).err(),
-            Some(ArcError::StartOffCurve)
-        );
-        assert_eq!(EllipseInterp::from_angles(s, 0, 5, 0.0, 1.0, Classic).err(), Some(ArcError::ZeroRadius));
-        assert_eq!(
-            EllipseInterp::from_angles(s, 5, 5, f32::NEG_INFINITY, 1.0, Classic).err(),
-            Some(ArcError::NotFinite)
-        );
-        assert_eq!(EllipseInterp::from_angles(s, 5, 5, 0.0, f32::NAN, Classic).err(), Some(ArcError::NotFinite));
-        assert_eq!(EllipseInterp::from_angles(s, 5, far, 0.0, 1.0, Classic).err(), Some(ArcError::TooLarge));
-        assert_eq!(
-            EllipseInterp::from_angles(Point::new(i32::MIN + 3, 0), 100, 50, 0.0, 1.0, Classic).err(),
-            Some(ArcError::TooLarge)
-        );
-    }
-
-    #[test]
-    fn from_angles_draws_what_the_menu_asks_for() {
-        let pen = Point::new(-5000, 777);
-        // Half an ellipse counter-clockwise from parametric angle 0: a + b + a + b... = 2(a + b).
-        let mut e = EllipseInterp::from_angles(pen, 80, 30, 0.0, PI as f32, Classic).unwrap();
-        assert_eq!((e.center(), e.end(), e.rotation()), (Point::new(-5080, 777), Point::new(-5160, 777), Ccw));
-        assert_eq!(trace(&mut e, pen, 80, 30, Classic).len(), 2 * (80 + 30));
-        // From the top, clockwise a quarter: to the right end.
-        let mut e = EllipseInterp::from_angles(pen, 80, 30, FRAC_PI_2 as f32, -FRAC_PI_2 as f32, Diagonal).unwrap();
-        assert_eq!((e.center(), e.end(), e.rotation()), (Point::new(-5000, 747), Point::new(-4920, 747), Cw));
-        let w = trace(&mut e, pen, 80, 30, Diagonal);
-        check(&w, pen, e.center(), 80, 30, e.end(), Cw, Diagonal, 1);
-        // Full turns end on the pen.
-        for sweep in [TAU as f32, -7.0] {
-            let mut e = EllipseInterp::from_angles(pen, 80, 30, 1.0, sweep, Classic).unwrap();
-            assert_eq!(e.end(), pen);
-            let w = trace(&mut e, pen, 80, 30, Classic);
-            assert_eq!(w.last(), pen);
-            assert!((w.len() as i32 - 4 * (80 + 30)).abs() <= 4, "{} steps", w.len());
-        }
-        // Too short to move.
-        let mut e = EllipseInterp::from_angles(pen, 80, 30, 1.0, 0.002, Diagonal).unwrap();
-        assert_eq!(e.next_step(), Ok(None));
-    }
-
-    #[test]
-    fn the_tangent_follows_the_ellipse_in_the_direction_of_travel() {
-        let (a, b) = (60, 25);
-        for rotation in [Ccw, Cw] {
-            for method in [Classic, Diagonal] {
-                let c = Point::new(3, 4);
-                let s = Point::new(c.x - a, c.y);
-                let mut e = EllipseInterp::new(s, c, a, b, s, rotation, method).unwrap();
-                let mut p = s;
-                let sign = if rotation == Ccw { 1.0 } else { -1.0 };
-                loop {
-                    let t = e.tangent();
-                    let (x, y) = ((p.x - c.x) as f32, (p.y - c.y) as f32);
-                    // ∝ (−a²y, b²x) counter-clockwise, negated clockwise.
-                    let (wx, wy) = (-((a * a) as f32) * y * sign, (b * b) as f32 * x * sign);
-                    let n = (wx * wx + wy * wy).sqrt();
-                    assert!((t.x - wx / n).abs() < 1e-5 && (t.y - wy / n).abs() < 1e-5, "{t:?} at {p:?}");
-                    let Some(step) = e.next_step().unwrap() else { break };
-                    assert!(
-                        t.x * step.x as f32 + t.y * step.y as f32 >= 0.0,
-                        "step {step:?} against the tangent at {p:?}"
-                    );
-                    p = p.stepped(step);
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn the_largest_ellipses_do_not_overflow() {
-        let c = Point::new(-100_000, 100_000);
-        let cases = [
-            (200_000, 100_000, Point::new(100_000, 100_000), Point::new(100_000, 100_000), Ccw),
-            (100_000, 200_000, Point::new(-100_000, -100_000), Point::new(-100_000, -100_000), Cw),
-            (200_000, 1, Point::new(100_000, 100_000), Point::new(-300_000, 100_000), Cw),
-            (
-                MAX_RADIUS_STEPS,
-                MAX_RADIUS_STEPS / 2,
-                Point::new(c.x + MAX_RADIUS_STEPS, c.y),
-                Point::new(c.x, c.y + MAX_RADIUS_STEPS / 2),
-                Ccw,
-            ),
-        ];
-        for (a, b, start, end, rotation) in cases {
-            for method in [Classic, Diagonal] {
-                let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
-                let w = trace(&mut e, start, a, b, method);
-                check(&w, start, c, a, b, end, rotation, method, 17);
-                if (a, b) == (200_000, 100_000) {
-                    // The full ellipse from an axis: exactly 4(a + b) classic steps,
-                    // 4·√(a² + b²) ± 4 diagonal ones.
-                    let analytic = if method == Classic { 1_200_000.0 } else { 4.0 * libm::hypot(2e5, 1e5) };
-                    let slack = if method == Classic { 0.0 } else { 4.0 };
-                    assert!((w.len() as f64 - analytic).abs() <= slack, "{method:?}: {} steps", w.len());
-                }
-            }
-        }
-    }
-
-    fn rounded(c: Point, a: i32, b: i32, t: f64) -> Point {
-        Point::new(c.x + round(a as f64 * libm::cos(t)) as i32, c.y + round(b as f64 * libm::sin(t)) as i32)
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
-
-        /// Random elliptic arcs between lattice points rounded from random parametric angles.
-        #[test]
-        fn random_elliptic_arcs_stay_on_the_ellipse_and_end_exactly(
-            cx in -100_000i32..100_000, cy in -100_000i32..100_000, a in 1i32..300, b in 1i32..300,
-            t0 in 0.0f64..TAU, t1 in 0.0f64..TAU, ccw: bool, classic: bool,
-        ) {
-            let (c, method, rotation) = (Point::new(cx, cy), if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
-            let (start, end) = (rounded(c, a, b, t0), rounded(c, a, b, t1));
-            prop_assume!(start != c && end != c);
-            prop_assume!(end == start || !same_ray(start, end, c), "distinct ends on one ray mean a full turn");
-            let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
-            let w = trace(&mut e, start, a, b, method);
-            check(&w, start, c, a, b, end, rotation, method, 1);
-        }
-
-        /// Very flat ellipses, where one region of the curve is shorter than a step.
-        #[test]
-        fn flat_ellipses_stay_on_the_ellipse(
-            long in 20i32..600, short in 1i32..4, along_x: bool, t0 in 0.0f64..TAU, full: bool, t1 in 0.0f64..TAU,
-            ccw: bool, classic: bool,
-        ) {
-            let (a, b) = if along_x { (long, short) } else { (short, long) };
-            let (method, rotation) = (if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
-            let c = Point::new(5, -5);
-            let start = rounded(c, a, b, t0);
-            let end = if full { start } else { rounded(c, a, b, t1) };
-            prop_assume!(start != c && end != c);
-            prop_assume!(end == start || !same_ray(start, end, c), "distinct ends on one ray mean a full turn");
-            let mut e = EllipseInterp::new(start, c, a, b, end, rotation, method).unwrap();
-            let w = trace(&mut e, start, a, b, method);
-            check(&w, start, c, a, b, end, rotation, method, 1);
-        }
-
-        /// Ellipses given by angles, as the keypad and serial commands give them.
-        #[test]
-        fn ellipses_from_angles_sweep_what_was_asked(
-            px in -100_000i32..100_000, py in -100_000i32..100_000, a in 1i32..300, b in 1i32..300,
-            start_angle in -7.0f32..7.0, sweep in -7.0f32..7.0, classic: bool,
-        ) {
-            let method = if classic { Classic } else { Diagonal };
-            let pen = Point::new(px, py);
-            let mut e = EllipseInterp::from_angles(pen, a, b, start_angle, sweep, method).unwrap();
-            let (c, end, rotation) = (e.center(), e.end(), e.rotation());
-            prop_assert!(off(pen, c, a, b) <= 0.71 && off(end, c, a, b) <= 0.71);
-            let w = trace(&mut e, pen, a, b, method);
-            prop_assert_eq!(w.last(), end);
-            if w.len() == 0 {
-                prop_assert_eq!(end, pen);
-            } else if sweep.abs() as f64 >= TAU {
-                prop_assert_eq!(end, pen);
-                check(&w, pen, c, a, b, end, rotation, method, 1);
-            } else {
-                // The requested arc: the pen is only rounded onto it.
-                let t0 = start_angle as f64;
-                let (t, sign) = (sweep.abs() as f64, (sweep as f64).signum());
-                let (af, bf) = (a as f64, b as f64);
-                let (l1, linf) = ideal_lengths(|u| (af * libm::cos(t0 + sign * u), bf * libm::sin(t0 + sign * u)), 0.0, t, 4096);
-                let analytic = if classic { l1 } else { linf };
-                let slack = count_slack(axes_crossed(t0, t, sign)) + 3.0;
-                prop_assert!((w.len() as f64 - analytic).abs() <= slack, "{} steps for {} ± {}", w.len(), analytic, slack);
-            }
-        }
-
-        /// Garbage in never panics and never hangs.
-        #[test]
-        fn any_input_is_refused_or_drawn(
-            s in any::<(i32, i32)>(), c in any::<(i32, i32)>(), e in any::<(i32, i32)>(), a in any::<i32>(), b in any::<i32>(),
-            t in any::<f32>(), sweep in any::<f32>(), ccw: bool, classic: bool,
-        ) {
-            let (method, rotation) = (if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
-            let (s, c, e) = (Point::new(s.0, s.1), Point::new(c.0, c.1), Point::new(e.0, e.1));
-            if let Ok(mut el) = EllipseInterp::new(s, c, a, b, e, rotation, method)
-                && a < 5000
-                && b < 5000
-            {
-                trace(&mut el, s, a, b, method);
-            }
-            let (a, b) = (a.rem_euclid(3000) + 1, b.rem_euclid(3000) + 1);
-            if let Ok(mut el) = EllipseInterp::from_angles(s, a, b, t, sweep, method) {
-                let end = el.end();
-                prop_assert_eq!(trace(&mut el, s, a, b, method).last(), end);
-            }
-        }
-    }
 }

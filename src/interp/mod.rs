@@ -6,6 +6,7 @@
 //! step, fewer steps). Interpolators never read a clock and never allocate.
 
 pub mod arc;
+pub(crate) mod conic;
 pub mod ellipse;
 pub mod function;
 pub mod line;

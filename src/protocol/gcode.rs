@@ -155,8 +155,10 @@ pub const ARC_RADIUS_SLACK_MM: f32 = 0.005;
 pub const ARC_RADIUS_ERROR_MAX_MM: f32 = 0.5;
 pub const ARC_RADIUS_ERROR_MAX_RATIO: f32 = 0.001;
 
-/// Largest radius or semi-axis of an arc or ellipse: 1_000_000 steps at 200 steps/mm, which
-/// keeps the interpolators' integer discriminants inside 64 bits.
+/// Largest radius or semi-axis of an arc or ellipse: 1_000_000 steps at 200 steps/mm, the
+/// circle interpolator's limit. Ellipses (and circles on axes of different steps/mm, which are
+/// ellipses in steps) are held to their interpolator's smaller limit, 262_144 steps
+/// (`MAX_ELLIPSE_AXIS_STEPS`), by the setup check: beyond it they are error 33.
 pub const CURVE_RADIUS_MAX_MM: f32 = 5_000.0;
 
 /// Rounding allowance when a target is compared with the travel limits.

@@ -611,6 +611,15 @@ fn arcs_too_small_for_their_interpolator_are_refused() {
 }
 
 #[test]
+fn ellipses_larger_than_their_interpolator_takes_are_refused() {
+    // At 100 steps/mm a semi-axis of 2700 mm is 270_000 steps, beyond the ellipse
+    // interpolator's MAX_ELLIPSE_AXIS_STEPS (262_144); a short arc of it stays inside the travel.
+    let mut g = GcodeState::new();
+    refused(&mut g, "$E A2700 B1000 S90 W1", 33);
+    assert!(run(&mut g, "$E A2600 B1000 S90 W1").is_ok());
+}
+
+#[test]
 fn function_command() {
     let mut g = GcodeState::new();
     ok_all(&mut g, &["G0 X10 Y10"]);
