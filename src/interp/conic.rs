@@ -469,7 +469,9 @@ impl Tracer {
     }
 
     /// Writes the next steps into `out`, exactly those [`step`](Self::step) would take one by
-    /// one, until `out` is full or the trace ends.
+    /// one, until `out` is full or the trace ends. A conic never kinks: its tangent turns
+    /// smoothly, even round a tip narrower than a step, which the planner slows for by its
+    /// curvature.
     pub(crate) fn fill(&mut self, out: &mut [Step]) -> Filled {
         let mut i = 0;
         while i < out.len() {
@@ -486,11 +488,11 @@ impl Tracer {
                         out[i] = step;
                         i += 1;
                     }
-                    None => return Filled { steps: i, end: Some(Ok(())) },
+                    None => return Filled::ended(i, Ok(())),
                 }
             }
         }
-        Filled { steps: i, end: if self.phase == Phase::Done { Some(Ok(())) } else { None } }
+        if self.phase == Phase::Done { Filled::ended(i, Ok(())) } else { Filled::more(i) }
     }
 
     /// One step by the rules, checking everything: the reference the quiet runs follow. Never

@@ -66,7 +66,7 @@ fn in_batches<I: Interpolator>(
         assert!(steps.len() <= cap, "no end after {cap} steps");
     }
     // Ended for good.
-    assert_eq!(curve.fill(&mut buf[..4]), Filled { steps: 0, end: Some(Ok(())) });
+    assert_eq!(curve.fill(&mut buf[..4]), Filled::ended(0, Ok(())));
     assert_eq!(curve.next_step(), Ok(None));
     steps
 }
