@@ -14,6 +14,7 @@ extern crate std;
 #[macro_use]
 mod fmt;
 
+pub mod decimal;
 pub mod expr;
 pub mod geom;
 pub mod interp;

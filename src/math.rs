@@ -2,9 +2,11 @@
 //!
 //! The Cortex-M4F's FPU works in `f32` only; `f64` arithmetic there is a software library tens
 //! of times slower, so the firmware has none. Square roots are the FPU's own instruction. The
-//! elementary functions are computed in `f32` throughout (the `f32` functions of `libm` that
-//! work in `f32` inside, and our own where `libm` computes in `f64`). `min` and `max` are plain
-//! comparisons: `f32::min` is a library call on this FPU.
+//! elementary functions are computed in `f32` throughout: our own where `libm` computes in
+//! `f64` inside (`sinf`, `cosf`, `tanf` and `asinf` do, `acosf` uses a software square root),
+//! `libm`'s `f32` functions where they stay in `f32` (exp, ln, log10, pow, atan, atan2, floor,
+//! ceil, round, trunc). `min` and `max` are plain comparisons: `f32::min` is a library call on
+//! this FPU.
 //!
 //! Owns no state. Everything here is a pure function of its arguments.
 
@@ -65,39 +67,145 @@ pub fn hypot(x: f32, y: f32) -> f32 {
     m * sqrt(u * u + v * v)
 }
 
+// ----- sine, cosine, tangent ----------------------------------------------------------------
+//
+// x = n·π/2 + r with n an integer and |r| ≤ π/4 (Cody–Waite: π/2 in three parts, the first two
+// short enough that n times them is exact), then a polynomial for sin r or cos r chosen by n
+// mod 4. The polynomials are minimax (Remez exchange, relative error) on [-π/4, π/4]:
+// sin r ≈ r + r·z·(S1 + z·(S2 + z·S3)) within 3.8e-9 of sin r relatively, and
+// cos r ≈ 1 - z/2 + z²·(C1 + z·(C2 + z·C3)) within 1.2e-10, with z = r² (both far below an f32
+// ulp, 6e-8, so the rounding of the f32 arithmetic is what remains).
+
+/// π/2 = `FRAC_PI_2_HI + FRAC_PI_2_MID + FRAC_PI_2_LO` to 1.7e-15. HI has 8 significant bits and
+/// MID 11, so `n·HI` and `n·MID` are exact f32 products for |n| < 2^13 (n has at most 13 bits).
+const FRAC_PI_2_HI: f32 = 1.570_312_5;
+const FRAC_PI_2_MID: f32 = 4.837_513e-4;
+const FRAC_PI_2_LO: f32 = 7.549_79e-8;
+
+/// 2/π.
+const FRAC_2_PI: f32 = core::f32::consts::FRAC_2_PI;
+
+/// 1.5·2^23: an f32 of magnitude below 2^22 plus this is rounded to an integer (ties to even),
+/// which is then in the low bits of the sum's significand.
+const ROUND_TO_INT_MAGIC: f32 = 12_582_912.0;
+
+/// Largest |x| (radians) for which the reduction of sin, cos and tan is exact to 5e-11 before its
+/// last rounding: n = round(x·2/π) stays below 2^13 (8191.5·π/2 ≈ 12_867.2). Beyond it products
+/// start to round: sin and cos stay within 1e-6 up to 1e5 rad, then the error grows about as
+/// 2^-24·|x|, the spacing of f32 numbers there, so as the argument's own precision; from
+/// 2^22·π/2 ≈ 6.6e6 on even the quadrant is lost and the result means nothing, but it stays
+/// finite (and within [-1, 1] for sin and cos).
+pub const TRIG_ACCURATE_MAX_RAD: f32 = 12_867.0;
+
+/// Bound on the reduced argument for |x| beyond [`TRIG_ACCURATE_MAX_RAD`], where rounding can
+/// make it anything: there the polynomials stay within [-1, 1]. It is not π/4 because the
+/// rounded x·2/π can pick the neighbouring n near a half-integer, leaving r a little beyond π/4
+/// with the result still right.
+const REDUCED_MAX_RAD: f32 = 1.0;
+
+const S1: f32 = -1.666_665_5e-1;
+const S2: f32 = 8.332_16e-3;
+const S3: f32 = -1.951_528_2e-4;
+const C1: f32 = 4.166_664_6e-2;
+const C2: f32 = -1.388_731_6e-3;
+const C3: f32 = 2.443_315_7e-5;
+
+/// `(r, n mod 4)` with x = n·π/2 + r, |r| ≤ π/4 (a hair more at the edges). NaN for a non-finite
+/// x; beyond [`TRIG_ACCURATE_MAX_RAD`] r is clamped to ±[`REDUCED_MAX_RAD`] so results stay
+/// bounded.
+#[inline]
+fn reduce(x: f32) -> (f32, u32) {
+    let t = x * FRAC_2_PI + ROUND_TO_INT_MAGIC;
+    let n = t - ROUND_TO_INT_MAGIC;
+    // x - n·HI is exact (Sterbenz: the two are within a factor of two of each other, or n = 0),
+    // n·MID is exact and so is the difference (both are multiples of 2^-24 and it is below 1);
+    // only n·LO and the last difference round.
+    let r = ((x - n * FRAC_PI_2_HI) - n * FRAC_PI_2_MID) - n * FRAC_PI_2_LO;
+    // The low bits of t's significand are n (two's complement modulo 2^22).
+    let quadrant = t.to_bits() & 3;
+    if x.abs() <= TRIG_ACCURATE_MAX_RAD {
+        (r, quadrant)
+    } else if x.is_finite() {
+        (max(-REDUCED_MAX_RAD, min(r, REDUCED_MAX_RAD)), quadrant)
+    } else {
+        (f32::NAN, 0)
+    }
+}
+
+/// sin r for |r| ≤ π/4.
+#[inline]
+fn sin_poly(r: f32) -> f32 {
+    let z = r * r;
+    r + r * z * (S1 + z * (S2 + z * S3))
+}
+
+/// cos r for |r| ≤ π/4.
+#[inline]
+fn cos_poly(r: f32) -> f32 {
+    let z = r * r;
+    z * z * (C1 + z * (C2 + z * C3)) - 0.5 * z + 1.0
+}
+
+/// sin x (radians). Within 1 ulp for |x| ≤ π/4; for |x| ≤ [`TRIG_ACCURATE_MAX_RAD`] within
+/// 1.6 ulp of the result plus 1e-10 (the reduction's error, which shows only near the zeros),
+/// at most 8e-8; see that constant beyond. NaN for an infinite or NaN x.
 pub fn sin(x: f32) -> f32 {
-    libm::sinf(x)
+    let (r, quadrant) = reduce(x);
+    let v = if quadrant & 1 == 0 { sin_poly(r) } else { cos_poly(r) };
+    if quadrant & 2 == 0 { v } else { -v }
 }
 
+/// cos x (radians); accuracy as [`sin`].
 pub fn cos(x: f32) -> f32 {
-    libm::cosf(x)
+    let (r, quadrant) = reduce(x);
+    let v = if quadrant & 1 == 0 { cos_poly(r) } else { sin_poly(r) };
+    if (quadrant + 1) & 2 == 0 { v } else { -v }
 }
 
-/// `(sin x, cos x)`.
+/// `(sin x, cos x)` for the cost of one reduction; accuracy as [`sin`].
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    (sin(x), cos(x))
+    let (r, quadrant) = reduce(x);
+    let (s, c) = (sin_poly(r), cos_poly(r));
+    let (s, c) = if quadrant & 1 == 0 { (s, c) } else { (c, -s) };
+    if quadrant & 2 == 0 { (s, c) } else { (-s, -c) }
 }
 
+/// tan x (radians) as sin x / cos x. Within 3 ulp for |x| ≤ π/4; for |x| ≤
+/// [`TRIG_ACCURATE_MAX_RAD`] within 3 ulp plus 1e-8·(1 + tan²x), the reduction's error times
+/// the derivative, which grows toward the poles. At the f32 nearest each pole there it is large
+/// (|tan| > 1e3) but finite and within 1e-3 of itself.
 pub fn tan(x: f32) -> f32 {
-    libm::tanf(x)
+    let (s, c) = sin_cos(x);
+    s / c
 }
 
+// ----- inverse functions ----------------------------------------------------------------------
+
+/// asin x (radians, in [-π/2, π/2]) as atan2(x, √((1-x)(1+x))), with the FPU's square root:
+/// within 2.5 ulp. NaN outside [-1, 1].
 pub fn asin(x: f32) -> f32 {
-    libm::asinf(x)
+    atan2(x, sqrt((1.0 - x) * (1.0 + x)))
 }
 
+/// acos x (radians, in [0, π]) as atan2(√((1-x)(1+x)), x): within 2.5 ulp. NaN outside
+/// [-1, 1].
 pub fn acos(x: f32) -> f32 {
-    libm::acosf(x)
+    atan2(sqrt((1.0 - x) * (1.0 + x)), x)
 }
 
+// ----- libm's f32 functions that stay in f32 (each checked within 1 ulp, atan2 1.5 ulp) --------
+
+/// atan x (radians, in [-π/2, π/2]).
 pub fn atan(x: f32) -> f32 {
     libm::atanf(x)
 }
 
+/// The angle of (x, y) (radians, in [-π, π]).
 pub fn atan2(y: f32, x: f32) -> f32 {
     libm::atan2f(y, x)
 }
 
+/// e^x.
 pub fn exp(x: f32) -> f32 {
     libm::expf(x)
 }
@@ -107,18 +215,22 @@ pub fn ln(x: f32) -> f32 {
     libm::logf(x)
 }
 
+/// Decimal logarithm.
 pub fn log10(x: f32) -> f32 {
     libm::log10f(x)
 }
 
+/// x^y.
 pub fn pow(x: f32, y: f32) -> f32 {
     libm::powf(x, y)
 }
 
+/// Largest integer not above x.
 pub fn floor(x: f32) -> f32 {
     libm::floorf(x)
 }
 
+/// Smallest integer not below x.
 pub fn ceil(x: f32) -> f32 {
     libm::ceilf(x)
 }
@@ -128,6 +240,10 @@ pub fn round(x: f32) -> f32 {
     libm::roundf(x)
 }
 
+/// x without its fraction (toward zero).
 pub fn trunc(x: f32) -> f32 {
     libm::truncf(x)
 }
+
+#[cfg(test)]
+mod tests;

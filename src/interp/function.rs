@@ -368,7 +368,8 @@ impl ExprFn {
 
 impl CurveFn for ExprFn {
     fn y_steps(&self, column: i32) -> Result<f64, CurveError> {
-        Ok(self.expr.eval(self.x_mm(column))? * self.y_steps_per_mm)
+        // Expressions evaluate in f32; the curve still steps in f64 around them.
+        Ok(f64::from(self.expr.eval(self.x_mm(column) as f32)?) * self.y_steps_per_mm)
     }
 }
 

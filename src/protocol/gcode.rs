@@ -987,7 +987,9 @@ impl GcodeState {
         if dx == 0.0 {
             return Ok(Commands::default());
         }
-        let f = |x: f64| expr.eval(x).map_err(|error| GrblError::FunctionUndefined { x_mm: x as f32, error });
+        let f = |x: f64| {
+            expr.eval(x as f32).map(f64::from).map_err(|error| GrblError::FunctionUndefined { x_mm: x as f32, error })
+        };
         let (x0, x1) = (x0_mm as f64, x1_mm as f64);
         let y0 = f(x0)?;
         let y_at_pen = |y: f64| [p[0], p[1] + (y - y0) as f32];

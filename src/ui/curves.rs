@@ -424,8 +424,8 @@ mod tests {
             let expr = crate::expr::parse(preset.expression()).unwrap();
             for k in -40..=40 {
                 let x = k as f32 * 0.75;
-                match (preset.eval(x), expr.eval(f64::from(x))) {
-                    (Some(a), Ok(b)) => assert!((f64::from(a) - b).abs() < 1e-3 * (1.0 + b.abs()), "{preset:?} at {x}"),
+                match (preset.eval(x), expr.eval(x)) {
+                    (Some(a), Ok(b)) => assert!((a - b).abs() < 1e-3 * (1.0 + b.abs()), "{preset:?} at {x}"),
                     (None, Err(_)) => {}
                     other => panic!("{preset:?} at {x}: {other:?}"),
                 }

@@ -1,0 +1,190 @@
+//! Accuracy of the single-precision functions against the host's `f64` ones, which are exact to
+//! far below an `f32` ulp: dense grids for the stated bounds, proptest for what holds everywhere.
+
+extern crate std;
+use super::*;
+use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use proptest::prelude::*;
+
+/// The spacing of `f32` numbers at `v` (the ulp of `v` rounded to `f32`).
+fn ulp(v: f64) -> f64 {
+    let f = (v as f32).abs();
+    f64::from(f32::from_bits(f.to_bits() + 1) - f)
+}
+
+/// Error of `got` against `want`, in ulps of `want`.
+fn ulps(got: f32, want: f64) -> f64 {
+    (f64::from(got) - want).abs() / ulp(want)
+}
+
+/// `n + 1` points evenly spread over `[lo, hi]`, as `f32`.
+fn grid(lo: f64, hi: f64, n: u32) -> impl Iterator<Item = f32> {
+    (0..=n).map(move |i| (lo + (hi - lo) * f64::from(i) / f64::from(n)) as f32)
+}
+
+#[test]
+fn the_parts_of_pi_over_2_multiply_exactly() {
+    // 8 and 11 significant bits: times any n below 2^13 the product has at most 24.
+    assert!(FRAC_PI_2_HI.to_bits().trailing_zeros() >= 23 - 7);
+    assert!(FRAC_PI_2_MID.to_bits().trailing_zeros() >= 23 - 10);
+    let sum = f64::from(FRAC_PI_2_HI) + f64::from(FRAC_PI_2_MID) + f64::from(FRAC_PI_2_LO);
+    assert!((sum - core::f64::consts::FRAC_PI_2).abs() < 2e-15);
+    assert!(f64::from(TRIG_ACCURATE_MAX_RAD) < 8191.5 * core::f64::consts::FRAC_PI_2);
+}
+
+#[test]
+fn the_reduction_is_exact_but_for_its_last_rounding() {
+    let limit = f64::from(TRIG_ACCURATE_MAX_RAD);
+    for x in grid(-limit, limit, 2_000_000) {
+        let (r, quadrant) = reduce(x);
+        let n = ((f64::from(x) - f64::from(r)) / core::f64::consts::FRAC_PI_2).round();
+        assert_eq!(n.rem_euclid(4.0) as u32, quadrant, "x = {x}");
+        let exact = f64::from(x) - n * core::f64::consts::FRAC_PI_2;
+        assert!((f64::from(r) - exact).abs() <= 0.5 * ulp(exact) + 5e-11, "x = {x}: {r} vs {exact}");
+        assert!(r.abs() <= FRAC_PI_4 + 1e-3, "x = {x}: r = {r}");
+    }
+}
+
+#[test]
+fn sin_and_cos_within_a_quarter_turn_are_within_1_ulp() {
+    for x in grid(-f64::from(FRAC_PI_4), f64::from(FRAC_PI_4), 2_000_000) {
+        let xs = f64::from(x);
+        assert!(ulps(sin(x), xs.sin()) <= 1.0, "sin {x}");
+        assert!(ulps(cos(x), xs.cos()) <= 1.0, "cos {x}");
+    }
+    // Tiny arguments: sin x = x, cos x = 1.
+    for x in [1e-30f32, f32::MIN_POSITIVE, 1e-45, 1e-8] {
+        assert_eq!((sin(x), sin(-x), cos(x)), (x, -x, 1.0));
+    }
+}
+
+#[test]
+fn sin_and_cos_over_the_accurate_range() {
+    // Within 1.6 ulp of the result plus 1e-10 (the reduction's error, seen only near the
+    // zeros), so at most 8e-8.
+    let limit = f64::from(TRIG_ACCURATE_MAX_RAD);
+    for x in grid(-limit, limit, 10_000_000) {
+        let xs = f64::from(x);
+        for (got, want) in [(sin(x), xs.sin()), (cos(x), xs.cos())] {
+            let error = (f64::from(got) - want).abs();
+            assert!(error <= 1.6 * ulp(want) + 1e-10 && error <= 8e-8, "x = {x}: {got} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn sin_cos_is_sin_and_cos_and_both_are_symmetric() {
+    for x in grid(-2_000.0, 2_000.0, 400_000) {
+        assert_eq!(sin_cos(x), (sin(x), cos(x)), "x = {x}");
+        assert_eq!(sin(-x), -sin(x), "x = {x}");
+        assert_eq!(cos(-x), cos(x), "x = {x}");
+    }
+    assert_eq!(sin_cos(FRAC_PI_2).0, 1.0);
+    assert_eq!(cos(PI), -1.0);
+}
+
+#[test]
+fn beyond_the_accurate_range_precision_fades_slowly() {
+    // n·MID rounds from 12_867 rad on, n·HI from 102_943: until then within 1e-6.
+    for x in grid(0.0, 1e5, 1_000_000) {
+        let xs = f64::from(x);
+        assert!((f64::from(sin(x)) - xs.sin()).abs() <= 1e-6, "sin {x}");
+        assert!((f64::from(cos(x)) - xs.cos()).abs() <= 1e-6, "cos {x}");
+    }
+}
+
+#[test]
+fn not_a_number_in_not_a_number_out() {
+    for x in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+        assert!(sin(x).is_nan() && cos(x).is_nan() && tan(x).is_nan(), "{x}");
+    }
+    assert!(asin(1.000_001).is_nan() && acos(-1.5).is_nan());
+}
+
+#[test]
+fn tan_is_within_3_ulp_plus_its_poles_sensitivity() {
+    for x in grid(-f64::from(FRAC_PI_4), f64::from(FRAC_PI_4), 1_000_000) {
+        assert!(ulps(tan(x), f64::from(x).tan()) <= 3.0, "tan {x}");
+    }
+    // Elsewhere the reduction's error is multiplied by tan' = 1 + tan².
+    let limit = f64::from(TRIG_ACCURATE_MAX_RAD);
+    for x in grid(-limit, limit, 4_000_000) {
+        let want = f64::from(x).tan();
+        let error = (f64::from(tan(x)) - want).abs();
+        assert!(error <= 3.0 * ulp(want) + 1e-8 * (1.0 + want * want), "tan {x}: {} vs {want}", tan(x));
+    }
+}
+
+#[test]
+fn tan_at_the_float_nearest_each_pole_is_large_and_finite() {
+    let mut k = 0.5;
+    while k * core::f64::consts::PI < f64::from(TRIG_ACCURATE_MAX_RAD) {
+        for pole in [k * core::f64::consts::PI, -k * core::f64::consts::PI] {
+            let x = pole as f32;
+            let (t, want) = (tan(x), f64::from(x).tan());
+            assert!(t.is_finite() && t.abs() > 1e3, "tan({x}) = {t}");
+            assert!((f64::from(t) - want).abs() <= 1e-3 * want.abs(), "tan({x}) = {t} vs {want}");
+        }
+        k += 1.0;
+    }
+}
+
+#[test]
+fn asin_and_acos_are_within_2_5_ulp() {
+    for x in grid(-1.0, 1.0, 2_000_000) {
+        let xs = f64::from(x);
+        assert!(ulps(asin(x), xs.asin()) <= 2.5, "asin {x}");
+        assert!(ulps(acos(x), xs.acos()) <= 2.5, "acos {x}");
+    }
+    assert_eq!((asin(1.0), asin(-1.0), asin(0.0)), (FRAC_PI_2, -FRAC_PI_2, 0.0));
+    assert_eq!((acos(1.0), acos(-1.0), acos(0.0)), (0.0, PI, FRAC_PI_2));
+}
+
+#[test]
+fn the_libm_functions_kept_are_within_1_ulp() {
+    for i in 0..=1_000_000u32 {
+        let u = f64::from(i) / 1e6;
+        let x = (-80.0 + 160.0 * u) as f32;
+        assert!(ulps(exp(x), f64::from(x).exp()) <= 1.0, "exp {x}");
+        let p = (1e-30 * 1e60f64.powf(u)) as f32;
+        assert!(ulps(ln(p), f64::from(p).ln()) <= 1.0, "ln {p}");
+        assert!(ulps(log10(p), f64::from(p).log10()) <= 1.0, "log10 {p}");
+        let a = (-1e4 + 2e4 * u) as f32;
+        assert!(ulps(atan(a), f64::from(a).atan()) <= 1.0, "atan {a}");
+        let (y, x) = ((-3.0 + 6.0 * u) as f32, (2.0 - 5.0 * u * u) as f32);
+        assert!(ulps(atan2(y, x), f64::from(y).atan2(f64::from(x))) <= 1.5, "atan2({y}, {x})");
+        let (b, e) = ((0.01 + 100.0 * u) as f32, (-3.0 + 6.0 * (u64::from(i) * 7_919 % 1_000_001) as f64 / 1e6) as f32);
+        assert!(ulps(pow(b, e), f64::from(b).powf(f64::from(e))) <= 1.0, "pow({b}, {e})");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4096))]
+
+    /// Any finite argument, however large: sin and cos finite and within [-1, 1].
+    #[test]
+    fn sin_and_cos_are_bounded_everywhere(bits in any::<u32>()) {
+        let x = f32::from_bits(bits);
+        prop_assume!(x.is_finite());
+        let (s, c) = sin_cos(x);
+        prop_assert!(s.abs() <= 1.0 && c.abs() <= 1.0, "x = {x}: {s}, {c}");
+        prop_assert_eq!((s, c), (sin(x), cos(x)));
+    }
+
+    /// Random arguments of the accurate range, against the host.
+    #[test]
+    fn sin_cos_tan_match_the_host(x in -TRIG_ACCURATE_MAX_RAD..TRIG_ACCURATE_MAX_RAD) {
+        let xs = f64::from(x);
+        let (s, c) = sin_cos(x);
+        prop_assert!((f64::from(s) - xs.sin()).abs() <= 1.6 * ulp(xs.sin()) + 1e-10);
+        prop_assert!((f64::from(c) - xs.cos()).abs() <= 1.6 * ulp(xs.cos()) + 1e-10);
+        let t = xs.tan();
+        prop_assert!((f64::from(tan(x)) - t).abs() <= 3.0 * ulp(t) + 1e-8 * (1.0 + t * t));
+    }
+
+    #[test]
+    fn asin_acos_match_the_host(x in -1.0f32..=1.0) {
+        prop_assert!(ulps(asin(x), f64::from(x).asin()) <= 2.5);
+        prop_assert!(ulps(acos(x), f64::from(x).acos()) <= 2.5);
+    }
+}
