@@ -1,9 +1,12 @@
-//! Decimal numbers read from text into `f32`, without the core library's float parsing.
+//! Decimal numbers read from text into `f32`, and written from `f32` into text, without the core
+//! library's float parsing and formatting.
 //!
-//! `str::parse::<f32>` works through `f64`-sized tables and big-number arithmetic (kilobytes of
-//! flash); the numbers the machine reads (G-code words, expression literals) need far less. This
-//! module owns that reading: [`parse_prefix`] reads one number at the start of a byte slice and
-//! says how many bytes it used, so a tokenizer can go on after it.
+//! `str::parse::<f32>` and `{:.3}` work through `f64`-sized tables and big-number arithmetic
+//! (kilobytes of flash); the numbers the machine reads (G-code words, expression literals) and
+//! writes (positions, settings, the LCD) need far less. This module owns both: [`parse_prefix`]
+//! reads one number at the start of a byte slice and says how many bytes it used, so a
+//! tokenizer can go on after it; [`write_fixed`] and [`write_trimmed`] write a number with a
+//! given count of decimals.
 //!
 //! ```text
 //! number := [sign] digits ['.' [digits]] [exponent]     sign only with `Syntax::sign`
@@ -229,6 +232,72 @@ fn scale(mut mantissa: u64, mut exp10: i32) -> Result<f32, DecimalError> {
     if value == 0.0 || value.is_infinite() { Err(DecimalError::OutOfRange) } else { Ok(value) }
 }
 
+/// Most decimals [`write_fixed`] writes.
+pub const WRITE_MAX_DECIMALS: u8 = 6;
+
+/// Writes `value` with exactly `decimals` decimals (at most [`WRITE_MAX_DECIMALS`]), rounded
+/// to the nearest, halfway away from zero, and never as `-0.000`. The integer part is exact up
+/// to 2^24 (every whole `f32` is) and rounded like the `f32` beyond; the decimals are those of
+/// the `f32`'s own fraction. `nan`, `inf`, `-inf` for what is not a finite number.
+pub fn write_fixed(out: &mut impl core::fmt::Write, value: f32, decimals: u8) -> core::fmt::Result {
+    let Some((negative, whole, fraction)) = split(value, decimals.min(WRITE_MAX_DECIMALS)) else {
+        return out.write_str(if value.is_nan() {
+            "nan"
+        } else if value > 0.0 {
+            "inf"
+        } else {
+            "-inf"
+        });
+    };
+    let decimals = decimals.min(WRITE_MAX_DECIMALS);
+    let sign = if negative && (whole != 0 || fraction != 0) { "-" } else { "" };
+    if decimals == 0 {
+        write!(out, "{sign}{whole}")
+    } else {
+        write!(out, "{sign}{whole}.{fraction:0width$}", width = usize::from(decimals))
+    }
+}
+
+/// Writes `value` with at most `max_decimals` decimals, leaving off trailing zeros down to
+/// `min_decimals` (`2.5` with 0 to 6 is `2.5`, `20000` is `20000`, with 3 to 6 `20000.000`).
+pub fn write_trimmed(
+    out: &mut impl core::fmt::Write,
+    value: f32,
+    min_decimals: u8,
+    max_decimals: u8,
+) -> core::fmt::Result {
+    let max = max_decimals.min(WRITE_MAX_DECIMALS);
+    let mut decimals = max;
+    if let Some((_, _, mut fraction)) = split(value, max) {
+        while decimals > min_decimals && fraction % 10 == 0 {
+            fraction /= 10;
+            decimals -= 1;
+        }
+    }
+    write_fixed(out, value, decimals)
+}
+
+/// `value` as (negative, whole part, the first `decimals` decimals as an integer), rounded to
+/// the last of them; `None` if it is not finite.
+fn split(value: f32, decimals: u8) -> Option<(bool, u64, u32)> {
+    if !value.is_finite() {
+        return None;
+    }
+    let scale = 10u32.pow(u32::from(decimals));
+    let magnitude = value.abs();
+    // Exact: every f32 at or above 2^23 is whole, and below it `trunc` and the difference are
+    // exact operations.
+    let whole = crate::math::trunc(magnitude);
+    let fraction = magnitude - whole;
+    let mut whole = whole as u64;
+    let mut fraction = crate::math::round(fraction * scale as f32) as u32;
+    if fraction >= scale {
+        whole += 1;
+        fraction -= scale;
+    }
+    Some((value < 0.0, whole, fraction))
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -410,6 +479,52 @@ mod tests {
             let (v, n) = read(&text, SIGNED).unwrap();
             prop_assert_eq!(read(&format!("-{text}"), SIGNED), Ok((-v, n + 1)));
             prop_assert_eq!(read(&format!("+{text}"), SIGNED), Ok((v, n + 1)));
+        }
+    }
+
+    fn fixed(value: f32, decimals: u8) -> std::string::String {
+        let mut s = std::string::String::new();
+        write_fixed(&mut s, value, decimals).unwrap();
+        s
+    }
+
+    fn trimmed(value: f32, min: u8, max: u8) -> std::string::String {
+        let mut s = std::string::String::new();
+        write_trimmed(&mut s, value, min, max).unwrap();
+        s
+    }
+
+    #[test]
+    fn numbers_are_written_with_the_decimals_asked_for() {
+        assert_eq!(fixed(10.0, 3), "10.000");
+        assert_eq!(fixed(-1234.56, 3), "-1234.560");
+        assert_eq!(fixed(-0.01, 3), "-0.010");
+        assert_eq!(fixed(-0.0004, 3), "0.000", "no minus zero");
+        assert_eq!(fixed(0.0005, 3), "0.001", "halfway away from zero");
+        assert_eq!(fixed(2.9996, 3), "3.000", "a carry into the whole part");
+        assert_eq!(fixed(-2.9996, 3), "-3.000");
+        assert_eq!(fixed(1_000_000.0, 3), "1000000.000");
+        assert_eq!(fixed(60_000.0, 6), "60000.000000", "no float noise from scaling the whole");
+        assert_eq!(fixed(12.5, 0), "13");
+        assert_eq!(fixed(3.25, 9), "3.250000", "at most six decimals");
+        assert_eq!(fixed(f32::NAN, 3), "nan");
+        assert_eq!(fixed(f32::NEG_INFINITY, 3), "-inf");
+        assert_eq!(trimmed(2.5, 0, 6), "2.5");
+        assert_eq!(trimmed(20_000.0, 0, 6), "20000");
+        assert_eq!(trimmed(20_000.0, 3, 6), "20000.000");
+        assert_eq!(trimmed(0.02, 3, 6), "0.020");
+        assert_eq!(trimmed(0.123456, 3, 6), "0.123456");
+    }
+
+    proptest::proptest! {
+        /// What is written reads back as the nearest number with that many decimals.
+        #[test]
+        fn written_numbers_round_to_the_value(value in -1.0e6f32..1.0e6, decimals in 0u8..=4) {
+            let text = fixed(value, decimals);
+            let back: f64 = text.parse().unwrap();
+            let exact = f64::from(value);
+            let step = 10f64.powi(-i32::from(decimals));
+            proptest::prop_assert!((back - exact).abs() <= step / 2.0 + exact.abs() * 1e-7, "{value} as {text}");
         }
     }
 }

@@ -133,7 +133,7 @@ impl Settings {
         if !value.is_finite() || value < info.min || value > info.max {
             return Err(SettingError::OutOfRange);
         }
-        let whole = value == libm::floorf(value);
+        let whole = value == crate::math::floor(value);
         let mut next = self.clone();
         match id {
             0 => next.pulse_width_us = value,
@@ -173,7 +173,7 @@ impl Settings {
 
     /// Millimetres to the nearest whole step on `axis`.
     pub fn mm_to_steps(&self, axis: crate::geom::Axis, mm: f32) -> i32 {
-        libm::roundf(mm * self.steps_per_mm(axis)) as i32
+        crate::math::round(mm * self.steps_per_mm(axis)) as i32
     }
 
     /// Steps to millimetres on `axis`.

@@ -61,7 +61,7 @@ pub struct Tangent {
 impl Tangent {
     /// The unit vector along `(x, y)`; `(1, 0)` for a zero vector.
     pub fn along(x: f32, y: f32) -> Self {
-        let len = libm::sqrtf(x * x + y * y);
+        let len = crate::math::sqrt(x * x + y * y);
         if len > 0.0 && len.is_finite() { Tangent { x: x / len, y: y / len } } else { Tangent { x: 1.0, y: 0.0 } }
     }
 }

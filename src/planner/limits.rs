@@ -102,7 +102,7 @@ impl Limits {
             let range = SETTING_INFO.iter().find(|info| info.id == id).map(|info| (info.min, info.max));
             let default = defaults.get(id).ok();
             if let (Some(value), Some((min, max)), Some(default)) = (setting_mut(&mut fixed, id), range, default) {
-                *value = if value.is_nan() { default } else { value.clamp(min, max) };
+                *value = if value.is_nan() { default } else { math::min(math::max(*value, min), max) };
             }
         }
         let slowest_max = math::min(fixed.max_rate_mm_per_min[0], fixed.max_rate_mm_per_min[1]);
@@ -376,7 +376,7 @@ pub fn plot_time_lower_bound(limits: &Limits, method: Method, feed: Feed, points
     let stop = limits.start_speed_mm_per_s;
     let start = math::sqrt(stop * stop + 2.0 * accel * longest_step_mm);
     // Where the rising ramp (from `start` at 0) meets the falling one (to `stop` at the end).
-    let half = ((total_mm + (stop * stop - start * start) / (2.0 * accel)) / 2.0).clamp(0.0, total_mm);
+    let half = math::min(math::max((total_mm + (stop * stop - start * start) / (2.0 * accel)) / 2.0, 0.0), total_mm);
     let (mut at_mm, mut seconds) = (0.0f32, 0.0f32);
     for (len, caps, _) in points.windows(2).filter_map(segment) {
         let (from, to) = (at_mm, at_mm + len);

@@ -420,7 +420,7 @@ impl GcodeState {
         let mut out = Commands::default();
         if block.non_modal == Some(NonModal::Dwell) {
             let p = words.take(b'P').ok_or(GrblError::ValueWordMissing)?;
-            let ms = libm::roundf(p * 1000.0);
+            let ms = crate::math::round(p * 1000.0);
             if !(ms <= DWELL_MAX_MS as f32) {
                 return Err(GrblError::MaxValueExceeded);
             }
@@ -568,7 +568,7 @@ impl GcodeState {
                 }
                 // Centre on the perpendicular bisector of the chord; the side follows the
                 // rotation, and a negative R takes the other side (the long arc).
-                let mut k = -libm::sqrtf(h2) / libm::hypotf(dx, dy);
+                let mut k = -crate::math::sqrt(h2) / crate::math::hypot(dx, dy);
                 if rotation == Rotation::CounterClockwise {
                     k = -k;
                 }
@@ -579,8 +579,8 @@ impl GcodeState {
             }
             ArcForm::Offsets([i, j]) => {
                 let center = [start[0] + i, start[1] + j];
-                let radius = libm::hypotf(i, j);
-                let delta = (libm::hypotf(end[0] - center[0], end[1] - center[1]) - radius).abs();
+                let radius = crate::math::hypot(i, j);
+                let delta = (crate::math::hypot(end[0] - center[0], end[1] - center[1]) - radius).abs();
                 if delta > ARC_RADIUS_SLACK_MM
                     && (delta > ARC_RADIUS_ERROR_MAX_MM || delta > ARC_RADIUS_ERROR_MAX_RATIO * radius)
                 {
@@ -591,14 +591,19 @@ impl GcodeState {
         };
         let (sx, sy) = (start[0] - center[0], start[1] - center[1]);
         let (ex, ey) = (end[0] - center[0], end[1] - center[1]);
-        let mut sweep = libm::atan2f(sx * ey - sy * ex, sx * ex + sy * ey);
+        let mut sweep = crate::math::atan2(sx * ey - sy * ex, sx * ex + sy * ey);
         match rotation {
             Rotation::Clockwise if sweep >= -ARC_ANGLE_EPSILON_RAD => sweep -= TAU,
             Rotation::CounterClockwise if sweep <= ARC_ANGLE_EPSILON_RAD => sweep += TAU,
             _ => {}
         }
-        let conic =
-            Conic { center, semi_axes_mm: [radius, radius], start_rad: libm::atan2f(sy, sx), sweep_rad: sweep, end };
+        let conic = Conic {
+            center,
+            semi_axes_mm: [radius, radius],
+            start_rad: crate::math::atan2(sy, sx),
+            sweep_rad: sweep,
+            end,
+        };
         self.conic(conic, Feed::MmPerMin(feed_mm_per_min), settings)
     }
 
@@ -619,8 +624,8 @@ impl GcodeState {
         } else {
             (c.start_rad + c.sweep_rad, c.start_rad)
         };
-        let first = libm::ceilf(lo / FRAC_PI_2) as i32;
-        let last = libm::floorf(hi / FRAC_PI_2) as i32;
+        let first = crate::math::ceil(lo / FRAC_PI_2) as i32;
+        let last = crate::math::floor(hi / FRAC_PI_2) as i32;
         // A sweep of at most a full turn passes at most five such angles.
         for k in first..=last.min(first.saturating_add(4)) {
             let (cos, sin) = match k.rem_euclid(4) {
@@ -641,7 +646,7 @@ impl GcodeState {
             return Ok(None);
         }
         let spm = settings.steps_per_mm;
-        let semi = [libm::roundf(c.semi_axes_mm[0] * spm[0]), libm::roundf(c.semi_axes_mm[1] * spm[1])];
+        let semi = [crate::math::round(c.semi_axes_mm[0] * spm[0]), crate::math::round(c.semi_axes_mm[1] * spm[1])];
         if !(semi[0] >= 1.0 && semi[1] >= 1.0) {
             return Err(GrblError::InvalidTarget);
         }
@@ -879,15 +884,15 @@ impl GcodeState {
         if sweep_deg == 0.0 {
             return Ok(None);
         }
-        let t0 = libm::fmodf(start_deg, 360.0).to_radians();
+        let t0 = (start_deg % 360.0).to_radians();
         let sweep = sweep_deg.to_radians();
         let [a, b] = semi_axes_mm;
         let p = self.position_mm;
-        let center = [p[0] - a * libm::cosf(t0), p[1] - b * libm::sinf(t0)];
+        let center = [p[0] - a * crate::math::cos(t0), p[1] - b * crate::math::sin(t0)];
         let end = if sweep_deg.abs() == 360.0 {
             p
         } else {
-            [center[0] + a * libm::cosf(t0 + sweep), center[1] + b * libm::sinf(t0 + sweep)]
+            [center[0] + a * crate::math::cos(t0 + sweep), center[1] + b * crate::math::sin(t0 + sweep)]
         };
         self.conic(Conic { center, semi_axes_mm, start_rad: t0, sweep_rad: sweep, end }, feed, settings)
     }
@@ -907,12 +912,12 @@ impl GcodeState {
         if !(t1.is_finite() && amplitude_mm.abs() <= CURVE_RADIUS_MAX_MM) {
             return Err(GrblError::InvalidTarget);
         }
-        let s0 = libm::sinf(phase_rad);
+        let s0 = crate::math::sin(phase_rad);
         let (lo, hi) = sin_range(phase_rad, t1);
         check_travel(settings, [p[0] + length_mm, p[1] + amplitude_mm * (lo - s0)])?;
         check_travel(settings, [p[0], p[1] + amplitude_mm * (hi - s0)])?;
         let spm = settings.steps_per_mm;
-        let dx = libm::roundf(length_mm * spm[0]);
+        let dx = crate::math::round(length_mm * spm[0]);
         if dx == 0.0 {
             return Ok(None);
         }
@@ -983,25 +988,23 @@ impl GcodeState {
         let p = self.position_mm;
         check_travel(settings, [p[0] + (x1_mm - x0_mm), p[1]])?;
         let spm = settings.steps_per_mm;
-        let dx = libm::roundf((x1_mm - x0_mm) * spm[0]);
+        let dx = crate::math::round((x1_mm - x0_mm) * spm[0]);
         if dx == 0.0 {
             return Ok(Commands::default());
         }
-        let f = |x: f64| {
-            expr.eval(x as f32).map(f64::from).map_err(|error| GrblError::FunctionUndefined { x_mm: x as f32, error })
-        };
-        let (x0, x1) = (x0_mm as f64, x1_mm as f64);
+        let f = |x: f32| expr.eval(x).map_err(|error| GrblError::FunctionUndefined { x_mm: x, error });
+        let (x0, x1) = (x0_mm, x1_mm);
         let y0 = f(x0)?;
-        let y_at_pen = |y: f64| [p[0], p[1] + (y - y0) as f32];
+        let y_at_pen = |y: f32| [p[0], p[1] + (y - y0)];
         for k in 0..=FUNCTION_CHECK_SAMPLES {
-            let x = x0 + (x1 - x0) * k as f64 / FUNCTION_CHECK_SAMPLES as f64;
+            let x = x0 + (x1 - x0) * k as f32 / FUNCTION_CHECK_SAMPLES as f32;
             check_travel(settings, y_at_pen(f(x)?))?;
         }
         // The x the curve really ends at, on the step lattice.
-        let x_end = x0 + dx as f64 / spm[0] as f64;
+        let x_end = x0 + dx / spm[0];
         let y_end = f(x_end)?;
         check_travel(settings, y_at_pen(y_end))?;
-        let dy = libm::round((y_end - y0) * spm[1] as f64);
+        let dy = crate::math::floor((y_end - y0) * spm[1] + 0.5);
         let to = Point::new(self.position.x + dx as i32, self.position.y + dy as i32);
         self.land_on(to, settings);
         let shape = Shape::Function { expr, x0_mm, x1_mm };
@@ -1065,43 +1068,14 @@ impl Iterator for WordIter<'_> {
     }
 }
 
-/// A G-code number: optional sign, digits with at most one point, at least one digit.
+/// A G-code number: optional sign, digits with at most one point, at least one digit (no
+/// exponent: in G-code `E` is a word letter). The whole of `text` must be the number.
 fn parse_number(text: &[u8]) -> Result<f32, GrblError> {
-    const MANTISSA_MAX: u64 = 100_000_000_000_000_000;
-    let (negative, digits) = match text.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        Some((b'+', rest)) => (false, rest),
-        _ => (false, text),
-    };
-    let (mut mantissa, mut exp10, mut any_digit, mut seen_point) = (0u64, 0i32, false, false);
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                any_digit = true;
-                if mantissa < MANTISSA_MAX {
-                    mantissa = mantissa * 10 + (c - b'0') as u64;
-                    if seen_point {
-                        exp10 -= 1;
-                    }
-                } else if !seen_point {
-                    exp10 += 1;
-                }
-            }
-            b'.' if !seen_point => seen_point = true,
-            _ => return Err(GrblError::BadNumberFormat),
-        }
+    let syntax = crate::decimal::Syntax { sign: true, exponent: false };
+    match crate::decimal::parse_prefix(text, syntax) {
+        Ok(n) if n.len_bytes == text.len() => Ok(n.value),
+        _ => Err(GrblError::BadNumberFormat),
     }
-    if !any_digit {
-        return Err(GrblError::BadNumberFormat);
-    }
-    let mut value = mantissa as f64;
-    let mut scale = 1.0f64;
-    for _ in 0..exp10.unsigned_abs() {
-        scale *= 10.0;
-    }
-    value = if exp10 < 0 { value / scale } else { value * scale };
-    let value = (if negative { -value } else { value }) as f32;
-    if value.is_finite() { Ok(value) } else { Err(GrblError::BadNumberFormat) }
 }
 
 /// Letter values of one line.
@@ -1323,7 +1297,7 @@ fn command_number(value: f32) -> Result<(u16, u8), GrblError> {
     if !(0.0..1000.0).contains(&value) {
         return Err(GrblError::Unsupported);
     }
-    let hundredths = libm::roundf(value * 100.0) as u32;
+    let hundredths = crate::math::round(value * 100.0) as u32;
     if !hundredths.is_multiple_of(10) {
         return Err(GrblError::ValueNotInteger);
     }

@@ -42,7 +42,7 @@ pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
         }
         GrblError::FunctionUndefined { x_mm, error } => {
             out.write_str("[MSG:Function undefined at x=")?;
-            mm(out, x_mm as f64)?;
+            mm(out, x_mm)?;
             write!(out, ": {}]\r\n", error.message())?;
         }
         _ => {}
@@ -85,14 +85,14 @@ pub fn status(
         RunState::Alarm => "Alarm",
     };
     write!(out, "<{state}|MPos:")?;
-    let x = status.position.x as f64 / settings.steps_per_mm(Axis::X) as f64;
-    let y = status.position.y as f64 / settings.steps_per_mm(Axis::Y) as f64;
+    let x = settings.steps_to_mm(Axis::X, status.position.x);
+    let y = settings.steps_to_mm(Axis::Y, status.position.y);
     xyz(out, x, y)?;
-    let feed = if feed_mm_per_min.is_finite() { libm::roundf(feed_mm_per_min.abs()) as u32 } else { 0 };
+    let feed = if feed_mm_per_min.is_finite() { crate::math::round(feed_mm_per_min.abs()) as u32 } else { 0 };
     write!(out, "|FS:{feed},0")?;
     if let Some([x, y]) = work_offset_mm {
         out.write_str("|WCO:")?;
-        xyz(out, x as f64, y as f64)?;
+        xyz(out, x, y)?;
     }
     if status.underruns > 0 {
         write!(out, "|Un:{}", status.underruns)?;
@@ -142,8 +142,8 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
         Spindle::Ccw => "M4",
         Spindle::Off => "M5",
     };
-    let feed = libm::roundf(gcode.feed_mm_per_min(settings)) as u32;
-    let speed = libm::roundf(gcode.spindle_speed()) as u32;
+    let feed = crate::math::round(gcode.feed_mm_per_min(settings)) as u32;
+    let speed = crate::math::round(gcode.spindle_speed()) as u32;
     write!(out, "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} M9 T{} F{feed} S{speed}]\r\n", gcode.tool())
 }
 
@@ -154,7 +154,7 @@ pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
     }
     let [x, y] = gcode.work_offset_mm();
     out.write_str("[G92:")?;
-    xyz(out, x as f64, y as f64)?;
+    xyz(out, x, y)?;
     out.write_str("]\r\n[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
 }
 
@@ -170,7 +170,7 @@ pub fn help(out: &mut impl Write) -> fmt::Result {
 }
 
 /// `x,y,0.000` in millimetres.
-fn xyz(out: &mut impl Write, x: f64, y: f64) -> fmt::Result {
+fn xyz(out: &mut impl Write, x: f32, y: f32) -> fmt::Result {
     mm(out, x)?;
     out.write_char(',')?;
     mm(out, y)?;
@@ -178,27 +178,13 @@ fn xyz(out: &mut impl Write, x: f64, y: f64) -> fmt::Result {
 }
 
 /// Millimetres with exactly three decimals, rounded to the micrometre; never `-0.000`.
-fn mm(out: &mut impl Write, value: f64) -> fmt::Result {
-    let um = if value.is_finite() { libm::round(value * 1000.0) as i64 } else { 0 };
-    let sign = if um < 0 { "-" } else { "" };
-    let um = um.unsigned_abs();
-    write!(out, "{sign}{}.{:03}", um / 1000, um % 1000)
+fn mm(out: &mut impl Write, value: f32) -> fmt::Result {
+    crate::decimal::write_fixed(out, if value.is_finite() { value } else { 0.0 }, 3)
 }
 
 /// A setting's value: at least three decimals like GRBL, more (up to six) when it has them.
 fn decimal(out: &mut impl Write, value: f32) -> fmt::Result {
-    let mut text: heapless::String<48> = heapless::String::new();
-    if write!(text, "{value:.6}").is_err() {
-        return write!(out, "{value:.3}");
-    }
-    let keep = match text.find('.') {
-        Some(point) => {
-            let digits = text.trim_end_matches('0').len();
-            digits.max(point + 4)
-        }
-        None => text.len(),
-    };
-    out.write_str(&text[..keep])
+    crate::decimal::write_trimmed(out, value, 3, 6)
 }
 
 #[cfg(test)]

@@ -108,7 +108,7 @@ impl EllipseParams {
 
     /// True when the arc closes on itself.
     pub fn is_full(&self) -> bool {
-        libm::fabsf(self.sweep_deg) >= 360.0
+        self.sweep_deg.abs() >= 360.0
     }
 
     /// The box the arc covers, relative to the start point.
@@ -117,7 +117,8 @@ impl EllipseParams {
         let hi = self.start_deg.max(self.start_deg + self.sweep_deg);
         let (x0, y0) = self.point_mm(self.start_deg);
         // Extremes of x and y lie at the ends and at every multiple of 90 degrees in between.
-        let quarters = (libm::ceilf(lo / 90.0) as i32..=libm::floorf(hi / 90.0) as i32).map(|k| k as f32 * 90.0);
+        let quarters =
+            (crate::math::ceil(lo / 90.0) as i32..=crate::math::floor(hi / 90.0) as i32).map(|k| k as f32 * 90.0);
         let angles = [lo, hi].into_iter().chain(quarters);
         Extent::around(angles.map(|t| {
             let (x, y) = self.point_mm(t);
@@ -147,7 +148,7 @@ impl SineParams {
     /// The curve's y at `x_mm`, relative to the start point.
     pub fn y_at(&self, x_mm: f32) -> f32 {
         let phase = self.phase_deg.to_radians();
-        self.amplitude_mm * (libm::sinf(self.omega_rad_per_mm() * x_mm + phase) - libm::sinf(phase))
+        self.amplitude_mm * (crate::math::sin(self.omega_rad_per_mm() * x_mm + phase) - crate::math::sin(phase))
     }
 
     /// The box the curve covers, relative to the start point.
@@ -157,7 +158,7 @@ impl SineParams {
         let w = self.omega_rad_per_mm();
         let (s_min, s_max) = sin_range(w * x_min + phase, w * x_max + phase);
         let (y_a, y_b) = (self.amplitude_mm * s_min, self.amplitude_mm * s_max);
-        let offset = self.amplitude_mm * libm::sinf(phase);
+        let offset = self.amplitude_mm * crate::math::sin(phase);
         Extent { x_min_mm: x_min, x_max_mm: x_max, y_min_mm: y_a.min(y_b) - offset, y_max_mm: y_a.max(y_b) - offset }
     }
 }
@@ -209,10 +210,10 @@ impl FunctionPreset {
     pub fn eval(self, x: f32) -> Option<f32> {
         match self {
             FunctionPreset::Parabola => Some(x * x / 20.0),
-            FunctionPreset::Wave => Some(10.0 * libm::sinf(x / 5.0)),
-            FunctionPreset::Root => (x >= 0.0).then(|| 5.0 * libm::sqrtf(x)),
+            FunctionPreset::Wave => Some(10.0 * crate::math::sin(x / 5.0)),
+            FunctionPreset::Root => (x >= 0.0).then(|| 5.0 * crate::math::sqrt(x)),
             FunctionPreset::Cubic => Some(x * x * x / 400.0),
-            FunctionPreset::Bell => Some(20.0 * libm::expf(-x * x / 200.0)),
+            FunctionPreset::Bell => Some(20.0 * crate::math::exp(-x * x / 200.0)),
         }
     }
 
@@ -335,7 +336,7 @@ impl CurveJob {
 /// sin and cos of an angle in degrees, exact at multiples of 90.
 fn sin_cos_deg(deg: f32) -> (f32, f32) {
     let quarter = deg / 90.0;
-    if quarter == libm::roundf(quarter) {
+    if quarter == crate::math::round(quarter) {
         match (quarter as i32).rem_euclid(4) {
             0 => (0.0, 1.0),
             1 => (1.0, 0.0),
@@ -343,7 +344,7 @@ fn sin_cos_deg(deg: f32) -> (f32, f32) {
             _ => (-1.0, 0.0),
         }
     } else {
-        libm::sincosf(deg.to_radians())
+        crate::math::sin_cos(deg.to_radians())
     }
 }
 
@@ -411,7 +412,7 @@ mod tests {
         assert_extent(r.extent().unwrap(), (-100.0, 0.0), (-50.0, 0.0));
         assert_eq!(FunctionParams { x1_mm: -1.0, ..r }.extent(), None, "sqrt of a negative");
         let b = FunctionParams { preset: FunctionPreset::Bell, x0_mm: -30.0, x1_mm: 30.0 };
-        let y0 = 20.0 * libm::expf(-4.5);
+        let y0 = 20.0 * crate::math::exp(-4.5);
         assert_extent(b.extent().unwrap(), (0.0, 60.0), (0.0, 20.0 - y0));
         for p in FunctionPreset::ALL {
             assert_eq!(FunctionPreset::ALL[p.index()], p);

@@ -122,7 +122,7 @@ impl NumberEntry {
         if !any_digit {
             return Err(EntryError::NotANumber);
         }
-        let magnitude = mantissa as f32 / libm::powf(10.0, decimals as f32);
+        let magnitude = mantissa as f32 / crate::math::pow(10.0, decimals as f32);
         Ok(Some(if self.negative { -magnitude } else { magnitude }))
     }
 }

@@ -225,7 +225,7 @@ fn mm_text(mm: f32) -> String<POSITION_CHARS> {
     let mut s = String::new();
     for decimals in [3, 1, 0] {
         s.clear();
-        if write!(s, "{:.*}", decimals, mm).is_ok() {
+        if crate::decimal::write_fixed(&mut s, mm, decimals).is_ok() {
             return s;
         }
     }
@@ -237,12 +237,12 @@ fn mm_text(mm: f32) -> String<POSITION_CHARS> {
 fn settings_line(i: usize, s: &Settings) -> TextLine {
     let line = |args| TextLine::new(args, false);
     match i {
-        0 => line(format_args!("Steps/mm X{} Y{}", s.steps_per_mm[0], s.steps_per_mm[1])),
-        1 => line(format_args!("Travel mm X{} Y{}", s.max_travel_mm[0], s.max_travel_mm[1])),
-        2 => line(format_args!("Feed {} mm/min", s.default_feed_mm_per_min)),
-        3 => line(format_args!("Start {} mm/min", s.start_rate_mm_per_min)),
-        4 => line(format_args!("Jog {} mm/min", JOG_FEED_MM_PER_MIN)),
-        5 => line(format_args!("Pulse max {} Hz", s.max_pulse_rate_hz)),
+        0 => line(format_args!("Steps/mm X{} Y{}", Num(s.steps_per_mm[0]), Num(s.steps_per_mm[1]))),
+        1 => line(format_args!("Travel mm X{} Y{}", Num(s.max_travel_mm[0]), Num(s.max_travel_mm[1]))),
+        2 => line(format_args!("Feed {} mm/min", Num(s.default_feed_mm_per_min))),
+        3 => line(format_args!("Start {} mm/min", Num(s.start_rate_mm_per_min))),
+        4 => line(format_args!("Jog {} mm/min", Num(JOG_FEED_MM_PER_MIN))),
+        5 => line(format_args!("Pulse max {} Hz", Num(s.max_pulse_rate_hz))),
         6 => line(format_args!(
             "Interpolation {}",
             match s.method {
@@ -251,6 +251,15 @@ fn settings_line(i: usize, s: &Settings) -> TextLine {
             }
         )),
         _ => TextLine::default(),
+    }
+}
+
+/// A setting's value as the screen shows it: up to three decimals, trailing zeros left off.
+struct Num(f32);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        crate::decimal::write_trimmed(f, self.0, 0, 3)
     }
 }
 
@@ -278,7 +287,7 @@ impl fmt::Display for ErrorText {
             UiError::Entry(EntryError::TooLong) => write!(f, "Max {ENTRY_MAX_CHARS} characters"),
             UiError::Entry(EntryError::NotANumber) => f.write_str("Not a number"),
             UiError::Empty => f.write_str("Type a value"),
-            UiError::OutOfRange { min, max, unit } => write!(f, "Range {min}..{max} {}", unit.symbol()),
+            UiError::OutOfRange { min, max, unit } => write!(f, "Range {}..{} {}", Num(min), Num(max), unit.symbol()),
             UiError::Zero => f.write_str("Must not be 0"),
             UiError::SameEnds => f.write_str("x1 must differ from x0"),
             UiError::Domain => f.write_str("f(x) undefined there"),
