@@ -126,9 +126,9 @@ pub const STEP_RING_LEN: usize = 4_096;
 pub const CHUNK_RING_LEN: usize = 256;
 
 /// Steps per chunk on a curve: the scan reads the tangent, and works out the caps, once per
-/// chunk. 16 steps turn by 3° on a circle of 300 steps radius, so the caps follow the curve
-/// closely.
-pub const CHUNK_STEPS: usize = 16;
+/// chunk. 32 steps turn by 6° on a circle of 300 steps radius, so the caps follow the curve
+/// closely; kinks do not wait for a chunk's end (a fill stops at each).
+pub const CHUNK_STEPS: usize = 32;
 
 /// Steps per chunk on a straight line ([`Interpolator::is_straight`]): its steps all have the
 /// same length and caps.
