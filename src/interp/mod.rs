@@ -8,14 +8,18 @@
 pub mod arc;
 pub(crate) mod conic;
 pub mod ellipse;
+pub mod explicit;
 pub mod function;
 pub mod line;
+pub mod setup;
 pub mod sine;
 
 pub use arc::{ArcError, ArcInterp};
 pub use ellipse::EllipseInterp;
-pub use function::{CurveSetupError, FunctionInterp};
+pub use explicit::{RowRange, jump_limit_steps};
+pub use function::FunctionInterp;
 pub use line::LineInterp;
+pub use setup::CurveSetupError;
 pub use sine::SineInterp;
 
 use crate::geom::{Point, Step};
@@ -200,8 +204,8 @@ impl Curve {
                     f64::from(*omega_rad_per_step),
                     f64::from(*phase_rad),
                     *length_steps,
-                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
-                    function::RowRange::within_travel(start.y, travel_steps),
+                    jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
                 let d = sine.end();
@@ -216,8 +220,8 @@ impl Curve {
                     f64::from(*x0_mm),
                     f64::from(*x1_mm),
                     spm,
-                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
-                    function::RowRange::within_travel(start.y, travel_steps),
+                    jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
                 // Where it ends if nothing stops it; a curve that stops early (a domain error,
