@@ -3,27 +3,31 @@
 //! with the limits every explicit curve is held to ([`RowRange`], [`jump_limit_steps`],
 //! [`MAX_CURVE_OFFSET_STEPS`]).
 //!
-//! [`ExplicitCurve`] sees the curve only through [`CurveFn`]: the ideal y, in steps, at each
-//! whole-step *column* 0, 1, ..., n along the direction of travel. The path is translated to
-//! start at the pen: it follows `h(k) = g(k) - g(0)`.
+//! [`ExplicitCurve`] sees the curve only through [`CurveFn`]: the ideal y at each whole-step
+//! *column* 0, 1, ..., n along the direction of travel, in the curve's own unit, and how many
+//! steps that unit is. The path is translated to start at the pen: it follows
+//! `h(k) = (g(k) - g(0))·steps_per_unit`, in steps.
 //!
 //! Between two columns the ideal curve is taken as its chord, the segment from `(k, h(k))` to
 //! `(k + 1, h(k + 1))`; the curve as drawn is the polyline through the column values (for a
 //! smooth g it differs from g by at most `max|g''| / 8` between columns).
 //!
 //! * The chain. Every column `k` is entered at its rounded value `r(k) = round(h(k))` (nearest
-//!   step, ties toward +y). A flat chord (|slope| <= 1) is one step, straight or diagonal, to
-//!   `(k + 1, r(k + 1))`. A steep chord is walked row by row from `r(k)` to `r(k + 1)`, and in each
-//!   row the pen stands in the column nearer to where the chord crosses that row, so X advances
-//!   in the middle of a steep rise, not at its end.
+//!   step, ties toward +y). A chord whose rows differ by at most one is one step, straight or
+//!   diagonal, to `(k + 1, r(k + 1))`. A steeper chord is walked row by row from `r(k)` to
+//!   `r(k + 1)`, and in each row the pen stands in the column nearer to where the chord crosses
+//!   that row, so X advances in the middle of a steep rise, not at its end: at the first row at
+//!   or past the chord's middle value `(h(k) + h(k + 1)) / 2`.
 //! * `Diagonal` takes the chain as it is: both axes may move together. Every lattice point
 //!   visited lies within 0.5 step (Euclidean distance) of the chord it belongs to;
 //!   `Σ max(1, |r(k+1) - r(k)|)` steps in all.
 //! * `Classic` moves one axis per step, in the manner of the point-by-point comparison: where
 //!   the chain moves diagonally it compares the two corners of that move and passes through the
-//!   one nearer to the chord. Every lattice point visited lies within √2/2 ≈ 0.71 step of its
-//!   chord (both ends of the move are within 0.5 of it, so the chord crosses the move's other
-//!   diagonal within 0.5 of its middle); `n + Σ |r(k+1) - r(k)|` steps in all, none wasted.
+//!   one nearer to the chord's line (ties: X first). Every lattice point visited lies within
+//!   √2/2 ≈ 0.71 step of its chord (both ends of the move are within 0.5 of it, so the chord
+//!   crosses the move's other diagonal within 0.5 of its middle, and the corner nearer to the
+//!   line is the one nearer to that crossing); `n + Σ |r(k+1) - r(k)|` steps in all, none
+//!   wasted.
 //! * The end point is exactly `(n, round(h(n)))`, and every chord takes at most
 //!   `1 + |r(k+1) - r(k)|` steps, so the curve always terminates.
 //!
@@ -46,10 +50,48 @@
 //!   anything moves.
 //!
 //! [`Interpolator::tangent`] is the direction of the current chord, `(1, h(k+1) - h(k))`
-//! normalised and pointing in the direction of travel (the derivative by finite difference).
+//! normalised and pointing in the direction of travel (the derivative by finite difference). It
+//! changes only where the pen reaches a column, so that is the only place a curve can kink
+//! ([`KINK_CHORD`]).
+//!
+//! # Batches
+//!
+//! Once a chord's two rows are known its steps are fixed: some steps along Y, the one move that
+//! advances X (two steps for `Classic` where it is diagonal), the rest along Y. Loading a chord
+//! works that pattern out once; [`Interpolator::fill`] then writes it straight into the buffer,
+//! and does per-chord work (evaluate g, round, check the limits, choose the classic corner,
+//! test for a kink) only where a column is reached. `next_step` is `fill` with a
+//! buffer of one, so both hand out the same steps by construction. A kink can only fall where a
+//! chord starts, and only where the slope changes by more than [`KINK_CHORD`] (the angle
+//! between two directions is at most the difference of their slopes), so only there are the
+//! two unit tangents compared.
+//!
+//! # Arithmetic
+//!
+//! Columns and rows are integers; values are `f32`, whose 24-bit significand is what limits
+//! their precision. The care taken:
+//!
+//! * Cancellation in `g(k) - g(0)`: g is subtracted in its own unit, before the scale to steps,
+//!   so a curve far from zero (`1000 + sin(x)` mm) loses nothing to the subtraction itself:
+//!   two `f32` within a factor of two of each other subtract exactly. What remains is the error
+//!   g's values carry in themselves, a few units in the last place of |g| (an `f32`'s ulp is
+//!   2⁻²³ of it), then one rounding of h relative to |h|. A curve's rows are therefore exact to
+//!   about `2⁻²¹·(max|g| in steps)`: 0.005 step for a curve reaching 10_000 steps from zero,
+//!   0.05 step at the machine's full ±100_000 (f32 numbers there are 1/128 step apart). The
+//!   sine and function modules state what their g adds.
+//! * Rounding to rows is exact: `floor` by conversion to an integer, then a comparison with
+//!   the integer plus one half (both exact below 2²³), so `(n, round(h(n)))` is exact for the
+//!   value computed, and ties go toward +y.
+//! * The chain's own decisions (the middle of a steep chord, the classic corner) use the chord's
+//!   two values; each costs at most one more rounding of a value of the size of h. So every
+//!   bound above holds for the computed values within `2⁻²³·max|h|`, for the ideal ones within
+//!   the values' own error besides.
+//! * Offsets are checked against [`MAX_CURVE_OFFSET_STEPS`] (below 2²⁰) before any rounding to
+//!   an integer, so all of the above stays in the exact range, and all step arithmetic is `i32`.
 
 use crate::geom::{Point, Step};
-use crate::interp::{CurveError, CurveSetupError, Interpolator, Method, Tangent};
+use crate::interp::{CurveError, CurveSetupError, Filled, Interpolator, KINK_CHORD, Method, Tangent};
+use crate::math;
 
 #[cfg(test)]
 pub(crate) mod test_support;
@@ -60,6 +102,10 @@ mod tests;
 /// machine's full travel (±500 mm at 200 steps/mm is 200_000 steps corner to corner), so a curve
 /// that fits the machine is never refused and all step arithmetic stays far from `i32`'s limits.
 pub const MAX_CURVE_OFFSET_STEPS: i32 = 1_000_000;
+
+/// [`MAX_CURVE_OFFSET_STEPS`] as an `f32` (exactly: it is below 2²⁴).
+const MAX_CURVE_OFFSET_STEPS_F32: f32 = MAX_CURVE_OFFSET_STEPS as f32;
+
 /// The rows an explicit curve may reach, relative to its start, both ends included: the
 /// machine's travel on Y as seen from the start. A column whose row lies outside ends the curve
 /// with [`CurveError::Travel`].
@@ -91,34 +137,102 @@ impl RowRange {
 /// The jump limit of an explicit curve, in rows: the `max_jump_mm` setting (`$204`) at
 /// `y_steps_per_mm`, rounded down, and at least one row, or any slope at all would be a jump.
 pub fn jump_limit_steps(max_jump_mm: f32, y_steps_per_mm: f32) -> i32 {
-    (max_jump_mm * y_steps_per_mm).max(1.0) as i32
+    math::max(max_jump_mm * y_steps_per_mm, 1.0) as i32
 }
 
 /// An explicit curve as [`ExplicitCurve`] sees it.
 pub trait CurveFn {
-    /// The ideal y, in steps, at `column` (0 at the start, counted in the direction of travel,
-    /// up to the curve's length). Only differences from column 0 matter.
-    fn y_steps(&self, column: i32) -> Result<f64, CurveError>;
+    /// The ideal y at `column` (0 at the start, counted in the direction of travel, up to the
+    /// curve's length), in the curve's own unit. Only differences from column 0 matter.
+    fn y(&self, column: i32) -> Result<f32, CurveError>;
+
+    /// Steps per unit of [`CurveFn::y`]; any finite number (negative mirrors the curve).
+    fn y_steps_per_unit(&self) -> f32 {
+        1.0
+    }
 }
 
-impl<F: Fn(i32) -> Result<f64, CurveError>> CurveFn for F {
-    fn y_steps(&self, column: i32) -> Result<f64, CurveError> {
+impl<F: Fn(i32) -> Result<f32, CurveError>> CurveFn for F {
+    fn y(&self, column: i32) -> Result<f32, CurveError> {
         self(column)
     }
 }
 
+/// The largest integer not above `v`, for |v| < 2²³ (exact there).
+#[inline]
+fn floor_steps(v: f32) -> i32 {
+    // Toward zero, then one down where that went up.
+    let t = v as i32;
+    if t as f32 > v { t - 1 } else { t }
+}
+
 /// The nearest whole step to `h`, ties toward +y (monotonic, so that neighbouring columns whose
-/// values differ by at most one step round at most one step apart).
-pub(crate) fn nearest_step(h: f64) -> i32 {
-    libm::floor(h + 0.5) as i32
+/// values differ by at most one step round at most one step apart). Exact for |h| < 2²²: the
+/// comparison is with `floor(h) + 0.5`, which is an `f32` there.
+#[inline]
+pub(crate) fn nearest_step(h: f32) -> i32 {
+    let f = floor_steps(h);
+    f + i32::from(h >= f as f32 + 0.5)
+}
+
+/// The unit tangent `(dir, slope)` normalised.
+#[inline]
+fn unit(dir: i8, slope: f32) -> Tangent {
+    let inv = 1.0 / math::sqrt(1.0 + slope * slope);
+    Tangent { x: f32::from(dir) * inv, y: slope * inv }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
     Running,
-    /// Ends with this error at the next call.
+    /// Ends with this error where the next step would be.
     Failed(CurveError),
     Done,
+}
+
+/// The steps of the current chord: `total` steps, each `vertical` except the step at
+/// `middle_at` (`middle`, the one that advances X or its first half) and the one after it
+/// (`after_middle`: the second half of a classic diagonal move, otherwise `vertical`).
+#[derive(Clone, Copy, Debug)]
+struct Chord {
+    vertical: Step,
+    middle: Step,
+    after_middle: Step,
+    middle_at: usize,
+    total: usize,
+    /// Steps handed out so far.
+    done: usize,
+}
+
+impl Chord {
+    /// No steps: before the first chord is loaded.
+    const EMPTY: Chord =
+        Chord { vertical: Step::NONE, middle: Step::NONE, after_middle: Step::NONE, middle_at: 0, total: 0, done: 0 };
+
+    /// Writes the chord's steps `from..from + out.len()` into `out`.
+    #[inline]
+    fn write(&self, from: usize, out: &mut [Step]) {
+        out.fill(self.vertical);
+        // Where the middle falls in `out` (wrapping: before it, the step after the middle can
+        // still be its first slot).
+        let at = self.middle_at.wrapping_sub(from);
+        if let Some(slot) = out.get_mut(at) {
+            *slot = self.middle;
+        }
+        if let Some(slot) = out.get_mut(at.wrapping_add(1)) {
+            *slot = self.after_middle;
+        }
+    }
+
+    fn step(&self, j: usize) -> Step {
+        if j == self.middle_at {
+            self.middle
+        } else if j == self.middle_at + 1 {
+            self.after_middle
+        } else {
+            self.vertical
+        }
+    }
 }
 
 /// Steps along an explicit curve y = g(x); see the module documentation.
@@ -133,24 +247,20 @@ pub struct ExplicitCurve<G> {
     max_jump_steps: i32,
     /// Rows every column must lie in.
     rows: RowRange,
-    /// g(0): the curve is translated by it so that it starts at the pen.
-    origin: f64,
-    /// The current chord runs from column `seg` to `seg + 1`...
+    /// g(0), in g's unit: the curve is translated by it so that it starts at the pen.
+    origin: f32,
+    /// Steps per unit of g.
+    steps_per_unit: f32,
+    /// The current chord runs from column `seg` (row `r0`) to `seg + 1` (value `h1`, row `r1`)...
     seg: i32,
-    /// ...from `h0` to `h1` (steps relative to the start)...
-    h0: f64,
-    h1: f64,
-    /// ...and ends at row `r1 = round(h1)`.
+    r0: i32,
+    h1: f32,
     r1: i32,
-    /// The chain's current lattice point: column (counted along the travel) and row.
-    col: i32,
-    y: i32,
-    /// `Classic`: the second half of a diagonal chain move.
-    pending: Option<Step>,
-    /// Where the steps handed out so far have taken the pen, relative to the start.
-    at: Point,
+    /// ...rising `h1 - h0` rows per column...
+    slope: f32,
+    /// ...in these steps.
+    chord: Chord,
     phase: Phase,
-    tangent: Tangent,
 }
 
 impl<G: CurveFn> ExplicitCurve<G> {
@@ -165,13 +275,14 @@ impl<G: CurveFn> ExplicitCurve<G> {
         rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
-        if max_jump_steps < 0 {
+        let steps_per_unit = g.y_steps_per_unit();
+        if max_jump_steps < 0 || !steps_per_unit.is_finite() {
             return Err(CurveSetupError::BadParameter);
         }
         if length_steps.unsigned_abs() > MAX_CURVE_OFFSET_STEPS as u32 {
             return Err(CurveSetupError::OutOfRange);
         }
-        let origin = g.y_steps(0).map_err(CurveSetupError::Start)?;
+        let origin = g.y(0).map_err(CurveSetupError::Start)?;
         if !origin.is_finite() {
             return Err(CurveSetupError::Start(CurveError::Overflow));
         }
@@ -184,16 +295,14 @@ impl<G: CurveFn> ExplicitCurve<G> {
             max_jump_steps,
             rows,
             origin,
+            steps_per_unit,
             seg: 0,
-            h0: 0.0,
+            r0: 0,
             h1: 0.0,
             r1: 0,
-            col: 0,
-            y: 0,
-            pending: None,
-            at: Point::ORIGIN,
+            slope: 0.0,
+            chord: Chord::EMPTY,
             phase: Phase::Running,
-            tangent: Tangent::along(f32::from(dir), 0.0),
         };
         if curve.columns == 0 {
             curve.phase = Phase::Done;
@@ -203,118 +312,148 @@ impl<G: CurveFn> ExplicitCurve<G> {
         Ok(curve)
     }
 
+    /// The curve's g.
+    #[cfg(test)]
+    pub(crate) fn curve_fn(&self) -> &G {
+        &self.g
+    }
+
     /// Where the steps handed out so far have taken the pen, relative to the start.
     pub fn position(&self) -> Point {
-        self.at
+        let c = &self.chord;
+        let start = Point::new(i32::from(self.dir) * self.seg, self.r0);
+        (0..c.done).fold(start, |p, j| p.stepped(c.step(j)))
     }
 
     /// Where the whole curve ends, relative to the start, `(±n, round(h(n)))`, found from its
-    /// last column alone; an error there means the curve cannot reach its end.
+    /// last column alone (exactly as the steps reach it); an error there means the curve cannot
+    /// reach its end.
     pub fn nominal_end(&self) -> Result<Point, CurveError> {
         Ok(Point::new(i32::from(self.dir) * self.columns, nearest_step(self.offset(self.columns)?)))
     }
 
-    /// The ideal curve at `column`, relative to the start, in steps.
-    fn offset(&self, column: i32) -> Result<f64, CurveError> {
-        let h = self.g.y_steps(column)? - self.origin;
-        if h.is_finite() && libm::fabs(h) <= f64::from(MAX_CURVE_OFFSET_STEPS) {
-            Ok(h)
-        } else {
-            Err(CurveError::Overflow)
-        }
+    /// The value the curve steps by at `column`, relative to the start, in steps.
+    #[cfg(test)]
+    pub(crate) fn offset_steps(&self, column: i32) -> Result<f32, CurveError> {
+        self.offset(column)
     }
 
-    /// Makes the chord from column `seg` (where the chain stands, at row `r(seg)`) to `seg + 1`
-    /// current, or tells why it cannot be drawn.
+    /// The ideal curve at `column`, relative to the start, in steps.
+    #[inline]
+    fn offset(&self, column: i32) -> Result<f32, CurveError> {
+        let h = (self.g.y(column)? - self.origin) * self.steps_per_unit;
+        // False for NaN as well.
+        if h.abs() <= MAX_CURVE_OFFSET_STEPS_F32 { Ok(h) } else { Err(CurveError::Overflow) }
+    }
+
+    /// Makes the chord from column `seg` (where the pen stands, at the end row of the chord
+    /// before) to `seg + 1` current, or tells why it cannot be drawn.
     fn load(&mut self, seg: i32) -> Result<(), CurveError> {
         let h1 = self.offset(seg + 1)?;
         let r1 = nearest_step(h1);
-        if (r1 - self.y).abs() > self.max_jump_steps {
+        let r0 = self.r1;
+        let rise = r1 - r0;
+        if rise.abs() > self.max_jump_steps {
             return Err(CurveError::Jump);
         }
         if !self.rows.contains(r1) {
             return Err(CurveError::Travel);
         }
+        let (h0, slope) = (self.h1, h1 - self.h1);
+        let s = Step::sign(rise);
+        let rows = rise.unsigned_abs() as usize;
+        // X advances at the first row at or past the chord's middle value (never before the
+        // first row, at the last at the latest).
+        let middle_at = if rows <= 1 {
+            0
+        } else {
+            let mid = h0 + 0.5 * slope;
+            let first = if rise > 0 { -floor_steps(-mid) - r0 } else { r0 - floor_steps(mid) };
+            first.clamp(1, rise.abs()) as usize - 1
+        };
+        let (vertical, x) = (Step::new(0, s), Step::new(self.dir, 0));
+        let (middle, after_middle, total) = if self.method == Method::Classic && s != 0 {
+            // Through the corner nearer to the chord's line: from the move's start `(0, y)`, X
+            // first passes `(1, y)`, at |y - h1|·c from it, Y first `(0, y + s)`, at
+            // |y + s - h0|·c (c = 1/√(1 + slope²), the same for both).
+            let y = (r0 + i32::from(s) * middle_at as i32) as f32;
+            if (y - h1).abs() <= (y + f32::from(s) - h0).abs() {
+                (x, vertical, rows + 1)
+            } else {
+                (vertical, x, rows + 1)
+            }
+        } else {
+            (Step::new(self.dir, s), vertical, rows.max(1))
+        };
+        self.chord = Chord { vertical, middle, after_middle, middle_at, total, done: 0 };
         self.seg = seg;
-        self.h0 = self.h1;
+        self.r0 = r0;
         self.h1 = h1;
         self.r1 = r1;
-        self.tangent = Tangent::along(f32::from(self.dir), (h1 - self.h0) as f32);
+        self.slope = slope;
         Ok(())
-    }
-
-    /// The chain's next move along the current chord: (columns 0 or 1, rows -1, 0 or +1).
-    fn chain_move(&self) -> (i32, i32) {
-        let toward = (self.r1 - self.y).signum();
-        if self.col > self.seg {
-            // In the chord's last column: the remaining rows.
-            return (0, toward);
-        }
-        let slope = self.h1 - self.h0;
-        if libm::fabs(slope) <= 1.0 || toward == 0 {
-            // Flat: rounded values of neighbouring columns are at most one row apart.
-            return (1, toward);
-        }
-        // Steep: in the next row, stand in the column nearer to the chord's crossing.
-        let row = self.y + toward;
-        let crossed_half = row == self.r1 || (f64::from(row) - self.h0) / slope >= 0.5;
-        (i32::from(crossed_half), toward)
-    }
-
-    /// Squared distance from the lattice point `(col, y)` to the current chord.
-    fn chord_distance2(&self, col: i32, y: i32) -> f64 {
-        let (px, py) = (f64::from(col - self.seg), f64::from(y) - self.h0);
-        let slope = self.h1 - self.h0;
-        let t = ((px + py * slope) / (1.0 + slope * slope)).clamp(0.0, 1.0);
-        let (ex, ey) = (px - t, py - t * slope);
-        ex * ex + ey * ey
-    }
-
-    fn emit(&mut self, step: Step) -> Result<Option<Step>, CurveError> {
-        self.at = self.at.stepped(step);
-        Ok(Some(step))
     }
 }
 
 impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
-        if let Some(step) = self.pending.take() {
-            return self.emit(step);
+        let mut one = [Step::NONE];
+        let filled = self.fill(&mut one);
+        if filled.steps == 1 {
+            return Ok(Some(one[0]));
         }
-        match self.phase {
-            Phase::Running => {}
-            Phase::Done => return Ok(None),
-            Phase::Failed(e) => {
-                self.phase = Phase::Done;
-                return Err(e);
-            }
+        match filled.end {
+            Some(Err(e)) => Err(e),
+            _ => Ok(None),
         }
-        let (dc, dy) = self.chain_move();
-        let (sx, sy) = (if dc != 0 { self.dir } else { 0 }, dy as i8);
-        let step = if self.method == Method::Classic && sx != 0 && sy != 0 {
-            // Through the corner nearer to the chord.
-            let x_first = self.chord_distance2(self.col + 1, self.y) <= self.chord_distance2(self.col, self.y + dy);
-            let (first, second) =
-                if x_first { (Step::new(sx, 0), Step::new(0, sy)) } else { (Step::new(0, sy), Step::new(sx, 0)) };
-            self.pending = Some(second);
-            first
-        } else {
-            Step::new(sx, sy)
-        };
-        self.col += dc;
-        self.y += dy;
-        if self.col > self.seg && self.y == self.r1 {
-            let next = self.seg + 1;
-            if next == self.columns {
-                self.phase = Phase::Done;
-            } else if let Err(e) = self.load(next) {
-                self.phase = Phase::Failed(e);
-            }
-        }
-        self.emit(step)
     }
 
     fn tangent(&self) -> Tangent {
-        self.tangent
+        unit(self.dir, self.slope)
+    }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        let mut i = 0;
+        loop {
+            // An error is handed out only where there is room for a step: where `next_step`
+            // would hand it out.
+            if i == out.len() {
+                return if self.phase == Phase::Done { Filled::ended(i, Ok(())) } else { Filled::more(i) };
+            }
+            match self.phase {
+                Phase::Running => {}
+                Phase::Done => return Filled::ended(i, Ok(())),
+                Phase::Failed(e) => {
+                    self.phase = Phase::Done;
+                    return Filled::ended(i, Err(e));
+                }
+            }
+            let c = &mut self.chord;
+            let take = (c.total - c.done).min(out.len() - i);
+            c.write(c.done, &mut out[i..i + take]);
+            c.done += take;
+            i += take;
+            if c.done < c.total {
+                return Filled::more(i);
+            }
+            // On column `seg + 1`: the next chord starts here.
+            let next = self.seg + 1;
+            if next == self.columns {
+                self.phase = Phase::Done;
+                continue;
+            }
+            let before = self.slope;
+            if let Err(e) = self.load(next) {
+                self.phase = Phase::Failed(e);
+            } else if (self.slope - before).abs() > KINK_CHORD {
+                // Unit tangents whose slopes differ by at most the kink chord differ by less
+                // (the angle between them is at most the difference of slopes), so only past it
+                // can the curve kink.
+                let before = unit(self.dir, before);
+                if before.kinks_to(self.tangent()) {
+                    return Filled::kink(i, before);
+                }
+            }
+        }
     }
 }

@@ -1,12 +1,32 @@
 //! The function curve y = f(x) of an [`Expr`] given in millimetres, drawn from the pen:
-//! [`FunctionInterp`] evaluates the expression at each X step (a *column*) and leaves the
+//! [`FunctionInterp`] evaluates the expression once per X step (a *column*) and leaves the
 //! stepping, its bounds and its limits (jump, travel, overflow) to
 //! [`ExplicitCurve`](crate::interp::explicit).
+//!
+//! # Columns
+//!
+//! The X range becomes `n = round((x1 - x0)·steps_per_mm[0])` columns, rounded as the G-code
+//! parser rounds it (half away from zero, from the same `f32` product), so both count the same
+//! columns. Column `k` is at `x0 + (x1 - x0)·(k/n)` millimetres, computed from the integer `k`
+//! every time, never by adding up a step: its error is a few roundings relative to `|x1 - x0|`
+//! and one relative to `|x|`, within `2⁻²³·(|x1 - x0| + |x|)`, the same at the last column as at
+//! the first (0.02 µm on a 100 mm range, 0.005 step at 200 steps/mm). The ends are exactly `x0`
+//! and `x1`.
+//!
+//! # Values
+//!
+//! The expression evaluates in `f32` ([`Expr::eval`]); its value in millimetres, minus f(x0), is
+//! scaled to steps by the Y steps/mm: the subtraction comes first, so a curve far from zero
+//! (`1000 + sin(x)`) loses nothing to cancellation beyond the error of the values themselves
+//! (a few units in the last place of |f|: 2⁻²³·1000 mm is 0.01 step at 80 steps/mm). An
+//! evaluation error (domain, division by zero, overflow) ends the curve at the column before;
+//! at x0 it is a setup error and nothing moves.
 
 use crate::expr::{EvalError, Expr};
 use crate::geom::{Point, Step};
-use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, RowRange, nearest_step};
-use crate::interp::{CurveError, CurveSetupError, Interpolator, Method, Tangent};
+use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, RowRange};
+use crate::interp::{CurveError, CurveSetupError, Filled, Interpolator, Method, Tangent};
+use crate::math;
 
 #[cfg(test)]
 mod tests;
@@ -28,35 +48,45 @@ impl From<EvalError> for CurveError {
 #[derive(Clone, Debug)]
 struct ExprFn {
     expr: Expr,
-    x0_mm: f64,
-    x1_mm: f64,
+    x0_mm: f32,
+    x1_mm: f32,
+    /// `x1 - x0`.
+    span_mm: f32,
     columns: i32,
-    y_steps_per_mm: f64,
+    /// `columns` as an `f32` (exactly: at most [`MAX_CURVE_OFFSET_STEPS`]).
+    columns_f32: f32,
+    y_steps_per_mm: f32,
 }
 
 impl ExprFn {
-    /// Column `k` of `n` is at `x0 + (x1 - x0)·k/n`: the ends are exactly x0 and x1, the X scale
-    /// off by less than half a step over the whole range.
-    fn x_mm(&self, column: i32) -> f64 {
-        if column == 0 || self.columns == 0 {
+    /// Column `k` of `n` is at `x0 + (x1 - x0)·(k/n)`: the ends exactly x0 and x1, and no error
+    /// that grows along the range (see the module documentation).
+    #[inline]
+    fn x_mm(&self, column: i32) -> f32 {
+        if column <= 0 {
             self.x0_mm
         } else if column >= self.columns {
             self.x1_mm
         } else {
-            self.x0_mm + (self.x1_mm - self.x0_mm) * (f64::from(column) / f64::from(self.columns))
+            self.x0_mm + self.span_mm * (column as f32 / self.columns_f32)
         }
     }
 }
 
 impl CurveFn for ExprFn {
-    fn y_steps(&self, column: i32) -> Result<f64, CurveError> {
-        // Expressions evaluate in f32; the curve still steps in f64 around them.
-        Ok(f64::from(self.expr.eval(self.x_mm(column) as f32)?) * self.y_steps_per_mm)
+    #[inline]
+    fn y(&self, column: i32) -> Result<f32, CurveError> {
+        Ok(self.expr.eval(self.x_mm(column))?)
+    }
+
+    fn y_steps_per_unit(&self) -> f32 {
+        self.y_steps_per_mm
     }
 }
 
 /// The curve y = f(x) for x from `x0_mm` to `x1_mm`, drawn from the pen: see the module
-/// documentation for how it steps and where it stops.
+/// documentation for its columns and values, and `crate::interp::explicit` for how it steps
+/// and where it stops.
 #[derive(Clone, Debug)]
 pub struct FunctionInterp {
     curve: ExplicitCurve<ExprFn>,
@@ -66,9 +96,10 @@ impl FunctionInterp {
     /// The curve of `expr` (x and y in millimetres) for x from `x0_mm` to `x1_mm` (`x1 < x0`
     /// runs toward -x), converted with `steps_per_mm` (X, Y) and translated so that it starts at
     /// the pen: the path is `(xs - xs0, ys(x) - ys(x0))` in steps. The range becomes
-    /// `round(|x1 - x0|·steps_per_mm[0])` columns. A rise or fall of more than `max_jump_steps`
+    /// `round((x1 - x0)·steps_per_mm[0])` columns. A rise or fall of more than `max_jump_steps`
     /// between neighbouring columns ends the curve with [`CurveError::Jump`] (the caller derives
-    /// it from the `max_jump_mm` setting with [`jump_limit_steps`](crate::interp::explicit::jump_limit_steps)), a column outside `rows`
+    /// it from the `max_jump_mm` setting with
+    /// [`jump_limit_steps`](crate::interp::explicit::jump_limit_steps)), a column outside `rows`
     /// with [`CurveError::Travel`] (the caller derives it from the travel limits with
     /// [`RowRange::within_travel`]).
     ///
@@ -76,25 +107,34 @@ impl FunctionInterp {
     /// moves.
     pub fn new(
         expr: Expr,
-        x0_mm: f64,
-        x1_mm: f64,
-        steps_per_mm: [f64; 2],
+        x0_mm: f32,
+        x1_mm: f32,
+        steps_per_mm: [f32; 2],
         max_jump_steps: i32,
         rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let [x_spm, y_spm] = steps_per_mm;
-        let positive = |v: f64| v.is_finite() && v > 0.0;
+        let positive = |v: f32| v.is_finite() && v > 0.0;
         if !(x0_mm.is_finite() && x1_mm.is_finite() && positive(x_spm) && positive(y_spm)) {
             return Err(CurveSetupError::BadParameter);
         }
         // Finite inputs: the length is a number, at worst infinite.
         let length = (x1_mm - x0_mm) * x_spm;
-        if libm::fabs(length) > f64::from(MAX_CURVE_OFFSET_STEPS) {
+        if length.abs() > MAX_CURVE_OFFSET_STEPS as f32 {
             return Err(CurveSetupError::OutOfRange);
         }
-        let length_steps = nearest_step(length);
-        let g = ExprFn { expr, x0_mm, x1_mm, columns: length_steps.abs(), y_steps_per_mm: y_spm };
+        let length_steps = math::round(length) as i32;
+        let columns = length_steps.abs();
+        let g = ExprFn {
+            expr,
+            x0_mm,
+            x1_mm,
+            span_mm: x1_mm - x0_mm,
+            columns,
+            columns_f32: columns as f32,
+            y_steps_per_mm: y_spm,
+        };
         Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, rows, method)? })
     }
 
@@ -103,10 +143,16 @@ impl FunctionInterp {
         self.curve.position()
     }
 
-    /// Where the curve ends if nothing stops it on the way, relative to the start; an error
-    /// means f cannot be evaluated at x1. Costs one evaluation of f.
+    /// Where the curve ends if nothing stops it on the way, relative to the start: the last
+    /// column, at f(x1), exactly where the steps end; an error means f cannot be evaluated at
+    /// x1. Costs one evaluation of f.
     pub fn nominal_end(&self) -> Result<Point, CurveError> {
         self.curve.nominal_end()
+    }
+
+    #[cfg(test)]
+    fn curve_fn(&self) -> &ExprFn {
+        self.curve.curve_fn()
     }
 }
 
@@ -117,5 +163,9 @@ impl Interpolator for FunctionInterp {
 
     fn tangent(&self) -> Tangent {
         self.curve.tangent()
+    }
+
+    fn fill(&mut self, out: &mut [Step]) -> Filled {
+        self.curve.fill(out)
     }
 }

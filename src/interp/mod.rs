@@ -189,7 +189,6 @@ impl Curve {
     /// moves.
     pub fn for_job(job: &Job, start: Point, settings: &Settings) -> Result<Curve, CurveSetupError> {
         let method = settings.method;
-        let spm = settings.steps_per_mm.map(f64::from);
         Ok(match &job.shape {
             Shape::Line { to } => {
                 let d = to.offset_from(start);
@@ -200,9 +199,9 @@ impl Curve {
                 // no row outside the travel.
                 let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let sine = SineInterp::new(
-                    f64::from(*amplitude_steps),
-                    f64::from(*omega_rad_per_step),
-                    f64::from(*phase_rad),
+                    *amplitude_steps,
+                    *omega_rad_per_step,
+                    *phase_rad,
                     *length_steps,
                     jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
                     RowRange::within_travel(start.y, travel_steps),
@@ -217,9 +216,9 @@ impl Curve {
                 let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let f = FunctionInterp::new(
                     expr.clone(),
-                    f64::from(*x0_mm),
-                    f64::from(*x1_mm),
-                    spm,
+                    *x0_mm,
+                    *x1_mm,
+                    settings.steps_per_mm,
                     jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
                     RowRange::within_travel(start.y, travel_steps),
                     method,

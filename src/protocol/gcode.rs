@@ -920,8 +920,7 @@ impl GcodeState {
         let omega_rad_per_step = omega_rad_per_mm / spm[0];
         // The sine rises by at most |A·ω| steps from one X step to the next; above the jump
         // limit its interpolator would stop at the first chord that steep (as a function does
-        // at a jump), so refuse it before anything moves. Computed as the interpolator does, in
-        // f64 from the same f32 values.
+        // at a jump), so refuse it before anything moves.
         if !sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings) {
             return Err(GrblError::InvalidTarget);
         }
@@ -930,9 +929,9 @@ impl GcodeState {
         // Set up as the motion will set it up (the travel is checked above, in millimetres);
         // its end is where the parser plans the pen.
         let sine = SineInterp::new(
-            f64::from(amplitude_steps),
-            f64::from(omega_rad_per_step),
-            f64::from(phase_rad),
+            amplitude_steps,
+            omega_rad_per_step,
+            phase_rad,
             length_steps,
             max_jump_steps,
             RowRange::ANY,
