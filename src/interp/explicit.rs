@@ -58,9 +58,10 @@
 //!
 //! Once a chord's two rows are known its steps are fixed: some steps along Y, the one move that
 //! advances X (two steps for `Classic` where it is diagonal), the rest along Y. Loading a chord
-//! works that pattern out once; [`Interpolator::fill`] then writes it straight into the buffer,
-//! and does per-chord work (evaluate g, round, check the limits, choose the classic corner,
-//! test for a kink) only where a column is reached. `next_step` is `fill` with a
+//! works that pattern out once; [`Interpolator::fill`] then writes it straight into the buffer
+//! (a chord of one step, the most common, without even that), and does per-chord work
+//! (evaluate g, round, check the limits, choose the classic corner, test for a kink) only where
+//! a column is reached, with the chain's state in locals. `next_step` is `fill` with a
 //! buffer of one, so both hand out the same steps by construction. A kink can only fall where a
 //! chord starts, and only where the slope changes by more than [`KINK_CHORD`] (the angle
 //! between two directions is at most the difference of their slopes), so only there are the
@@ -258,7 +259,8 @@ pub struct ExplicitCurve<G> {
     r1: i32,
     /// ...rising `h1 - h0` rows per column...
     slope: f32,
-    /// ...in these steps.
+    /// ...in these steps (once all are handed out, the chords after it may have been written
+    /// straight into a batch, each all at once: `seg`, `r0`, `r1` are then the last one's).
     chord: Chord,
     phase: Phase,
 }
@@ -296,7 +298,8 @@ impl<G: CurveFn> ExplicitCurve<G> {
             rows,
             origin,
             steps_per_unit,
-            seg: 0,
+            // Before column 0: the pen stands at the end of no chord.
+            seg: -1,
             r0: 0,
             h1: 0.0,
             r1: 0,
@@ -306,7 +309,7 @@ impl<G: CurveFn> ExplicitCurve<G> {
         };
         if curve.columns == 0 {
             curve.phase = Phase::Done;
-        } else if let Err(e) = curve.load(0) {
+        } else if let Err(e) = curve.start() {
             curve.phase = Phase::Failed(e);
         }
         Ok(curve)
@@ -321,6 +324,10 @@ impl<G: CurveFn> ExplicitCurve<G> {
     /// Where the steps handed out so far have taken the pen, relative to the start.
     pub fn position(&self) -> Point {
         let c = &self.chord;
+        if c.done == c.total {
+            // The current chord is all handed out (or none is left): the pen is on its end.
+            return Point::new(i32::from(self.dir) * (self.seg + 1), self.r1);
+        }
         let start = Point::new(i32::from(self.dir) * self.seg, self.r0);
         (0..c.done).fold(start, |p, j| p.stepped(c.step(j)))
     }
@@ -346,20 +353,25 @@ impl<G: CurveFn> ExplicitCurve<G> {
         if h.abs() <= MAX_CURVE_OFFSET_STEPS_F32 { Ok(h) } else { Err(CurveError::Overflow) }
     }
 
-    /// Makes the chord from column `seg` (where the pen stands, at the end row of the chord
-    /// before) to `seg + 1` current, or tells why it cannot be drawn.
-    fn load(&mut self, seg: i32) -> Result<(), CurveError> {
-        let h1 = self.offset(seg + 1)?;
-        let r1 = nearest_step(h1);
-        let r0 = self.r1;
+    /// The value and row of `column`, checked against the limits for a chord that starts at
+    /// row `r0`, or why that chord cannot be drawn.
+    #[inline(always)]
+    fn column(&self, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
+        let h = self.offset(column)?;
+        let r = nearest_step(h);
+        if (r - r0).abs() > self.max_jump_steps {
+            Err(CurveError::Jump)
+        } else if !self.rows.contains(r) {
+            Err(CurveError::Travel)
+        } else {
+            Ok((h, r))
+        }
+    }
+
+    /// The steps of a chord from value `h0` (row `r0`) to value `h1` (row `r1`), one column on.
+    #[inline(always)]
+    fn chord(&self, h0: f32, r0: i32, h1: f32, r1: i32) -> Chord {
         let rise = r1 - r0;
-        if rise.abs() > self.max_jump_steps {
-            return Err(CurveError::Jump);
-        }
-        if !self.rows.contains(r1) {
-            return Err(CurveError::Travel);
-        }
-        let (h0, slope) = (self.h1, h1 - self.h1);
         let s = Step::sign(rise);
         let rows = rise.unsigned_abs() as usize;
         // X advances at the first row at or past the chord's middle value (never before the
@@ -367,7 +379,7 @@ impl<G: CurveFn> ExplicitCurve<G> {
         let middle_at = if rows <= 1 {
             0
         } else {
-            let mid = h0 + 0.5 * slope;
+            let mid = h0 + 0.5 * (h1 - h0);
             let first = if rise > 0 { -floor_steps(-mid) - r0 } else { r0 - floor_steps(mid) };
             first.clamp(1, rise.abs()) as usize - 1
         };
@@ -385,12 +397,17 @@ impl<G: CurveFn> ExplicitCurve<G> {
         } else {
             (Step::new(self.dir, s), vertical, rows.max(1))
         };
-        self.chord = Chord { vertical, middle, after_middle, middle_at, total, done: 0 };
-        self.seg = seg;
-        self.r0 = r0;
+        Chord { vertical, middle, after_middle, middle_at, total, done: 0 }
+    }
+
+    /// Makes the chord from column 0 to column 1 current, or tells why it cannot be drawn.
+    fn start(&mut self) -> Result<(), CurveError> {
+        let (h1, r1) = self.column(1, 0)?;
+        self.chord = self.chord(0.0, 0, h1, r1);
+        self.seg = 0;
         self.h1 = h1;
         self.r1 = r1;
-        self.slope = slope;
+        self.slope = h1;
         Ok(())
     }
 }
@@ -428,6 +445,7 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
                     return Filled::ended(i, Err(e));
                 }
             }
+            // The rest of the current chord.
             let c = &mut self.chord;
             let take = (c.total - c.done).min(out.len() - i);
             c.write(c.done, &mut out[i..i + take]);
@@ -436,24 +454,52 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
             if c.done < c.total {
                 return Filled::more(i);
             }
-            // On column `seg + 1`: the next chord starts here.
-            let next = self.seg + 1;
-            if next == self.columns {
-                self.phase = Phase::Done;
-                continue;
-            }
-            let before = self.slope;
-            if let Err(e) = self.load(next) {
-                self.phase = Phase::Failed(e);
-            } else if (self.slope - before).abs() > KINK_CHORD {
+            // Column by column while the chords fit, the chain's state in locals: the pen is on
+            // column `seg + 1`, row `r1`, where the next chord starts.
+            let (mut seg, mut r0, mut h1, mut r1, mut slope) = (self.seg, self.r0, self.h1, self.r1, self.slope);
+            let ended = loop {
+                if seg + 1 == self.columns {
+                    break Phase::Done;
+                }
+                let (h, r) = match self.column(seg + 2, r1) {
+                    Ok(v) => v,
+                    Err(e) => break Phase::Failed(e),
+                };
+                let (h0, before) = (h1, slope);
+                (seg, r0, h1, r1, slope) = (seg + 1, r1, h, r, h - h1);
                 // Unit tangents whose slopes differ by at most the kink chord differ by less
                 // (the angle between them is at most the difference of slopes), so only past it
                 // can the curve kink.
-                let before = unit(self.dir, before);
-                if before.kinks_to(self.tangent()) {
-                    return Filled::kink(i, before);
+                if (slope - before).abs() > KINK_CHORD {
+                    let before = unit(self.dir, before);
+                    if before.kinks_to(unit(self.dir, slope)) {
+                        (self.seg, self.r0, self.h1, self.r1, self.slope) = (seg, r0, h1, r1, slope);
+                        self.chord = self.chord(h0, r0, h1, r1);
+                        return Filled::kink(i, before);
+                    }
                 }
-            }
+                // Most chords are one step.
+                let rise = r1 - r0;
+                if i < out.len() && (rise == 0 || (rise.abs() == 1 && self.method == Method::Diagonal)) {
+                    out[i] = Step::new(self.dir, Step::sign(rise));
+                    i += 1;
+                    continue;
+                }
+                let mut chord = self.chord(h0, r0, h1, r1);
+                let room = out.len() - i;
+                if chord.total > room {
+                    chord.write(0, &mut out[i..]);
+                    chord.done = room;
+                    (self.seg, self.r0, self.h1, self.r1, self.slope) = (seg, r0, h1, r1, slope);
+                    self.chord = chord;
+                    return Filled::more(out.len());
+                }
+                chord.write(0, &mut out[i..i + chord.total]);
+                i += chord.total;
+            };
+            // Every chord so far is handed out: `chord` may be an earlier one, all done.
+            (self.seg, self.r0, self.h1, self.r1, self.slope) = (seg, r0, h1, r1, slope);
+            self.phase = ended;
         }
     }
 }
