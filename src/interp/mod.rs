@@ -8,14 +8,18 @@
 pub mod arc;
 pub(crate) mod conic;
 pub mod ellipse;
+pub mod explicit;
 pub mod function;
 pub mod line;
+pub mod setup;
 pub mod sine;
 
 pub use arc::{ArcError, ArcInterp};
 pub use ellipse::EllipseInterp;
-pub use function::{CurveSetupError, FunctionInterp};
+pub use explicit::{RowRange, jump_limit_steps};
+pub use function::FunctionInterp;
 pub use line::LineInterp;
+pub use setup::CurveSetupError;
 pub use sine::SineInterp;
 
 use crate::geom::{Point, Step};
@@ -185,7 +189,6 @@ impl Curve {
     /// moves.
     pub fn for_job(job: &Job, start: Point, settings: &Settings) -> Result<Curve, CurveSetupError> {
         let method = settings.method;
-        let spm = settings.steps_per_mm.map(f64::from);
         Ok(match &job.shape {
             Shape::Line { to } => {
                 let d = to.offset_from(start);
@@ -196,12 +199,12 @@ impl Curve {
                 // no row outside the travel.
                 let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let sine = SineInterp::new(
-                    f64::from(*amplitude_steps),
-                    f64::from(*omega_rad_per_step),
-                    f64::from(*phase_rad),
+                    *amplitude_steps,
+                    *omega_rad_per_step,
+                    *phase_rad,
                     *length_steps,
-                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
-                    function::RowRange::within_travel(start.y, travel_steps),
+                    jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
                 let d = sine.end();
@@ -213,11 +216,11 @@ impl Curve {
                 let travel_steps = settings.mm_to_steps(crate::geom::Axis::Y, settings.max_travel_mm[1]);
                 let f = FunctionInterp::new(
                     expr.clone(),
-                    f64::from(*x0_mm),
-                    f64::from(*x1_mm),
-                    spm,
-                    function::jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
-                    function::RowRange::within_travel(start.y, travel_steps),
+                    *x0_mm,
+                    *x1_mm,
+                    settings.steps_per_mm,
+                    jump_limit_steps(settings.max_jump_mm, settings.steps_per_mm[1]),
+                    RowRange::within_travel(start.y, travel_steps),
                     method,
                 )?;
                 // Where it ends if nothing stops it; a curve that stops early (a domain error,

@@ -83,9 +83,9 @@ use core::f32::consts::{FRAC_PI_2, PI, TAU};
 use super::GrblError;
 use super::line::LINE_MAX_BYTES;
 use crate::geom::{Axis, Point, Rotation};
-use crate::interp::function::{RowRange, jump_limit_steps};
 use crate::interp::sine::{self, sin_range};
 use crate::interp::{ArcInterp, EllipseInterp, SineInterp};
+use crate::interp::{RowRange, jump_limit_steps};
 use crate::job::{Feed, Job, Shape};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
@@ -925,8 +925,7 @@ impl GcodeState {
         let omega_rad_per_step = omega_rad_per_mm / spm[0];
         // The sine rises by at most |A·ω| steps from one X step to the next; above the jump
         // limit its interpolator would stop at the first chord that steep (as a function does
-        // at a jump), so refuse it before anything moves. Computed as the interpolator does, in
-        // f64 from the same f32 values.
+        // at a jump), so refuse it before anything moves.
         if !sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings) {
             return Err(GrblError::InvalidTarget);
         }
@@ -935,9 +934,9 @@ impl GcodeState {
         // Set up as the motion will set it up (the travel is checked above, in millimetres);
         // its end is where the parser plans the pen.
         let sine = SineInterp::new(
-            f64::from(amplitude_steps),
-            f64::from(omega_rad_per_step),
-            f64::from(phase_rad),
+            amplitude_steps,
+            omega_rad_per_step,
+            phase_rad,
             length_steps,
             max_jump_steps,
             RowRange::ANY,
