@@ -9,8 +9,8 @@
 //!
 //! The work is split as in GRBL (`planner.c` / `stepper.c`): the look-ahead ([`scan`]) decides
 //! speed caps and exit speeds per *block* of steps, with floating point once per chunk of steps;
-//! the step generator ([`stepgen`]) decides a speed once per *slice* of steps and times each step
-//! with integer additions.
+//! the step generator ([`stepgen`]) runs the steps out a *run* at a time, cruising steps with an
+//! integer addition each, ramps with the acceleration rule worked out once per run.
 //!
 //! # Speed along the ideal curve
 //!
@@ -54,18 +54,18 @@
 //! * Tangential acceleration: what each axis has left, `a·|u_axis| + v²κ·|n_axis| ≤ accel_axis`
 //!   with `n` the normal; on a straight line `a = min over axes of accel_axis / |u_axis|`.
 //!
-//! # Profile: slices
+//! # Profile: runs
 //!
-//! The step generator runs a *slice* of steps at one speed `w` (its `δ_mm` over its interval).
-//! From rest the first step runs at the start rate (or the cap, if lower). A slice of `n` steps
-//! after a slice at `w'` runs at `w` with `w² ≤ w'² + 2·a·n·δ`, `w ≤ cap` and
-//! `w² ≤ v_exit² + 2·a·R` where `R` is the distance left in the block after the slice and
-//! `v_exit` the speed allowed at its end: for `n = 1` this is the rule step by step. Slices are
-//! as long as keeps the speed change within [`SLICE_SPEED_GAIN`] (so one step at low speed, many
-//! at speed), and while cruising at the cap, as long as the way is clear of braking. Motion ends
-//! only where the plan ends with `v_exit` = start rate, so the last step is never faster than
-//! the start rate. Within a slice every step takes the slice's interval, in whole ticks with the
-//! fraction carried in 32 bits, so long runs have no rounding drift; after rest the first
+//! Every step `k` has one speed `w_k` (its `δ_mm` over its interval). From rest the first step
+//! runs at the start rate (or the cap, if lower); then `w_k² ≤ w_{k−1}² + 2·a·δ`, `w_k ≤ cap`,
+//! and `w_k² ≤ v_exit² + 2·a·R_k` where `R_k` is the distance left in the block after step `k`
+//! and `v_exit` the speed allowed at its end. The step generator runs the steps of one chunk of
+//! one block at a time. While the speed is below the cap, or braking, a *ramp* run applies this
+//! rule to every step, its figures (`2·a·δ`, the cap, the exit) worked out once for the run. At
+//! the cap a *cruise* run takes every step at the cap, as far as the way is clear of braking:
+//! each step's interval is the same number of whole ticks and a 32-bit fraction carried over,
+//! so long runs have no rounding drift. Motion ends only where the plan ends with `v_exit` =
+//! start rate, so the last step is never faster than the start rate. After rest the first
 //! interval is one step's time at the start rate (the pulse task may fire it at once when it
 //! has idled longer than that).
 //!
@@ -80,7 +80,7 @@
 //! and raised to at least the start rate (a servo takes a jump up to its start rate, as when it
 //! starts). A backward pass over the blocks, from a stop at the end of the last one (and at
 //! every curve error and at the scan's front), gives each block `v_exit = min(junction,
-//! cap_next, √(v_exit,next² + 2·a_next·L_next))`; the slices are the forward pass.
+//! cap_next, √(v_exit,next² + 2·a_next·L_next))`; the runs are the forward pass.
 //!
 //! # Hold and abort
 //!
@@ -104,7 +104,7 @@ use crate::job::Feed;
 use ring::{CopyRing, Ring, StepRing};
 use scan::{Block, Chunk, ScanPoint, Segment};
 pub use stepgen::Emitted;
-use stepgen::Slice;
+use stepgen::Run;
 
 /// Segments the planner holds (pushed and not yet fully emitted): its look-ahead depth in
 /// segments. At the default limits 16 segments of a 2,000-segment polyline circle of 100 mm
@@ -139,14 +139,6 @@ pub const SCAN_STEPS_PER_PUSH: usize = 64;
 
 /// Caps of a curve's later blocks sit this far (relative) below those of their first chunk.
 pub const BLOCK_MARGIN: f32 = 0.02;
-
-/// Largest change of `v²` (relative) from one slice to the next while accelerating or braking:
-/// 0.5 % of `v²` is 0.25 % of the speed, a staircase fine enough that the acceleration measured
-/// over a few milliseconds stays within 1 % of the ramp's.
-pub const SLICE_SPEED_GAIN: f32 = 0.005;
-
-/// Most steps in one slice.
-pub const SLICE_MAX_STEPS: u32 = 1_024;
 
 /// The planner holds as many segments as it can ([`Planner::is_full`]); try again after the next
 /// [`Planner::next_cmd`].
@@ -199,10 +191,10 @@ pub struct Planner<C: Interpolator, const N: usize> {
     /// The scanned steps, cut into blocks with one cap each.
     blocks: CopyRing<Block, PLANNER_BLOCKS>,
     request: Request,
-    /// Speed of the last slice while moving, mm/s; `None` at rest.
+    /// Speed of the last step while moving, mm/s; `None` at rest.
     speed: Option<f32>,
-    /// The slice being emitted.
-    slice: Slice,
+    /// The run being emitted.
+    run: Run,
     /// Fraction of a tick carried to the next step, in units of 2⁻³² tick.
     carry: u32,
     /// Steps emitted since the scan last ran: it scans that many again, and more.
@@ -223,7 +215,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             blocks: CopyRing::new(),
             request: Request::Run,
             speed: None,
-            slice: Slice::EMPTY,
+            run: Run::EMPTY,
             carry: 0,
             emitted_since_scan: 0,
         }
@@ -286,7 +278,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     pub fn hold(&mut self) {
         if self.request == Request::Run {
             self.request = Request::Hold;
-            self.slice.cut();
+            self.run.cut();
         }
     }
 
@@ -294,7 +286,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     pub fn resume(&mut self) {
         if self.request == Request::Hold {
             self.request = Request::Run;
-            self.slice.cut();
+            self.run.cut();
         }
     }
 
@@ -302,7 +294,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// queued one. At rest this happens at once.
     pub fn abort(&mut self) {
         self.request = Request::Abort;
-        self.slice.cut();
+        self.run.cut();
         if self.speed.is_none() {
             self.rest();
         }
@@ -311,7 +303,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// The machine is at rest: finishes an abort, applies pending limits.
     fn rest(&mut self) {
         self.speed = None;
-        self.slice = Slice::EMPTY;
+        self.run = Run::EMPTY;
         if self.request == Request::Abort {
             self.segments.clear();
             self.held = 0;

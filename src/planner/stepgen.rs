@@ -1,40 +1,26 @@
-//! The step generator: runs the scanned steps out as timed [`StepCmd`]s. It decides one speed
-//! per slice of steps (floating point, once per slice); each step of a slice then costs a
-//! ring read and an integer addition.
+//! The step generator: runs the scanned steps out as timed [`StepCmd`]s, a *run* of steps at a
+//! time within one chunk of one block. A cruise run keeps one speed and times each step by an
+//! integer addition; a ramp run (accelerating or braking) applies the acceleration rule step by
+//! step, its block's and chunk's figures worked out once for the run, so each of its steps
+//! costs one square root and one division on the FPU.
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator};
 use crate::math;
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
-use crate::planner::scan::{Block, Chunk};
-use crate::planner::{CHUNK_STEPS, Planner, Request, SLICE_MAX_STEPS, SLICE_SPEED_GAIN};
+use crate::planner::scan::{Block, Chunk, NM_PER_MM};
+use crate::planner::{Planner, Request};
 
-/// 2³², the scale of a slice's fraction of a tick.
+/// 2³², the scale of a step's fraction of a tick.
 const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
+
+/// Most steps in a ramp run. Its figures are those of its block when it starts; the scan, and a
+/// block still growing at the scan's front, move on only between runs.
+const RAMP_RUN_MAX_STEPS: u32 = 32;
 
 /// Half a tick in units of 2⁻³² tick: the carry from rest, so that the ticks of a run are its
 /// exact times rounded to the nearest tick.
 const HALF_TICK: u32 = 1 << 31;
-
-/// Steps of one speed: each takes `ticks` and `frac` / 2³² ticks, the fractions carried over.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Slice {
-    /// Steps in the slice, and how many of them are still to emit.
-    steps: u32,
-    pub left: u32,
-    ticks: u32,
-    frac: u32,
-}
-
-impl Slice {
-    pub const EMPTY: Slice = Slice { steps: 0, left: 0, ticks: 0, frac: 0 };
-
-    /// Ends the slice after the steps emitted so far: the next step gets a speed of its own.
-    pub fn cut(&mut self) {
-        self.steps -= self.left;
-        self.left = 0;
-    }
-}
 
 /// What [`Planner::fill`] wrote, and why it stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,11 +38,68 @@ pub struct Emitted {
     pub end: Option<Result<(), CurveError>>,
 }
 
-/// What planning the next slice found.
-enum SliceStart {
+/// Steps of one chunk of one block, timed one way.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Run {
+    /// Steps in the run, and how many of them are still to emit.
+    steps: u32,
+    pub left: u32,
+    pace: Pace,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Pace {
+    /// Every step takes `ticks` and `frac` / 2³² ticks, the fractions carried over.
+    Cruise { ticks: u32, frac: u32 },
+    /// Each step at the speed the acceleration rule allows.
+    Ramp(Ramp),
+}
+
+/// The figures of the acceleration rule for the steps of one chunk of one block.
+#[derive(Clone, Copy, Debug)]
+struct Ramp {
+    /// A step at speed `w` takes `ticks_mm / w` ticks (its length in mm times the tick rate).
+    ticks_mm: f32,
+    /// `2·a·δ`: what one step adds to (or takes from) `v²`.
+    gain: f32,
+    /// `2·a`, for the distance left to brake.
+    two_a: f32,
+    cap2: f32,
+    exit2: f32,
+    /// `v²` from rest, and the floor of a hold's or an abort's braking.
+    start2: f32,
+    /// The step's length, nm, and the distance left in the block before the run, nm.
+    step_nm: u32,
+    left_nm: u32,
+    /// A hold or an abort: decelerate to the start rate.
+    braking: bool,
+    min_ticks: u32,
+}
+
+impl Run {
+    pub const EMPTY: Run = Run { steps: 0, left: 0, pace: Pace::Cruise { ticks: 0, frac: 0 } };
+
+    /// Ends the run after the steps emitted so far: the next step is planned afresh.
+    pub fn cut(&mut self) {
+        self.steps -= self.left;
+        self.left = 0;
+    }
+}
+
+/// What planning the next run found.
+enum RunStart {
     Ready,
     Empty,
     Failed(CurveError),
+}
+
+/// `exact_ticks` as whole ticks and a fraction in 2⁻³² ticks, no shorter than `min_ticks`.
+fn split_ticks(exact_ticks: f32, min_ticks: u32) -> (u32, u32) {
+    let ticks = exact_ticks as u32;
+    if ticks < min_ticks {
+        return (min_ticks, 0);
+    }
+    (ticks, ((exact_ticks - ticks as f32) * TICK_FRACTION_SCALE) as u32)
 }
 
 impl<C: Interpolator, const N: usize> Planner<C, N> {
@@ -75,83 +118,131 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Writes the next step commands into `out`, until it is full, their intervals add up to
     /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
-    /// step queue this way, one slice at a time in a tight loop.
+    /// step queue this way, one run at a time in a tight loop.
     pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
         let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
         let end = loop {
             if written >= out.len() || ticks >= ticks_room {
                 break None;
             }
-            if self.slice.left == 0 {
-                match self.next_slice() {
-                    SliceStart::Ready => {}
-                    SliceStart::Empty => break Some(Ok(())),
-                    SliceStart::Failed(e) => break Some(Err(e)),
+            if self.run.left == 0 {
+                match self.next_run() {
+                    RunStart::Ready => {}
+                    RunStart::Empty => break Some(Ok(())),
+                    RunStart::Failed(e) => break Some(Err(e)),
                 }
             }
             let room = out.len() - written;
-            let steps = self.steps.front_slice((self.slice.left as usize).min(room));
-            let (mut carry, frac, whole) = (self.carry, self.slice.frac, self.slice.ticks);
+            let steps = self.steps.front_slice((self.run.left as usize).min(room));
+            let mut carry = self.carry;
             let mut taken = 0;
-            for (slot, &step) in out[written..].iter_mut().zip(steps) {
-                let (c, over) = carry.overflowing_add(frac);
-                carry = c;
-                let interval_ticks = whole + u32::from(over);
-                *slot = StepCmd { step, interval_ticks };
-                ticks = ticks.wrapping_add(interval_ticks);
-                dx += i32::from(step.x);
-                dy += i32::from(step.y);
-                taken += 1;
-                if ticks >= ticks_room {
-                    break;
+            // A ramp that reaches the cap goes on as a cruise; braking ends at the start rate.
+            let mut ends_early = false;
+            match &mut self.run.pace {
+                Pace::Cruise { ticks: whole, frac } => {
+                    for (slot, &step) in out[written..].iter_mut().zip(steps) {
+                        let (c, over) = carry.overflowing_add(*frac);
+                        carry = c;
+                        let interval_ticks = *whole + u32::from(over);
+                        *slot = StepCmd { step, interval_ticks };
+                        ticks = ticks.wrapping_add(interval_ticks);
+                        dx += i32::from(step.x);
+                        dy += i32::from(step.y);
+                        taken += 1;
+                        if ticks >= ticks_room {
+                            break;
+                        }
+                    }
+                }
+                Pace::Ramp(ramp) => {
+                    let mut v2 = self.speed.map_or(-1.0, |w| w * w);
+                    for (slot, &step) in out[written..].iter_mut().zip(steps) {
+                        // The rule step by step: from rest the start rate; then what the
+                        // acceleration adds, within the cap and the braking distance left, and
+                        // for a hold or an abort what braking allows.
+                        let mut w2 = if v2 < 0.0 { ramp.start2 } else { v2 + ramp.gain };
+                        w2 = math::min(w2, ramp.cap2);
+                        ramp.left_nm = ramp.left_nm.saturating_sub(ramp.step_nm);
+                        w2 = math::min(w2, ramp.exit2 + ramp.two_a * (ramp.left_nm as f32 / NM_PER_MM));
+                        if ramp.braking && v2 >= 0.0 {
+                            w2 = math::min(w2, math::max(v2 - ramp.gain, ramp.start2));
+                        }
+                        // `max` also replaces a NaN, which valid limits never produce.
+                        w2 = math::max(w2, MIN_SPEED_MM_PER_S * MIN_SPEED_MM_PER_S);
+                        let (whole, frac) = split_ticks(ramp.ticks_mm / math::sqrt(w2), ramp.min_ticks);
+                        let (c, over) = carry.overflowing_add(frac);
+                        carry = c;
+                        let interval_ticks = whole + u32::from(over);
+                        *slot = StepCmd { step, interval_ticks };
+                        ticks = ticks.wrapping_add(interval_ticks);
+                        dx += i32::from(step.x);
+                        dy += i32::from(step.y);
+                        taken += 1;
+                        let reached_cap = w2 >= ramp.cap2;
+                        let stopped = ramp.braking && w2 <= ramp.start2;
+                        v2 = w2;
+                        if stopped || (reached_cap && !ramp.braking) {
+                            ends_early = true;
+                            break;
+                        }
+                        if ticks >= ticks_room {
+                            break;
+                        }
+                    }
+                    if v2 >= 0.0 {
+                        self.speed = Some(math::sqrt(v2));
+                    }
                 }
             }
             if taken == 0 {
-                // A slice is never longer than the steps scanned; only a bug gets here.
-                self.slice.cut();
+                // A run is never longer than the steps scanned; only a bug gets here.
+                self.run.cut();
                 continue;
             }
             self.carry = carry;
             self.steps.drop_front(taken);
-            self.slice.left -= taken as u32;
+            self.run.left -= taken as u32;
+            if ends_early {
+                self.run.cut();
+            }
             written += taken;
-            if self.slice.left == 0 {
-                self.retire_slice();
+            if self.run.left == 0 {
+                self.retire_run();
             }
         };
         Emitted { steps: written, ticks, moved: Point::new(dx, dy), end }
     }
 
-    /// Plans the next slice.
+    /// Plans the next run.
     #[inline(never)]
-    fn next_slice(&mut self) -> SliceStart {
-        self.slice.cut();
-        self.retire_slice();
+    fn next_run(&mut self) -> RunStart {
+        self.run.cut();
+        self.retire_run();
         self.apply_pending_if_idle();
         if self.request == Request::Hold && self.speed.is_none() {
-            return SliceStart::Empty;
+            return RunStart::Empty;
         }
         // Keep the scan ahead: twice what was emitted since it last ran, and a chunk more.
-        if self.steps.free() >= CHUNK_STEPS {
-            self.scan(2 * self.emitted_since_scan + CHUNK_STEPS);
+        if self.steps.free() >= crate::planner::CHUNK_STEPS {
+            self.scan(2 * self.emitted_since_scan + crate::planner::CHUNK_STEPS);
             self.emitted_since_scan = 0;
         }
         // Every pass returns, drops a finished block, or scans where the motion has caught up
         // with the scan; the bound only guards against the unforeseen.
         for _ in 0..(N + crate::planner::PLANNER_BLOCKS + 8) {
-            let Some(block) = self.blocks.front().copied() else {
+            let Some(block) = self.blocks.front() else {
                 // Nothing scanned: scan on (at rest or at the start rate), unless nothing is left.
                 if self.scan_chunk().is_some() {
                     self.replan();
                     continue;
                 }
                 self.rest();
-                return SliceStart::Empty;
+                return RunStart::Empty;
             };
             if let Some(e) = block.error {
                 self.finish_block();
                 self.rest();
-                return SliceStart::Failed(e);
+                return RunStart::Failed(e);
             }
             if block.done_steps >= block.steps {
                 if block.open {
@@ -162,7 +253,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         continue;
                     }
                     self.rest();
-                    return SliceStart::Empty;
+                    return RunStart::Empty;
                 }
                 self.finish_block();
                 continue;
@@ -170,74 +261,68 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let start = math::min(self.limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
             if self.request != Request::Run && self.speed.is_none_or(|w| w <= start) {
                 self.rest();
-                return SliceStart::Empty;
+                return RunStart::Empty;
             }
-            let Some(chunk) = self.chunks.front().copied() else {
+            let (Some(block), Some(chunk)) = (self.blocks.front().copied(), self.chunks.front().copied()) else {
                 // Every scanned step is in a chunk; only a bug gets here.
                 self.rest();
-                return SliceStart::Empty;
+                return RunStart::Empty;
             };
-            self.plan_slice(&block, &chunk, start);
-            return SliceStart::Ready;
+            self.plan_run(&block, &chunk, start);
+            return RunStart::Ready;
         }
-        SliceStart::Empty
+        RunStart::Empty
     }
 
-    /// The speed and interval of the next slice, in `block` and `chunk` (the front ones), with
-    /// `start` the speed from rest; see the planner's module documentation.
-    fn plan_slice(&mut self, block: &Block, chunk: &Chunk, start: f32) {
+    /// The next run, in `block` and `chunk` (the front ones), with `start` the speed from rest:
+    /// a cruise as far as the way is clear of braking when the speed is at the cap, a ramp
+    /// otherwise; see the planner's module documentation.
+    fn plan_run(&mut self, block: &Block, chunk: &Chunk, start: f32) {
         let step_mm = chunk.step_mm;
         let a = block.caps.accel_mm_per_s2;
         let cap = block.caps.speed_mm_per_s;
         let exit = block.exit_mm_per_s;
-        let rem_mm = block.left_mm(block.done_nm);
         let available = chunk.left.min(block.steps - block.done_steps);
         let braking = self.request != Request::Run;
-        let n = match self.speed {
-            None => 1,
-            Some(p) => {
-                let mut n = (SLICE_SPEED_GAIN * p * p / (2.0 * a * step_mm)) as u32;
-                if !braking && p >= cap {
-                    // Cruising: as far as the way is clear of braking to the block's exit.
-                    let clear_mm = rem_mm - (cap * cap - exit * exit) / (2.0 * a);
-                    n = n.max((clear_mm / step_mm) as u32);
-                }
-                n.clamp(1, SLICE_MAX_STEPS)
-            }
-        }
-        .min(available);
-        let run_mm = n as f32 * step_mm;
-        let mut w = match self.speed {
-            None => start,
-            Some(p) => math::sqrt(p * p + 2.0 * a * run_mm),
-        };
-        w = math::min(w, cap);
-        w = math::min(w, block.brake_limit(block.done_nm.saturating_add(chunk.nm(n))));
-        if let (true, Some(p)) = (braking, self.speed) {
-            w = math::min(w, math::max(math::sqrt(math::max(p * p - 2.0 * a * run_mm, 0.0)), start));
-        }
-        // `max` also replaces a NaN, which valid limits never produce.
-        w = math::max(w, MIN_SPEED_MM_PER_S);
-        let exact_ticks = step_mm / w * TICK_HZ as f32;
-        let mut ticks = exact_ticks as u32;
-        let mut frac = ((exact_ticks - ticks as f32) * TICK_FRACTION_SCALE) as u32;
-        if ticks < self.limits.min_interval_ticks {
-            ticks = self.limits.min_interval_ticks;
-            frac = 0;
-        }
+        let min_ticks = self.limits.min_interval_ticks;
         if self.speed.is_none() {
             self.carry = HALF_TICK;
         }
-        self.speed = Some(w);
-        self.slice = Slice { steps: n, left: n, ticks, frac };
+        if let (false, Some(p)) = (braking, self.speed)
+            && p >= cap
+        {
+            // Cruising: as far as the way is clear of braking to the block's exit.
+            let clear_mm = block.left_mm(block.done_nm) - (cap * cap - exit * exit) / (2.0 * a);
+            let n = ((clear_mm / step_mm) as u32).min(available);
+            if n > 0 {
+                let (ticks, frac) = split_ticks(step_mm / cap * TICK_HZ as f32, min_ticks);
+                self.speed = Some(cap);
+                self.run = Run { steps: n, left: n, pace: Pace::Cruise { ticks, frac } };
+                return;
+            }
+        }
+        let ramp = Ramp {
+            ticks_mm: step_mm * TICK_HZ as f32,
+            gain: 2.0 * a * step_mm,
+            two_a: 2.0 * a,
+            cap2: cap * cap,
+            exit2: exit * exit,
+            start2: start * start,
+            step_nm: chunk.step_nm,
+            left_nm: block.len_nm.saturating_sub(block.done_nm),
+            braking,
+            min_ticks,
+        };
+        let n = available.min(RAMP_RUN_MAX_STEPS);
+        self.run = Run { steps: n, left: n, pace: Pace::Ramp(ramp) };
     }
 
-    /// Books the steps emitted in the slice just ended against its chunk and block; rests when
+    /// Books the steps emitted in the run just ended against its chunk and block; rests when
     /// the plan is done, or a hold or an abort has braked to the start rate.
     #[inline(never)]
-    pub(crate) fn retire_slice(&mut self) {
-        let emitted = self.slice.steps;
-        self.slice = Slice::EMPTY;
+    pub(crate) fn retire_run(&mut self) {
+        let emitted = self.run.steps;
+        self.run = Run::EMPTY;
         if emitted == 0 {
             return;
         }
