@@ -33,7 +33,9 @@
 //! block; a curve gets a new block where its caps fall below the block's (a block then takes
 //! caps [`BLOCK_MARGIN`] below its first chunk's, so a smooth curve is cut every few percent of
 //! change) or allow much more. Whatever is not scanned yet is treated as a stop at the scan's
-//! front. The scan also finds a segment's exit direction and a curve error: the plan stops at
+//! front, but for the rest of a straight line: its length is known
+//! ([`Interpolator::straight_steps_left`]), so its block brakes for the line's end and a long
+//! line reaches its speed whatever the horizon. The scan also finds a segment's exit direction and a curve error: the plan stops at
 //! the error point, and `next_cmd` returns `Some(Err(e))` exactly when the motion reaches it; the
 //! next segment starts from rest.
 //!

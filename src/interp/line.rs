@@ -57,6 +57,15 @@ impl LineInterp {
         }
     }
 
+    /// Steps still to take with its method.
+    fn steps_left(&self) -> u64 {
+        let left = match self.method {
+            Method::Classic => self.left_x + self.left_y,
+            Method::Diagonal => self.left_x.max(self.left_y),
+        };
+        left as u64
+    }
+
     fn classic(&mut self) -> Step {
         // Exhausted axes first: the comparison alone would overshoot a zero-length axis.
         let along_x = if self.left_y == 0 {
@@ -111,16 +120,13 @@ impl Interpolator for LineInterp {
         self.tangent
     }
 
-    fn is_straight(&self) -> bool {
-        true
+    fn straight_steps_left(&self) -> Option<u64> {
+        Some(self.steps_left())
     }
 
     /// A line never kinks: a tight loop of the same comparisons as `next_step`.
     fn fill(&mut self, out: &mut [Step]) -> Filled {
-        let left = match self.method {
-            Method::Classic => self.left_x + self.left_y,
-            Method::Diagonal => self.left_x.max(self.left_y),
-        };
+        let left = self.steps_left();
         let n = out.len().min(usize::try_from(left).unwrap_or(usize::MAX));
         let Some(out) = out.get_mut(..n) else { return Filled::more(0) };
         match self.method {
@@ -131,7 +137,7 @@ impl Interpolator for LineInterp {
             }
             Method::Diagonal => self.fill_diagonal(out),
         }
-        if n as i64 == left { Filled::ended(n, Ok(())) } else { Filled::more(n) }
+        if n as u64 == left { Filled::ended(n, Ok(())) } else { Filled::more(n) }
     }
 }
 

@@ -124,10 +124,11 @@ pub trait Interpolator {
     /// The unit tangent of the ideal curve at the current point, in the direction of travel.
     fn tangent(&self) -> Tangent;
 
-    /// True when the rest of the curve runs along one straight line (its tangent never changes
-    /// again): the planner then takes its steps in long chunks.
-    fn is_straight(&self) -> bool {
-        false
+    /// `Some(n)` when the rest of the curve is `n` steps along one straight line (its tangent
+    /// never changes again): the planner then takes its steps in long chunks, and plans its
+    /// braking from the curve's end rather than from what it has stepped so far.
+    fn straight_steps_left(&self) -> Option<u64> {
+        None
     }
 
     /// Writes the next steps into `out`, exactly those `next_step` would hand out one by one,
@@ -267,8 +268,11 @@ impl Interpolator for Curve {
         }
     }
 
-    fn is_straight(&self) -> bool {
-        matches!(self.kind, CurveKind::Line(_))
+    fn straight_steps_left(&self) -> Option<u64> {
+        match &self.kind {
+            CurveKind::Line(c) => c.straight_steps_left(),
+            _ => None,
+        }
     }
 
     fn fill(&mut self, out: &mut [Step]) -> Filled {

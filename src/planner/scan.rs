@@ -83,6 +83,9 @@ pub(crate) struct Block {
     /// Length, and distance emitted so far, nm (`u32`: up to 4.2 m, longer than any path on the
     /// machine).
     pub len_nm: u32,
+    /// Length of the straight rest of its line beyond the scan's front, nm: known steps of the
+    /// same caps, so the block brakes for the line's end, not for the scan's front.
+    pub ahead_nm: u32,
     pub done_steps: u32,
     pub done_nm: u32,
     pub caps: Caps,
@@ -102,9 +105,15 @@ pub(crate) struct Block {
 }
 
 impl Block {
-    /// Distance left after `at_nm` into the block, mm.
+    /// Where the motion must have braked to `exit_mm_per_s`, nm into the block: its end, or the
+    /// end of its line.
+    pub fn end_nm(&self) -> u32 {
+        self.len_nm.saturating_add(self.ahead_nm)
+    }
+
+    /// Distance left to [`Self::end_nm`] after `at_nm` into the block, mm.
     pub fn left_mm(&self, at_nm: u32) -> f32 {
-        self.len_nm.saturating_sub(at_nm) as f32 / NM_PER_MM
+        self.end_nm().saturating_sub(at_nm) as f32 / NM_PER_MM
     }
 
     /// Highest speed at `at_nm` into the block from which the motion can still brake to
@@ -165,7 +174,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         }
         let want = if self.scan.kink_from_mm.is_some() {
             1
-        } else if segment.curve.is_straight() {
+        } else if segment.curve.straight_steps_left().is_some() {
             STRAIGHT_CHUNK_STEPS
         } else {
             CHUNK_STEPS
@@ -179,6 +188,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         let last_step = buf.get(n.wrapping_sub(1)).copied();
         self.steps.commit(n);
         let after = segment.curve.tangent();
+        let straight_left = segment.curve.straight_steps_left();
         let (method, requested) = (segment.method, segment.requested_mm_per_s);
         if n > 0 {
             // The tangent at the chunk's last point, before any kink there.
@@ -186,6 +196,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let (sx, sy) = last_step.map_or((0, 0), |s| (s.x, s.y));
             let end = limits.step_geometry(method, UnitDir::from_tangent(end_tangent, sx, sy));
             self.take_chunk(n as u32, end, end_tangent, requested);
+            if let Some(left) = straight_left {
+                self.see_ahead(left);
+            }
             if filled.kink.is_some() {
                 self.scan.kink_from_mm = Some(end.dir_mm);
             }
@@ -243,11 +256,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 return;
             }
             back.open = false;
+            back.ahead_nm = 0;
         }
         let keep = 1.0 - if fresh { FIRST_BLOCK_MARGIN } else { BLOCK_MARGIN };
         let block = Block {
             steps: n,
             len_nm: chunk.nm(n),
+            ahead_nm: 0,
             done_steps: 0,
             done_nm: 0,
             caps: Caps {
@@ -269,6 +284,17 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         };
         if self.blocks.push_back(block) {
             self.push_chunk(chunk, false);
+        }
+    }
+
+    /// The open block's line goes on straight for `steps` more steps, as long as its last
+    /// chunk's.
+    fn see_ahead(&mut self, steps: u64) {
+        let step_nm = self.chunks.back_mut().map_or(0, |c| c.step_nm);
+        if let Some(back) = self.blocks.back_mut()
+            && back.open
+        {
+            back.ahead_nm = u32::try_from(steps.saturating_mul(u64::from(step_nm))).unwrap_or(u32::MAX);
         }
     }
 
@@ -309,6 +335,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         let exit_dir_mm = self.scan.at.dir_mm;
         if !fresh && let Some(back) = self.blocks.back_mut() {
             back.open = false;
+            back.ahead_nm = 0;
             back.ends_segment = end.is_ok();
             back.exit_dir_mm = exit_dir_mm;
             back.dirty = true;

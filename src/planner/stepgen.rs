@@ -309,7 +309,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             exit2: exit * exit,
             start2: start * start,
             step_nm: chunk.step_nm,
-            left_nm: block.len_nm.saturating_sub(block.done_nm),
+            left_nm: block.end_nm().saturating_sub(block.done_nm),
             braking,
             min_ticks,
         };
