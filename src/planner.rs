@@ -118,14 +118,17 @@ pub const PLANNER_SEGMENTS: usize = 16;
 /// scan waits, and the motion brakes for the scan's front.
 pub const PLANNER_BLOCKS: usize = 64;
 
-/// Steps scanned ahead of the motion, at most: the look-ahead horizon. 4,096 steps are 41 mm at
-/// 100 steps/mm, four times the braking distance from the default max rate (6,000 mm/min at
-/// 500 mm/s²: 10 mm). A power of two.
-pub const STEP_RING_LEN: usize = 4_096;
+/// Steps scanned ahead of the motion, at most: the look-ahead horizon on curves (a straight
+/// line brakes for its own end). A curve runs no faster than it can brake within it: 16,384
+/// steps are 82 mm at 200 steps/mm, enough to brake from 1,000 mm/s at 10,000 mm/s² (50 mm),
+/// so a curve can reach the drivers' 200 kHz; at the defaults (100 steps/mm, 6,000 mm/min,
+/// 500 mm/s²) sixteen times the braking distance. 32 KiB of steps. A power of two.
+pub const STEP_RING_LEN: usize = 16_384;
 
 /// Chunks in the ring, at most: a chunk is at least one step, usually [`CHUNK_STEPS`] or a
-/// straight run. When they run out the scan waits, as for blocks.
-pub const CHUNK_RING_LEN: usize = 256;
+/// straight run, so a curve's chunks cover the whole ring. When they run out the scan waits,
+/// as for blocks.
+pub const CHUNK_RING_LEN: usize = STEP_RING_LEN / CHUNK_STEPS;
 
 /// Steps per chunk on a curve: the scan reads the tangent, and works out the caps, once per
 /// chunk. 32 steps turn by 6° on a circle of 300 steps radius, so the caps follow the curve
