@@ -4,6 +4,7 @@
 extern crate std;
 
 use super::*;
+use crate::geom::Rotation;
 use std::vec::Vec;
 
 /// Default settings: 100 steps/mm on both axes, ±200 mm travel, default feed 3000 mm/min.

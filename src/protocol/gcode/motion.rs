@@ -1,0 +1,329 @@
+//! G-code blocks carried out on the parser state: modal groups, G92 offsets, and the straight
+//! moves and G2/G3 arcs a block hands out, each checked against the travel and its interpolator.
+
+use core::f32::consts::{FRAC_PI_2, PI, TAU};
+
+use super::words::{Block, NonModal, Stop};
+use super::{
+    ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM,
+    CURVE_RADIUS_MAX_MM, Command, Commands, DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
+    check_travel, to_steps,
+};
+use crate::geom::Rotation;
+use crate::interp::{ArcInterp, EllipseInterp};
+use crate::job::{Feed, Job, Shape};
+use crate::protocol::GrblError;
+use crate::settings::Settings;
+
+impl GcodeState {
+    /// Executes a parsed block on `self` (a copy the caller keeps only on success).
+    pub(super) fn run_block(&mut self, block: Block, settings: &Settings) -> Result<Commands, GrblError> {
+        let start_mm = self.position_mm;
+        let mut words = block.words;
+        if let Some(n) = words.take(b'N')
+            && n > LINE_NUMBER_MAX
+        {
+            return Err(GrblError::InvalidLineNumber);
+        }
+        if let Some(u) = block.units {
+            self.units = u;
+        }
+        if let Some(d) = block.distance {
+            self.distance = d;
+        }
+        if let Some(s) = block.spindle {
+            self.spindle = s;
+        }
+        if let Some(m) = block.motion {
+            self.motion = m;
+        }
+        let scale = self.units.mm_per_unit();
+        if let Some(f) = words.take(b'F') {
+            self.feed_mm_per_min = Some(f * scale);
+        }
+        if let Some(s) = words.take(b'S') {
+            self.spindle_speed = s;
+        }
+        if let Some(t) = words.take(b'T') {
+            self.tool = t as u8; // 0..=255, checked when parsed
+        }
+
+        let mut out = Commands::default();
+        if block.non_modal == Some(NonModal::Dwell) {
+            let p = words.take(b'P').ok_or(GrblError::ValueWordMissing)?;
+            let ms = crate::math::round(p * 1000.0);
+            if !(ms <= DWELL_MAX_MS as f32) {
+                return Err(GrblError::MaxValueExceeded);
+            }
+            out.dwell_ms = Some(ms as u32);
+        }
+
+        let axis = [words.get(b'X').map(|v| v * scale), words.get(b'Y').map(|v| v * scale)];
+        let has_z = words.get(b'Z').is_some();
+        let has_xy = axis[0].is_some() || axis[1].is_some();
+        let has_axis = has_xy || has_z;
+        let axis_command = if block.non_modal == Some(NonModal::SetOffset) {
+            AxisCommand::NonModal
+        } else if block.motion_word || has_axis {
+            AxisCommand::Motion
+        } else {
+            AxisCommand::None
+        };
+
+        match block.non_modal {
+            Some(NonModal::SetOffset) => {
+                if !has_axis {
+                    return Err(GrblError::NoAxisWords);
+                }
+                for (i, v) in axis.iter().enumerate() {
+                    if let Some(v) = v {
+                        self.offset_mm[i] = start_mm[i] - v;
+                    }
+                }
+            }
+            Some(NonModal::ClearOffset) => self.offset_mm = [0.0; 2],
+            Some(NonModal::MachineCoords) if !matches!(self.motion, MotionMode::Rapid | MotionMode::Linear) => {
+                return Err(GrblError::G53InvalidMotionMode);
+            }
+            _ => {}
+        }
+
+        if self.motion == MotionMode::Off {
+            if has_axis {
+                return Err(GrblError::AxisWordsExist);
+            }
+        } else if axis_command == AxisCommand::Motion {
+            let machine = block.non_modal == Some(NonModal::MachineCoords);
+            let mut target = start_mm;
+            for (i, v) in axis.iter().enumerate() {
+                if let Some(v) = *v {
+                    target[i] = if machine {
+                        v
+                    } else {
+                        match self.distance {
+                            Distance::Absolute => v + self.offset_mm[i],
+                            Distance::Incremental => start_mm[i] + v,
+                        }
+                    };
+                }
+            }
+            let motion = match self.motion {
+                MotionMode::Rapid if has_xy => self.line(target, Feed::Rapid, settings)?,
+                MotionMode::Linear => {
+                    let feed = self.checked_feed(settings)?;
+                    if has_xy { self.line(target, Feed::MmPerMin(feed), settings)? } else { None }
+                }
+                MotionMode::ArcCw | MotionMode::ArcCcw => {
+                    let feed = self.checked_feed(settings)?;
+                    if !has_axis {
+                        return Err(GrblError::NoAxisWords);
+                    }
+                    if !has_xy {
+                        return Err(GrblError::NoAxisWordsInPlane);
+                    }
+                    let form = match words.take(b'R') {
+                        Some(r) => ArcForm::Radius(r * scale),
+                        None => {
+                            let (i, j) = (words.take(b'I'), words.take(b'J'));
+                            words.take(b'K');
+                            if i.is_none() && j.is_none() {
+                                return Err(GrblError::NoOffsetsInPlane);
+                            }
+                            ArcForm::Offsets([i.unwrap_or(0.0) * scale, j.unwrap_or(0.0) * scale])
+                        }
+                    };
+                    let rotation =
+                        if self.motion == MotionMode::ArcCw { Rotation::Clockwise } else { Rotation::CounterClockwise };
+                    self.arc(target, rotation, form, feed, settings)?
+                }
+                _ => None,
+            };
+            out.main = motion;
+        }
+
+        if axis_command != AxisCommand::None {
+            words.take(b'X');
+            words.take(b'Y');
+            words.take(b'Z');
+        }
+        if !words.is_empty() {
+            return Err(GrblError::UnusedWords);
+        }
+
+        if block.stop == Some(Stop::End) {
+            // GRBL (after LinuxCNC) resets these groups at program end; units, F, S, T and the
+            // G92 offset stay.
+            self.motion = MotionMode::Linear;
+            self.distance = Distance::Absolute;
+            self.spindle = Spindle::Off;
+        }
+        out.stop = block.stop;
+        Ok(out)
+    }
+
+    /// The feed rate for a feed move; zero (an explicit F0) is GRBL's undefined feed rate.
+    pub(super) fn checked_feed(&self, settings: &Settings) -> Result<f32, GrblError> {
+        let feed = self.feed_mm_per_min(settings);
+        if feed > 0.0 { Ok(feed) } else { Err(GrblError::UndefinedFeedRate) }
+    }
+
+    /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
+    fn line(&mut self, target_mm: [f32; 2], feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
+        check_travel(settings, target_mm)?;
+        let from = self.position;
+        let to = to_steps(settings, target_mm);
+        self.position_mm = target_mm;
+        self.position = to;
+        Ok((to != from).then_some(Command::Job(Job::draw(Shape::Line { to }, feed))))
+    }
+
+    /// G2/G3 from the planned position to `end` (mm).
+    fn arc(
+        &mut self,
+        end: [f32; 2],
+        rotation: Rotation,
+        form: ArcForm,
+        feed_mm_per_min: f32,
+        settings: &Settings,
+    ) -> Result<Option<Command>, GrblError> {
+        let start = self.position_mm;
+        let (dx, dy) = (end[0] - start[0], end[1] - start[1]);
+        let (center, radius) = match form {
+            ArcForm::Radius(r) => {
+                if dx == 0.0 && dy == 0.0 {
+                    return Err(GrblError::InvalidTarget);
+                }
+                let h2 = 4.0 * r * r - dx * dx - dy * dy;
+                if !(h2 >= 0.0) {
+                    return Err(GrblError::ArcRadius);
+                }
+                // Centre on the perpendicular bisector of the chord; the side follows the
+                // rotation, and a negative R takes the other side (the long arc).
+                let mut k = -crate::math::sqrt(h2) / crate::math::hypot(dx, dy);
+                if rotation == Rotation::CounterClockwise {
+                    k = -k;
+                }
+                if r < 0.0 {
+                    k = -k;
+                }
+                ([start[0] + 0.5 * (dx - dy * k), start[1] + 0.5 * (dy + dx * k)], r.abs())
+            }
+            ArcForm::Offsets([i, j]) => {
+                let center = [start[0] + i, start[1] + j];
+                let radius = crate::math::hypot(i, j);
+                let delta = (crate::math::hypot(end[0] - center[0], end[1] - center[1]) - radius).abs();
+                if delta > ARC_RADIUS_SLACK_MM
+                    && (delta > ARC_RADIUS_ERROR_MAX_MM || delta > ARC_RADIUS_ERROR_MAX_RATIO * radius)
+                {
+                    return Err(GrblError::InvalidTarget);
+                }
+                (center, radius)
+            }
+        };
+        let (sx, sy) = (start[0] - center[0], start[1] - center[1]);
+        let (ex, ey) = (end[0] - center[0], end[1] - center[1]);
+        let mut sweep = crate::math::atan2(sx * ey - sy * ex, sx * ex + sy * ey);
+        match rotation {
+            Rotation::Clockwise if sweep >= -ARC_ANGLE_EPSILON_RAD => sweep -= TAU,
+            Rotation::CounterClockwise if sweep <= ARC_ANGLE_EPSILON_RAD => sweep += TAU,
+            _ => {}
+        }
+        let conic = Conic {
+            center,
+            semi_axes_mm: [radius, radius],
+            start_rad: crate::math::atan2(sy, sx),
+            sweep_rad: sweep,
+            end,
+        };
+        self.conic(conic, Feed::MmPerMin(feed_mm_per_min), settings)
+    }
+
+    /// An arc of a circle or an axis-aligned ellipse from the planned position to `c.end`.
+    pub(super) fn conic(&mut self, c: Conic, feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
+        if !(c.start_rad.is_finite() && c.sweep_rad.is_finite()) {
+            return Err(GrblError::InvalidTarget);
+        }
+        for r in c.semi_axes_mm {
+            if !(r <= CURVE_RADIUS_MAX_MM) {
+                return Err(GrblError::InvalidTarget);
+            }
+        }
+        check_travel(settings, c.end)?;
+        // The extremes of each axis lie at parametric angles k·90°: check those the sweep passes.
+        let (lo, hi) = if c.sweep_rad >= 0.0 {
+            (c.start_rad, c.start_rad + c.sweep_rad)
+        } else {
+            (c.start_rad + c.sweep_rad, c.start_rad)
+        };
+        let first = crate::math::ceil(lo / FRAC_PI_2) as i32;
+        let last = crate::math::floor(hi / FRAC_PI_2) as i32;
+        // A sweep of at most a full turn passes at most five such angles.
+        for k in first..=last.min(first.saturating_add(4)) {
+            let (cos, sin) = match k.rem_euclid(4) {
+                0 => (1.0, 0.0),
+                1 => (0.0, 1.0),
+                2 => (-1.0, 0.0),
+                _ => (0.0, -1.0),
+            };
+            let p = [c.center[0] + c.semi_axes_mm[0] * cos, c.center[1] + c.semi_axes_mm[1] * sin];
+            check_travel(settings, p)?;
+        }
+
+        let from = self.position;
+        let to = to_steps(settings, c.end);
+        if to == from && c.sweep_rad.abs() < PI {
+            // Shorter than one step: nothing to draw.
+            self.position_mm = c.end;
+            return Ok(None);
+        }
+        let spm = settings.steps_per_mm;
+        let semi = [crate::math::round(c.semi_axes_mm[0] * spm[0]), crate::math::round(c.semi_axes_mm[1] * spm[1])];
+        if !(semi[0] >= 1.0 && semi[1] >= 1.0) {
+            return Err(GrblError::InvalidTarget);
+        }
+        let center = to_steps(settings, c.center);
+        let rotation = if c.sweep_rad > 0.0 { Rotation::CounterClockwise } else { Rotation::Clockwise };
+        let shape = if c.semi_axes_mm[0] == c.semi_axes_mm[1] && spm[0] == spm[1] {
+            Shape::Arc { center, to, rotation }
+        } else {
+            Shape::Ellipse { center, a_steps: semi[0] as i32, b_steps: semi[1] as i32, to, rotation }
+        };
+        // Set up as the motion will set it up, from the same steps: a curve its interpolator
+        // would refuse (a tiny radius whose rounded centre falls on the start or the end) is
+        // refused here, before the planned position moves.
+        let accepted = match shape {
+            Shape::Arc { center, to, rotation } => ArcInterp::new(from, center, to, rotation, settings.method).is_ok(),
+            Shape::Ellipse { center, a_steps, b_steps, to, rotation } => {
+                EllipseInterp::new(from, center, a_steps, b_steps, to, rotation, settings.method).is_ok()
+            }
+            _ => true,
+        };
+        if !accepted {
+            return Err(GrblError::InvalidTarget);
+        }
+        self.position_mm = c.end;
+        self.position = to;
+        Ok(Some(Command::Curve { shape, feed, end: to }))
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum AxisCommand {
+    None,
+    NonModal,
+    Motion,
+}
+
+enum ArcForm {
+    Radius(f32),
+    Offsets([f32; 2]),
+}
+
+/// An elliptic (or circular) arc in machine millimetres.
+pub(super) struct Conic {
+    pub(super) center: [f32; 2],
+    pub(super) semi_axes_mm: [f32; 2],
+    pub(super) start_rad: f32,
+    pub(super) sweep_rad: f32,
+    pub(super) end: [f32; 2],
+}

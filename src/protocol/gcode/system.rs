@@ -1,0 +1,158 @@
+//! The `$` commands: reports, settings, restores, unlock and `$J=` jogs; the plotter curve
+//! commands are handed on to [`super::curves`].
+
+use super::words::{Group, NonModal, compact, parse_block, parse_number};
+use super::{Command, Commands, Distance, GcodeState, Report, check_travel, to_steps};
+use crate::job::{Feed, Job};
+use crate::protocol::GrblError;
+use crate::settings::{SettingError, Settings};
+use crate::status::RunState;
+
+impl GcodeState {
+    /// A line starting with `$`; `rest` follows the `$` and is a suffix of `line`.
+    pub(super) fn system(
+        &mut self,
+        line: &str,
+        rest: &str,
+        settings: &Settings,
+        state: RunState,
+    ) -> Result<Commands, GrblError> {
+        let c = compact(rest, true)?;
+        let report = |r| Ok(Commands::one(Command::Report(r)));
+        match c.as_slice() {
+            b"" => report(Report::Help),
+            b"$" => report(Report::Settings),
+            b"G" => report(Report::ParserState),
+            b"#" => report(Report::Parameters),
+            b"I" => report(Report::BuildInfo),
+            b"X" => Ok(Commands::one(Command::Unlock)),
+            b"H" => Err(GrblError::SettingDisabled),
+            b"SLP" => Err(GrblError::InvalidStatement),
+            [b'R', b'S', b'T', b'=', what] => self.restore(*what, settings, state),
+            [b'J', b'=', body @ ..] => self.jog(body, settings, state),
+            [b'0'..=b'9', ..] => self.set_setting(&c, settings, state),
+            [which @ (b'E' | b'O' | b'S'), ..] => {
+                if matches!(state, RunState::Alarm | RunState::Jog) {
+                    return Err(GrblError::Locked);
+                }
+                let mut next = self.clone();
+                let commands = next.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings)?;
+                *self = next;
+                Ok(commands)
+            }
+            [b'F', ..] => {
+                if matches!(state, RunState::Alarm | RunState::Jog) {
+                    return Err(GrblError::Locked);
+                }
+                let mut next = self.clone();
+                let commands = next.function(line, rest, settings)?;
+                *self = next;
+                Ok(commands)
+            }
+            _ => Err(GrblError::InvalidStatement),
+        }
+    }
+
+    /// `$id=value`.
+    fn set_setting(&mut self, c: &[u8], settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+        if !matches!(state, RunState::Idle | RunState::Alarm) {
+            return Err(GrblError::NotIdle);
+        }
+        let eq = c.iter().position(|&b| b == b'=').ok_or(GrblError::InvalidStatement)?;
+        let (id_text, value_text) = (&c[..eq], &c[eq + 1..]);
+        if id_text.len() > 5 || !id_text.iter().all(u8::is_ascii_digit) {
+            return Err(GrblError::InvalidStatement);
+        }
+        let id = id_text.iter().fold(0u32, |n, d| n * 10 + (d - b'0') as u32);
+        let id = u16::try_from(id).map_err(|_| GrblError::InvalidStatement)?;
+        let value = parse_number(value_text)?;
+        let mut next = settings.clone();
+        next.set(id, value).map_err(|e| match e {
+            SettingError::OutOfRange if value < 0.0 => GrblError::NegativeValue,
+            SettingError::Unknown | SettingError::OutOfRange => GrblError::InvalidStatement,
+        })?;
+        self.rescale(&next);
+        Ok(Commands::one(Command::SetSetting { id, value }))
+    }
+
+    /// `$RST=$`, `$RST=#`, `$RST=*`.
+    fn restore(&mut self, what: u8, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+        if !matches!(what, b'$' | b'#' | b'*') {
+            return Err(GrblError::InvalidStatement);
+        }
+        if !matches!(state, RunState::Idle | RunState::Alarm) {
+            return Err(GrblError::NotIdle);
+        }
+        if what != b'$' {
+            self.offset_mm = [0.0; 2];
+        }
+        if what == b'#' {
+            return Ok(Commands::default());
+        }
+        let defaults = Settings::default();
+        if defaults.steps_per_mm != settings.steps_per_mm {
+            self.rescale(&defaults);
+        }
+        Ok(Commands::one(Command::RestoreSettings))
+    }
+
+    /// Keeps the planned position on the same step when steps/mm change.
+    fn rescale(&mut self, next: &Settings) {
+        let position = self.position;
+        self.sync_position(position, next);
+    }
+
+    /// `$J=` followed by `body` (compacted).
+    fn jog(&mut self, body: &[u8], settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+        if !matches!(state, RunState::Idle | RunState::Jog) {
+            return Err(GrblError::NotIdle);
+        }
+        let block = parse_block(body)?;
+        let mut words = block.words;
+        let units = block.units.unwrap_or(self.units);
+        let distance = block.distance.unwrap_or(self.distance);
+        let f = words.take(b'F').ok_or(GrblError::UndefinedFeedRate)?;
+        let feed = f * units.mm_per_unit();
+        if !(feed > 0.0) {
+            return Err(GrblError::UndefinedFeedRate);
+        }
+        let allowed = Group::Distance.bit() | Group::Units.bit() | Group::NonModal.bit();
+        if block.groups & !allowed != 0 || !matches!(block.non_modal, None | Some(NonModal::MachineCoords)) {
+            return Err(GrblError::InvalidJog);
+        }
+        words.take(b'N');
+        let axis = [words.take(b'X'), words.take(b'Y')];
+        let has_z = words.take(b'Z').is_some();
+        if !words.is_empty() {
+            return Err(GrblError::InvalidJog);
+        }
+        if axis == [None, None] {
+            // A Z-only jog (a sender's Z buttons) moves nothing.
+            return if has_z { Ok(Commands::default()) } else { Err(GrblError::NoAxisWords) };
+        }
+        let machine = block.non_modal == Some(NonModal::MachineCoords);
+        let mut target = self.position_mm;
+        for (i, v) in axis.iter().enumerate() {
+            if let Some(v) = *v {
+                let v = v * units.mm_per_unit();
+                target[i] = if machine {
+                    v
+                } else {
+                    match distance {
+                        Distance::Absolute => v + self.offset_mm[i],
+                        Distance::Incremental => self.position_mm[i] + v,
+                    }
+                };
+            }
+        }
+        check_travel(settings, target)?;
+        let from = self.position;
+        let to = to_steps(settings, target);
+        self.position_mm = target;
+        self.position = to;
+        if to == from {
+            return Ok(Commands::default());
+        }
+        Ok(Commands::one(Command::Jog(Job::jog_to(to, Feed::MmPerMin(feed)))))
+    }
+}
