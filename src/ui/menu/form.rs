@@ -1,0 +1,327 @@
+//! The forms of the drawing modes: the ranges of their parameters, the fields each mode asks
+//! for, and [`Form`], which takes the keys of a form, checks the values and builds the job from
+//! the pen.
+
+use core::ops::RangeInclusive;
+
+use super::{MenuAction, Mode, UiError};
+use crate::geom::{Axis, Point};
+use crate::job::{Feed, Job, Shape};
+use crate::keypad::Key;
+use crate::settings::Settings;
+use crate::status::{RunState, Status};
+use crate::ui::curves::{
+    CircleParams, CurveJob, CurveParams, EllipseParams, Extent, FunctionParams, FunctionPreset, SineParams,
+};
+use crate::ui::entry::NumberEntry;
+
+/// Line: offset of the end point from the pen, per axis.
+pub const LINE_DELTA_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
+/// Circle: radius.
+pub const CIRCLE_RADIUS_RANGE_MM: RangeInclusive<f32> = 0.1..=500.0;
+/// Ellipse: semi-axes along X (a) and Y (b).
+pub const ELLIPSE_SEMI_AXIS_RANGE_MM: RangeInclusive<f32> = 0.1..=500.0;
+/// Circle and ellipse: angle of the pen on the curve, seen from the centre.
+pub const ARC_START_RANGE_DEG: RangeInclusive<f32> = -360.0..=360.0;
+/// Circle and ellipse: angle turned, positive counter-clockwise; 0 (or empty) is a full turn.
+pub const ARC_SWEEP_RANGE_DEG: RangeInclusive<f32> = -360.0..=360.0;
+/// Sine: amplitude (negative starts downwards).
+pub const SINE_AMPLITUDE_RANGE_MM: RangeInclusive<f32> = -250.0..=250.0;
+/// Sine: length of one wave along X.
+pub const SINE_PERIOD_RANGE_MM: RangeInclusive<f32> = 1.0..=1000.0;
+/// Sine: phase at the pen.
+pub const SINE_PHASE_RANGE_DEG: RangeInclusive<f32> = -360.0..=360.0;
+/// Sine: length along X (negative draws towards −X; never 0).
+pub const SINE_LENGTH_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
+/// Function: x0 and x1 of y = f(x).
+pub const FUNCTION_X_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
+
+/// Most fields one form has.
+pub const FORM_MAX_FIELDS: usize = 4;
+
+/// Unit of a number field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Unit {
+    Mm,
+    Deg,
+}
+
+impl Unit {
+    pub const fn symbol(self) -> &'static str {
+        match self {
+            Unit::Mm => "mm",
+            Unit::Deg => "deg",
+        }
+    }
+}
+
+/// A number to type: its name, unit, range, and what an empty field means.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NumberField {
+    pub label: &'static str,
+    pub unit: Unit,
+    pub range: RangeInclusive<f32>,
+    /// Used when `#` confirms an empty field; `None`: a value is required.
+    pub default: Option<f32>,
+    pub zero_allowed: bool,
+    /// One line of help shown under the field.
+    pub hint: &'static str,
+}
+
+impl NumberField {
+    /// The value of `entry` for this field, checked.
+    pub fn value(&self, entry: &NumberEntry) -> Result<f32, UiError> {
+        let v = match entry.value().map_err(UiError::Entry)? {
+            Some(v) => v,
+            None => self.default.ok_or(UiError::Empty)?,
+        };
+        if !v.is_finite() || !self.range.contains(&v) {
+            return Err(UiError::OutOfRange { min: *self.range.start(), max: *self.range.end(), unit: self.unit });
+        }
+        if v == 0.0 && !self.zero_allowed {
+            return Err(UiError::Zero);
+        }
+        Ok(v)
+    }
+}
+
+/// One field of a form.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Field {
+    Number(NumberField),
+    /// Choice of a [`FunctionPreset`]: `1`..`5` pick, `A`/`B` step, `#` confirms.
+    Preset,
+}
+
+const HINT_NUMBER: &str = "#ok *. A- Bdel Dback";
+
+const fn mm(label: &'static str, range: RangeInclusive<f32>, zero_allowed: bool, hint: &'static str) -> Field {
+    Field::Number(NumberField { label, unit: Unit::Mm, range, default: None, zero_allowed, hint })
+}
+
+const fn deg(label: &'static str, range: RangeInclusive<f32>, hint: &'static str) -> Field {
+    Field::Number(NumberField { label, unit: Unit::Deg, range, default: Some(0.0), zero_allowed: true, hint })
+}
+
+pub(super) const LINE_FIELDS: &[Field] = &[
+    mm("dX", LINE_DELTA_RANGE_MM, true, "X offset from the pen"),
+    mm("dY", LINE_DELTA_RANGE_MM, true, "Y offset from the pen"),
+];
+pub(super) const CIRCLE_FIELDS: &[Field] = &[
+    mm("Radius", CIRCLE_RADIUS_RANGE_MM, false, HINT_NUMBER),
+    deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
+    deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
+];
+pub(super) const ELLIPSE_FIELDS: &[Field] = &[
+    mm("a (X)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along X"),
+    mm("b (Y)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along Y"),
+    deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
+    deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
+];
+pub(super) const SINE_FIELDS: &[Field] = &[
+    mm("Amplitude", SINE_AMPLITUDE_RANGE_MM, true, HINT_NUMBER),
+    mm("Period", SINE_PERIOD_RANGE_MM, false, "One wave along X"),
+    deg("Phase", SINE_PHASE_RANGE_DEG, "Empty = 0"),
+    mm("Length", SINE_LENGTH_RANGE_MM, false, "Along X, - = leftwards"),
+];
+pub(super) const FUNCTION_FIELDS: &[Field] = &[
+    Field::Preset,
+    mm("x0", FUNCTION_X_RANGE_MM, true, "Start x (at the pen)"),
+    mm("x1", FUNCTION_X_RANGE_MM, true, "End x"),
+];
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Form {
+    mode: Mode,
+    field: usize,
+    entries: [NumberEntry; FORM_MAX_FIELDS],
+    preset: FunctionPreset,
+}
+
+impl Form {
+    pub(super) fn new(mode: Mode) -> Self {
+        Form {
+            mode,
+            field: 0,
+            entries: [const { NumberEntry::new() }; FORM_MAX_FIELDS],
+            preset: FunctionPreset::Parabola,
+        }
+    }
+
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Index of the field being typed.
+    pub fn field_index(&self) -> usize {
+        self.field
+    }
+
+    /// The field being typed.
+    pub fn field(&self) -> Option<&'static Field> {
+        self.mode.fields().get(self.field)
+    }
+
+    /// The text of the field being typed.
+    pub fn entry(&self) -> &NumberEntry {
+        &self.entries[self.field.min(FORM_MAX_FIELDS - 1)]
+    }
+
+    /// The function chosen (function mode).
+    pub fn preset(&self) -> FunctionPreset {
+        self.preset
+    }
+
+    pub(super) fn press(
+        &mut self,
+        key: Key,
+        repeated: bool,
+        status: &Status,
+        settings: &Settings,
+    ) -> Result<MenuAction, UiError> {
+        let Some(field) = self.field() else { return Ok(MenuAction::None) };
+        let entry = &mut self.entries[self.field.min(FORM_MAX_FIELDS - 1)];
+        match (field, key) {
+            (_, Key::Hash) => return self.confirm(status, settings),
+            (Field::Preset, Key::Digit(d)) => {
+                if let Some(&p) = (d as usize).checked_sub(1).and_then(|i| FunctionPreset::ALL.get(i)) {
+                    self.preset = p;
+                }
+            }
+            (Field::Preset, Key::A) => self.preset = FunctionPreset::ALL[self.preset.index().saturating_sub(1)],
+            (Field::Preset, Key::B) => {
+                self.preset = FunctionPreset::ALL[(self.preset.index() + 1).min(FunctionPreset::ALL.len() - 1)]
+            }
+            (Field::Number(_), Key::Digit(d)) => entry.push_digit(d).map_err(UiError::Entry)?,
+            (Field::Number(_), Key::Star) => entry.push_point().map_err(UiError::Entry)?,
+            (Field::Number(_), Key::A) => entry.toggle_sign(),
+            (Field::Number(_), Key::B) => {
+                let deleted = entry.backspace();
+                // An empty field gives way to the previous one, on a fresh press only.
+                if !deleted && !repeated && self.field > 0 {
+                    self.field -= 1;
+                }
+            }
+            (Field::Number(_), Key::C) => entry.clear(),
+            _ => {}
+        }
+        Ok(MenuAction::None)
+    }
+
+    /// `#`: checks the field, then moves on or, after the last one, builds the job.
+    fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
+        if let Some(Field::Number(spec)) = self.field() {
+            spec.value(self.entry())?;
+        }
+        if self.field + 1 < self.mode.fields().len() {
+            self.field += 1;
+            return Ok(MenuAction::None);
+        }
+        let action = self.build(status, settings)?;
+        *self = Form { preset: self.preset, ..Form::new(self.mode) };
+        Ok(action)
+    }
+
+    /// The checked value of number field `i`.
+    fn number(&self, i: usize) -> Result<f32, UiError> {
+        match (self.mode.fields().get(i), self.entries.get(i)) {
+            (Some(Field::Number(spec)), Some(entry)) => spec.value(entry),
+            _ => Err(UiError::Empty),
+        }
+    }
+
+    /// A full or partial turn: 0 means a full counter-clockwise turn.
+    fn sweep(&self, i: usize) -> Result<f32, UiError> {
+        let sweep = self.number(i)?;
+        Ok(if sweep == 0.0 { 360.0 } else { sweep })
+    }
+
+    /// The typed curve (every mode but line).
+    pub fn curve(&self) -> Result<CurveParams, UiError> {
+        Ok(match self.mode {
+            Mode::Circle => CurveParams::Circle(CircleParams {
+                radius_mm: self.number(0)?,
+                start_deg: self.number(1)?,
+                sweep_deg: self.sweep(2)?,
+            }),
+            Mode::Ellipse => CurveParams::Ellipse(EllipseParams {
+                a_mm: self.number(0)?,
+                b_mm: self.number(1)?,
+                start_deg: self.number(2)?,
+                sweep_deg: self.sweep(3)?,
+            }),
+            Mode::Sine => CurveParams::Sine(SineParams {
+                amplitude_mm: self.number(0)?,
+                period_mm: self.number(1)?,
+                phase_deg: self.number(2)?,
+                length_mm: self.number(3)?,
+            }),
+            Mode::Function => {
+                let (x0_mm, x1_mm) = (self.number(1)?, self.number(2)?);
+                if x0_mm == x1_mm {
+                    return Err(UiError::SameEnds);
+                }
+                CurveParams::Function(FunctionParams { preset: self.preset, x0_mm, x1_mm })
+            }
+            Mode::Jog | Mode::Line | Mode::Settings => return Err(UiError::Empty),
+        })
+    }
+
+    /// The job the form describes, from the pen at `status.position`.
+    fn build(&self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
+        let feed = Feed::MmPerMin(settings.default_feed_mm_per_min);
+        let start = status.position;
+        let action = if self.mode == Mode::Line {
+            let to = offset(start, self.number(0)?, self.number(1)?, settings);
+            if !within_travel(to, settings) {
+                return Err(UiError::Travel);
+            }
+            MenuAction::Start(Job::draw(Shape::Line { to }, feed))
+        } else {
+            let curve = self.curve()?;
+            let extent = curve.extent().ok_or(UiError::Domain)?;
+            if !extent_within_travel(start, &extent, settings) {
+                return Err(UiError::Travel);
+            }
+            let job = CurveJob { start, curve, feed };
+            if let Ok(Job { shape: Shape::Sine { amplitude_steps, omega_rad_per_step, .. }, .. }) = job.to_job(settings)
+                && !crate::interp::sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings)
+            {
+                return Err(UiError::TooSteep);
+            }
+            MenuAction::StartCurve(job)
+        };
+        match status.state {
+            RunState::Alarm => Err(UiError::Alarm),
+            RunState::Idle if status.queued_jobs == 0 => Ok(action),
+            _ => Err(UiError::Busy),
+        }
+    }
+}
+
+/// `start` moved by (`dx_mm`, `dy_mm`), in steps.
+fn offset(start: Point, dx_mm: f32, dy_mm: f32, settings: &Settings) -> Point {
+    Point::new(
+        start.x.saturating_add(settings.mm_to_steps(Axis::X, dx_mm)),
+        start.y.saturating_add(settings.mm_to_steps(Axis::Y, dy_mm)),
+    )
+}
+
+/// True when `p` is inside the travel area: |x|, |y| within max travel ($130, $131).
+fn within_travel(p: Point, settings: &Settings) -> bool {
+    Axis::ALL.into_iter().all(|axis| {
+        let limit = settings.mm_to_steps(axis, settings.max_travel_mm[axis.index()]);
+        let v = match axis {
+            Axis::X => p.x,
+            Axis::Y => p.y,
+        };
+        (-limit..=limit).contains(&v)
+    })
+}
+
+/// True when a drawing covering `extent` from `start` stays inside the travel area.
+fn extent_within_travel(start: Point, extent: &Extent, settings: &Settings) -> bool {
+    within_travel(offset(start, extent.x_min_mm, extent.y_min_mm, settings), settings)
+        && within_travel(offset(start, extent.x_max_mm, extent.y_max_mm, settings), settings)
+}

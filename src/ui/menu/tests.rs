@@ -1,0 +1,280 @@
+//! The menu driven key by key as on the keypad: the forms and their checks, starting jobs,
+//! run control, jogging and the mode list.
+
+extern crate std;
+use super::*;
+use crate::geom::Point;
+use crate::job::{Feed, Shape};
+use crate::ui::curves::{CircleParams, CurveParams, EllipseParams, FunctionParams, FunctionPreset, SineParams};
+use std::vec::Vec;
+
+fn key(ch: char) -> Key {
+    match ch {
+        '0'..='9' => Key::Digit(ch as u8 - b'0'),
+        'A' => Key::A,
+        'B' => Key::B,
+        'C' => Key::C,
+        'D' => Key::D,
+        '*' => Key::Star,
+        '#' => Key::Hash,
+        _ => panic!("no key {ch}"),
+    }
+}
+
+/// Presses each key of `keys` (spaces ignored); returns the actions other than `None`.
+fn type_keys(menu: &mut Menu, keys: &str, status: &Status) -> Vec<MenuAction> {
+    keys.chars()
+        .filter(|c| !c.is_whitespace())
+        .map(|c| menu.handle(KeyEvent::Press(key(c)), status, &Settings::default()))
+        .filter(|a| *a != MenuAction::None)
+        .collect()
+}
+
+fn idle() -> Status {
+    Status::default()
+}
+
+fn line(x: i32, y: i32) -> MenuAction {
+    MenuAction::Start(Job::draw(Shape::Line { to: Point::new(x, y) }, Feed::MmPerMin(3_000.0)))
+}
+
+fn form(menu: &Menu) -> &Form {
+    match menu.screen() {
+        Screen::Form(f) => f,
+        s => panic!("not a form: {s:?}"),
+    }
+}
+
+#[test]
+fn line_mode_starts_a_line_in_steps() {
+    let mut m = Menu::new();
+    assert_eq!(type_keys(&mut m, "2 10# 5#", &idle()), [line(1000, 500)]);
+    // The form is ready for the next line, empty.
+    assert_eq!(form(&m).field_index(), 0);
+    assert!(form(&m).entry().is_empty());
+}
+
+#[test]
+fn line_is_relative_to_the_pen() {
+    let mut m = Menu::new();
+    let status = Status { position: Point::new(200, -300), ..Status::default() };
+    assert_eq!(type_keys(&mut m, "2 10# 5#", &status), [line(1200, 200)]);
+}
+
+#[test]
+fn backspace_sign_and_decimal_point() {
+    let mut m = Menu::new();
+    // "12" then delete the 2, point, 5, minus: -1.5 mm. Then 0.25 mm.
+    assert_eq!(type_keys(&mut m, "2 12B*5A# *25#", &idle()), [line(-150, 25)]);
+}
+
+#[test]
+fn out_of_range_keeps_the_field_for_correction() {
+    let mut m = Menu::new();
+    assert_eq!(type_keys(&mut m, "2 2000#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::OutOfRange { min: -1000.0, max: 1000.0, unit: Unit::Mm }));
+    assert_eq!(form(&m).field_index(), 0);
+    assert_eq!(form(&m).entry().digits(), "2000");
+    // Any key clears the message; fix the value and go on.
+    assert_eq!(type_keys(&mut m, "B#", &idle()), []);
+    assert_eq!(m.message(), None);
+    assert_eq!(type_keys(&mut m, "0#", &idle()), [line(20_000, 0)]);
+}
+
+#[test]
+fn empty_and_malformed_fields_are_refused() {
+    let mut m = Menu::new();
+    assert_eq!(type_keys(&mut m, "2#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::Empty));
+    assert_eq!(type_keys(&mut m, "A#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::Entry(EntryError::NotANumber)));
+    assert_eq!(type_keys(&mut m, "C12345678 9", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::Entry(EntryError::TooLong)));
+    assert_eq!(form(&m).entry().digits(), "12345678");
+}
+
+#[test]
+fn beyond_travel_nothing_starts() {
+    let mut m = Menu::new();
+    // Pen at X 100 mm; 150 mm further is past the 200 mm travel.
+    let status = Status { position: Point::new(10_000, 0), ..Status::default() };
+    assert_eq!(type_keys(&mut m, "2 150# 0#", &status), []);
+    assert_eq!(m.message(), Some(UiError::Travel));
+    // The last field keeps its text; delete it, go back to dX and correct that.
+    assert_eq!(form(&m).field_index(), 1);
+    assert_eq!(form(&m).entry().digits(), "0");
+    assert_eq!(type_keys(&mut m, "B B BBB 100# 0#", &status), [line(20_000, 0)]);
+}
+
+#[test]
+fn held_backspace_stays_in_its_field() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    type_keys(&mut m, "2 7# 123", &idle());
+    for _ in 0..10 {
+        m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
+    }
+    assert_eq!(form(&m).field_index(), 1);
+    assert!(form(&m).entry().is_empty());
+    // A fresh press on the empty field goes back to dX, text intact.
+    m.handle(KeyEvent::Press(Key::B), &idle(), &s);
+    assert_eq!(form(&m).field_index(), 0);
+    assert_eq!(form(&m).entry().digits(), "7");
+    // The sign key does not repeat.
+    m.handle(KeyEvent::Repeat(Key::A), &idle(), &s);
+    assert!(!form(&m).entry().is_negative());
+}
+
+#[test]
+fn run_hold_resume_abort() {
+    let mut m = Menu::new();
+    type_keys(&mut m, "2 1", &idle());
+    let run = Status { state: RunState::Run, ..Status::default() };
+    let hold = Status { state: RunState::Hold, ..Status::default() };
+    assert_eq!(type_keys(&mut m, "C", &run), [MenuAction::Control(Control::Hold)]);
+    assert_eq!(type_keys(&mut m, "C", &hold), [MenuAction::Control(Control::Resume)]);
+    // Digits and # do nothing while a job runs; D aborts and leaves the form as it was.
+    assert_eq!(type_keys(&mut m, "5#", &run), []);
+    assert_eq!(type_keys(&mut m, "D", &run), [MenuAction::Control(Control::Abort)]);
+    assert_eq!(type_keys(&mut m, "D", &hold), [MenuAction::Control(Control::Abort)]);
+    assert_eq!(form(&m).entry().digits(), "1");
+    // Idle again: D goes back to the mode list.
+    assert_eq!(type_keys(&mut m, "D", &idle()), []);
+    assert_eq!(*m.screen(), Screen::Modes);
+}
+
+#[test]
+fn no_job_while_busy_or_in_alarm() {
+    let mut m = Menu::new();
+    let queued = Status { queued_jobs: 1, ..Status::default() };
+    assert_eq!(type_keys(&mut m, "2 1# 1#", &queued), []);
+    assert_eq!(m.message(), Some(UiError::Busy));
+    let alarm = Status { state: RunState::Alarm, ..Status::default() };
+    assert_eq!(type_keys(&mut m, "#", &alarm), []);
+    assert_eq!(m.message(), Some(UiError::Alarm));
+    assert_eq!(type_keys(&mut m, "#", &idle()), [line(100, 100)]);
+}
+
+#[test]
+fn jog_keys_start_and_stop_the_jog() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    type_keys(&mut m, "1", &idle());
+    assert_eq!(*m.screen(), Screen::Jog);
+    let jogging = Status { state: RunState::Jog, ..Status::default() };
+    for (k, step) in
+        [(2, Step::YP), (8, Step::YN), (4, Step::XN), (6, Step::XP), (3, Step::new(1, 1)), (7, Step::new(-1, -1))]
+    {
+        assert_eq!(m.handle(KeyEvent::Press(Key::Digit(k)), &idle(), &s), MenuAction::JogStart(step));
+        assert_eq!(m.handle(KeyEvent::Release(Key::Digit(k)), &jogging, &s), MenuAction::JogStop);
+    }
+    assert_eq!(m.handle(KeyEvent::Press(Key::Digit(5)), &idle(), &s), MenuAction::None);
+    // Releasing a key other than the jogging one does not stop it.
+    assert_eq!(m.handle(KeyEvent::Press(Key::Digit(1)), &idle(), &s), MenuAction::JogStart(Step::new(-1, 1)));
+    assert_eq!(m.handle(KeyEvent::Release(Key::Digit(5)), &jogging, &s), MenuAction::None);
+    // D while the key is held stops the jog; the late release then does nothing.
+    assert_eq!(m.handle(KeyEvent::Press(Key::D), &jogging, &s), MenuAction::JogStop);
+    assert_eq!(m.handle(KeyEvent::Release(Key::Digit(7)), &jogging, &s), MenuAction::None);
+    // No jog in alarm.
+    let alarm = Status { state: RunState::Alarm, ..Status::default() };
+    assert_eq!(m.handle(KeyEvent::Press(Key::Digit(3)), &alarm, &s), MenuAction::None);
+    assert_eq!(m.message(), Some(UiError::Alarm));
+}
+
+#[test]
+fn mode_list_by_digit_and_by_navigation() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    m.handle(KeyEvent::Press(Key::A), &idle(), &s);
+    assert_eq!(m.selected(), Mode::Jog, "stops at the top");
+    m.handle(KeyEvent::Press(Key::B), &idle(), &s);
+    m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
+    assert_eq!(m.selected(), Mode::Circle);
+    for _ in 0..20 {
+        m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
+    }
+    assert_eq!(m.selected(), Mode::Settings, "stops at the bottom, no wrap");
+    m.handle(KeyEvent::Press(Key::A), &idle(), &s);
+    m.handle(KeyEvent::Press(Key::Hash), &idle(), &s);
+    assert_eq!(form(&m).mode(), Mode::Function);
+    type_keys(&mut m, "D 4", &idle());
+    assert_eq!(form(&m).mode(), Mode::Ellipse);
+    type_keys(&mut m, "D 7", &idle());
+    assert_eq!(*m.screen(), Screen::Settings { first_line: 0 });
+}
+
+fn curve(action: &MenuAction) -> CurveParams {
+    match action {
+        MenuAction::StartCurve(job) => job.curve,
+        a => panic!("not a curve: {a:?}"),
+    }
+}
+
+#[test]
+fn circle_defaults_to_a_full_turn() {
+    let mut m = Menu::new();
+    let status = Status { position: Point::new(1000, 0), ..Status::default() };
+    let actions = type_keys(&mut m, "3 10# # #", &status);
+    assert_eq!(actions.len(), 1);
+    assert_eq!(
+        curve(&actions[0]),
+        CurveParams::Circle(CircleParams { radius_mm: 10.0, start_deg: 0.0, sweep_deg: 360.0 })
+    );
+    let MenuAction::StartCurve(job) = &actions[0] else { unreachable!() };
+    assert_eq!(job.start, Point::new(1000, 0));
+    // A half turn clockwise from the top.
+    let actions = type_keys(&mut m, "3# 90# A180#", &status);
+    assert_eq!(
+        curve(&actions[0]),
+        CurveParams::Circle(CircleParams { radius_mm: 3.0, start_deg: 90.0, sweep_deg: -180.0 })
+    );
+    // Radius 0 is refused; a circle leaving the travel area too.
+    assert_eq!(type_keys(&mut m, "0#", &status), []);
+    assert_eq!(m.message(), Some(UiError::OutOfRange { min: 0.1, max: 500.0, unit: Unit::Mm }));
+    assert_eq!(type_keys(&mut m, "C150# # #", &status), []);
+    assert_eq!(m.message(), Some(UiError::Travel), "a full circle of r 150 from x 10 reaches x -290");
+}
+
+#[test]
+fn ellipse_and_sine_forms() {
+    let mut m = Menu::new();
+    let a = type_keys(&mut m, "4 20# 10# 45# 90#", &idle());
+    assert_eq!(
+        curve(&a[0]),
+        CurveParams::Ellipse(EllipseParams { a_mm: 20.0, b_mm: 10.0, start_deg: 45.0, sweep_deg: 90.0 })
+    );
+    type_keys(&mut m, "D", &idle());
+    let a = type_keys(&mut m, "5 A5# 20# # 40#", &idle());
+    assert_eq!(
+        curve(&a[0]),
+        CurveParams::Sine(SineParams { amplitude_mm: -5.0, period_mm: 20.0, phase_deg: 0.0, length_mm: 40.0 })
+    );
+    assert_eq!(type_keys(&mut m, "5# 20# # 0#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::Zero));
+    // A 100 mm amplitude over a 1 mm period rises 628 mm per mm: far over the 5 mm jump limit.
+    type_keys(&mut m, "D", &idle());
+    assert_eq!(type_keys(&mut m, "5 100# 1# # 10#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::TooSteep));
+}
+
+#[test]
+fn function_presets_and_their_domains() {
+    let mut m = Menu::new();
+    let a = type_keys(&mut m, "6 2# 0# 20#", &idle());
+    assert_eq!(
+        curve(&a[0]),
+        CurveParams::Function(FunctionParams { preset: FunctionPreset::Wave, x0_mm: 0.0, x1_mm: 20.0 })
+    );
+    // The preset choice is kept for the next drawing; B steps to the next one.
+    assert_eq!(form(&m).preset(), FunctionPreset::Wave);
+    let a = type_keys(&mut m, "B# 0# 9#", &idle());
+    assert_eq!(
+        curve(&a[0]),
+        CurveParams::Function(FunctionParams { preset: FunctionPreset::Root, x0_mm: 0.0, x1_mm: 9.0 })
+    );
+    // sqrt of negative x, and an empty interval, are refused.
+    assert_eq!(type_keys(&mut m, "# A4# 9#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::Domain));
+    assert_eq!(type_keys(&mut m, "BBBB 9# 9#", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::SameEnds));
+}
