@@ -38,7 +38,7 @@ MODEL_KINDS = {
     "function": ["gauss", "cubic", "sinx"],
 }
 MODEL_HEADER = """\
-# The motion path's cost on the board, for the simulator's CPU model (`cargo sim -- --cpu f407`).
+# The motion path's cost on the board, for the simulator's CPU model (`cargo sim --cpu f407`).
 # Written by `python3 cost/count.py --write-model cost/f407.txt` from the instructions counted on
 # QEMU's Cortex-M4F (mps2-an386); `.ci/run` checks that it still matches what is counted.
 # Per step: the motion task all-in (interpolator, planner, task), the most costly case of each kind.

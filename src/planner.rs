@@ -1,11 +1,11 @@
-//! Motion planner: turns the steps of queued curves into timed [`StepCmd`](crate::geom::StepCmd)s — start rate,
-//! acceleration, tangential feed, per-axis limits, curvature, look-ahead across segments, hold
-//! and abort.
+//! Motion planner: turns the steps of queued curves into timed
+//! [`StepCmd`](crate::geom::StepCmd)s — start rate, acceleration, tangential feed, per-axis
+//! limits, curvature, look-ahead across segments, hold and abort.
 //!
 //! It owns the speed profile and nothing else: it reads no clock (time exists only as the
 //! intervals it computes), never touches pins, never allocates, and never panics. The motion
 //! task [`push`](Planner::push)es one interpolator per job (a segment) and hands what
-//! [`next_cmd`](Planner::next_cmd) returns to the pulse task.
+//! [`next_cmd`](Planner::next_cmd) returns to the pulse engine.
 //!
 //! The work is split as in GRBL (`planner.c` / `stepper.c`): the look-ahead ([`scan`]) decides
 //! speed caps and exit speeds per *block* of steps, with floating point once per chunk of steps;
@@ -35,9 +35,9 @@
 //! change) or allow much more. Whatever is not scanned yet is treated as a stop at the scan's
 //! front, but for the rest of a straight line: its length is known
 //! ([`Interpolator::straight_steps_left`]), so its block brakes for the line's end and a long
-//! line reaches its speed whatever the horizon. The scan also finds a segment's exit direction and a curve error: the plan stops at
-//! the error point, and `next_cmd` returns `Some(Err(e))` exactly when the motion reaches it; the
-//! next segment starts from rest.
+//! line reaches its speed whatever the horizon. The scan also finds a segment's exit direction
+//! and a curve error: the plan stops at the error point, and `next_cmd` returns `Some(Err(e))`
+//! exactly when the motion reaches it; the next segment starts from rest.
 //!
 //! A kink (the tangent jumps by more than [`KINK_CHORD`](crate::interp::KINK_CHORD) within one
 //! step) ends a fill ([`Interpolator::fill`]); the step after it is a chunk and a block of its

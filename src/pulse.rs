@@ -2,13 +2,13 @@
 //! PULS/SIGN timing and is the only writer of the position counters, so the position is the
 //! pulses emitted, always.
 //!
-//! The motion task fills the step queue ([`StepQueue`], single producer, single consumer, no
-//! lock) with step commands, and marks where its motion comes to rest. The step timer counts one *period* at a time; a period is as long
-//! as the interval before a step, and the hardware ends it with a pulse of the pulse width on
-//! the axes that step (PWM outputs), so every pulse edge is placed by the timer, not by
-//! software. The period after the current one is *preloaded*: the timer switches to it by
-//! itself. At the start of each period (an update event) [`PulseEngine::on_period`] runs: it
-//! counts the pulses of the period that just ended, drives SIGN for the pulse that ends the
+//! The motion task fills the step queue ([`StepQueue`], single producer, single consumer, no lock)
+//! with step commands, and marks where its motion comes to rest. The step timer counts one *period*
+//! at a time; a period is as long as the interval before a step, and the hardware ends it with a
+//! pulse of the pulse width on the axes that step (PWM outputs), so every pulse edge is placed by
+//! the timer, not by software. The period after the current one is *preloaded*: the timer switches
+//! to it by itself. At the start of each period (an update event) [`PulseEngine::on_period`] runs:
+//! it counts the pulses of the period that just ended, drives SIGN for the pulse that ends the
 //! period now starting (so SIGN settles for nearly a whole period before its edge, and never
 //! changes under a pulse), and preloads the next period from the next command.
 //!
