@@ -31,8 +31,9 @@ use std::time::Instant;
 
 use servoplot::expr;
 use servoplot::geom::{Point, Rotation, TICK_HZ};
-use servoplot::interp::{Curve, Interpolator, Method};
-use servoplot::job::{Feed, Job, Shape};
+use servoplot::interp::{Curve, Interpolator, Method, Shape};
+use servoplot::job::Feed;
+
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner, plot_time_lower_bound};
 use servoplot::settings::Settings;
 
@@ -204,8 +205,13 @@ fn settings_for(method: Method) -> Settings {
 }
 
 fn build(case: &CurveCase, method: Method) -> Result<Curve, String> {
-    let job = Job::draw((case.shape)(), DRAW_FEED);
-    Curve::for_job(&job, Point::ORIGIN, &settings_for(method)).map_err(|e| format!("{e:?}"))
+    Curve::new(&(case.shape)(), Point::ORIGIN, &settings_for(method)).map_err(|e| format!("{e:?}"))
+}
+
+/// Where the builder says the curve ends: its last lattice point.
+fn built_end(case: &CurveCase, method: Method) -> Result<Point, String> {
+    let drawing = servoplot::drawing::from_shape((case.shape)(), Point::ORIGIN, &settings_for(method));
+    drawing.map(|d| d.end()).map_err(|e| format!("{e:?}"))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -397,8 +403,9 @@ fn measure_curve(case: &CurveCase, method: Method) -> Result<CurveRow, String> {
     let limits = Limits::from_settings(&settings);
     let curve = build(case, method)?;
     let walk = walk(curve.clone(), case.ideal);
-    if walk.end != curve.end() {
-        return Err(format!("ends at {:?}, not at its end {:?}", walk.end, curve.end()));
+    let end = built_end(case, method)?;
+    if walk.end != end {
+        return Err(format!("ends at {:?}, not at its end {:?}", walk.end, end));
     }
     let (planned_steps, ticks) = plan_all(curve.clone(), method, limits);
     if planned_steps != walk.steps {

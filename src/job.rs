@@ -1,11 +1,11 @@
-//! What the machine is asked to do: drawing jobs and run-time controls.
+//! What the machine is asked to do: jobs (a built [`Drawing`] with its feed) and run-time
+//! controls.
 //!
-//! Both inputs (serial protocol and keypad menu) produce the same [`Job`]s, in machine units
-//! (steps), so everything the keypad can draw the host can draw too. A job starts where the pen
-//! is when the job begins; positions in it are absolute.
+//! Both inputs (serial protocol and keypad menu) build their drawings with the one builder
+//! ([`crate::drawing`]), so everything the keypad can draw the host can draw too, step for step.
 
-use crate::expr::Expr;
-use crate::geom::{Axis, Point, Rotation, Step};
+use crate::drawing::{self, DrawError, Drawing, Request};
+use crate::geom::{Axis, Point, Step};
 use crate::settings::Settings;
 
 /// Feed of a jog from the keypad.
@@ -21,55 +21,6 @@ pub enum Feed {
     MmPerMin(f32),
 }
 
-/// The path of one job, in steps. Curves that start "at the pen" (sine, function) are
-/// translated so their first point is wherever the pen is when the job begins.
-// No heap: a function carries its expression by value, so it is the largest.
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Shape {
-    /// Straight line to `to`.
-    Line { to: Point },
-    /// Circular arc around `center` to `to`; `to` equal to the start point is a full circle.
-    Arc { center: Point, to: Point, rotation: Rotation },
-    /// Elliptic arc with semi-axes `a_steps` (along X) and `b_steps` (along Y) around `center`
-    /// to `to`; `to` equal to the start point is the full ellipse.
-    Ellipse { center: Point, a_steps: i32, b_steps: i32, to: Point, rotation: Rotation },
-    /// y = A·sin(ω·x + φ) − A·sin φ, for x from 0 to `length_steps` (negative: towards −X).
-    Sine { amplitude_steps: f32, omega_rad_per_step: f32, phase_rad: f32, length_steps: i32 },
-    /// y = f(x) with x and y in millimetres, for x from `x0_mm` to `x1_mm`, translated so that
-    /// (x0, f(x0)) is the start point.
-    Function { expr: Expr, x0_mm: f32, x1_mm: f32 },
-}
-
-/// What a [`Shape`] is, without its parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum ShapeKind {
-    Line,
-    Arc,
-    Ellipse,
-    Sine,
-    Function,
-}
-
-impl ShapeKind {
-    pub const ALL: [ShapeKind; 5] =
-        [ShapeKind::Line, ShapeKind::Arc, ShapeKind::Ellipse, ShapeKind::Sine, ShapeKind::Function];
-}
-
-impl Shape {
-    pub fn kind(&self) -> ShapeKind {
-        match self {
-            Shape::Line { .. } => ShapeKind::Line,
-            Shape::Arc { .. } => ShapeKind::Arc,
-            Shape::Ellipse { .. } => ShapeKind::Ellipse,
-            Shape::Sine { .. } => ShapeKind::Sine,
-            Shape::Function { .. } => ShapeKind::Function,
-        }
-    }
-}
-
 /// Whether a job draws or jogs. A jog is reported as such and only a jog cancel stops it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -78,11 +29,11 @@ pub enum JobKind {
     Jog,
 }
 
-/// One job for the motion task.
+/// One job for the motion task: a drawing, checked and built, and how fast to draw it.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Job {
-    pub shape: Shape,
+    pub drawing: Drawing,
     pub feed: Feed,
     pub kind: JobKind,
     /// Aborts the machine had counted when the job was planned (`Machine::aborts`): a job
@@ -117,13 +68,14 @@ impl Control {
 
 impl Job {
     /// A drawing job.
-    pub const fn draw(shape: Shape, feed: Feed) -> Job {
-        Job { shape, feed, kind: JobKind::Draw, aborts_before: 0 }
+    pub const fn draw(drawing: Drawing, feed: Feed) -> Job {
+        Job { drawing, feed, kind: JobKind::Draw, aborts_before: 0 }
     }
 
-    /// A jog: a straight move to `to`.
-    pub const fn jog_to(to: Point, feed: Feed) -> Job {
-        Job { shape: Shape::Line { to }, feed, kind: JobKind::Jog, aborts_before: 0 }
+    /// A jog: a straight move from `from` to `to`; `None` when it goes nowhere.
+    pub fn jog_to(from: Point, to: Point, feed: Feed, settings: &Settings) -> Result<Option<Job>, DrawError> {
+        let drawing = drawing::build(&Request::Line { to }, from, settings)?;
+        Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog, aborts_before: 0 }))
     }
 
     /// The same job, planned after `aborts` aborts.
@@ -134,23 +86,25 @@ impl Job {
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a
     /// straight 0°, 45° or 90° line; releasing the key aborts it, which decelerates to a stop.
-    pub fn jog(direction: Step, from: Point, settings: &Settings) -> Job {
+    /// `None` when the pen is at the edge already.
+    pub fn jog(direction: Step, from: Point, settings: &Settings) -> Option<Job> {
+        let limit = settings.travel_steps();
         let room = |axis: Axis| -> i32 {
-            let limit = settings.mm_to_steps(axis, settings.max_travel_mm[axis.index()]);
             let at = match axis {
                 Axis::X => from.x,
                 Axis::Y => from.y,
             };
+            let l = limit[axis.index()];
             match direction.on(axis) {
-                1 => (limit - at).max(0),
-                -1 => (at + limit).max(0),
+                1 => (l - at).max(0),
+                -1 => (at + l).max(0),
                 _ => i32::MAX,
             }
         };
         let distance = room(Axis::X).min(room(Axis::Y));
         let distance = if distance == i32::MAX { 0 } else { distance };
         let to = Point::new(from.x + direction.x as i32 * distance, from.y + direction.y as i32 * distance);
-        Job::jog_to(to, Feed::MmPerMin(JOG_FEED_MM_PER_MIN))
+        Job::jog_to(from, to, Feed::MmPerMin(JOG_FEED_MM_PER_MIN), settings).ok().flatten()
     }
 }
 
@@ -170,9 +124,10 @@ mod tests {
     #[test]
     fn a_diagonal_jog_stays_at_45_degrees_and_inside_the_travel() {
         let s = Settings::default(); // ±200 mm at 100 steps/mm
-        let job = Job::jog(Step::new(1, -1), Point::new(19_000, 5_000), &s);
-        assert_eq!(job.shape, Shape::Line { to: Point::new(20_000, 4_000) });
-        let job = Job::jog(Step::XN, Point::new(19_000, 5_000), &s);
-        assert_eq!(job.shape, Shape::Line { to: Point::new(-20_000, 5_000) });
+        let job = Job::jog(Step::new(1, -1), Point::new(19_000, 5_000), &s).unwrap();
+        assert_eq!(job.drawing.end(), Point::new(20_000, 4_000));
+        let job = Job::jog(Step::XN, Point::new(19_000, 5_000), &s).unwrap();
+        assert_eq!(job.drawing.end(), Point::new(-20_000, 5_000));
+        assert!(Job::jog(Step::XP, Point::new(20_000, 0), &s).is_none(), "at the edge already");
     }
 }

@@ -15,6 +15,7 @@ extern crate std;
 mod fmt;
 
 pub mod decimal;
+pub mod drawing;
 pub mod expr;
 pub mod geom;
 pub mod interp;

@@ -17,7 +17,8 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
-use crate::job::{Control, Job, ShapeKind};
+use crate::interp::ShapeKind;
+use crate::job::{Control, Job};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};

@@ -166,6 +166,11 @@ impl Settings {
         Ok(())
     }
 
+    /// The travel limits ±`$130`, ±`$131` in steps: the lattice points the pen may reach.
+    pub fn travel_steps(&self) -> [i32; 2] {
+        [0, 1].map(|i| crate::math::floor(self.max_travel_mm[i] * self.steps_per_mm[i] + 1e-3) as i32)
+    }
+
     /// Steps per millimetre on `axis`.
     pub fn steps_per_mm(&self, axis: crate::geom::Axis) -> f32 {
         self.steps_per_mm[axis.index()]

@@ -2,7 +2,7 @@
 //! reports and the menu see it.
 
 use crate::geom::Point;
-use crate::interp::{CurveError, CurveSetupError};
+use crate::interp::CurveError;
 
 /// The machine's run state, named as GRBL reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -24,9 +24,8 @@ pub enum RunState {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum MotionFault {
-    /// The job could not start (bad parameter, function undefined at its first point).
-    Setup(CurveSetupError),
-    /// The curve ended part way (domain error, jump).
+    /// The curve ended part way: the travel guard stopped it at the edge (see
+    /// [`crate::interp::Curve`]).
     Curve(CurveError),
 }
 

@@ -11,7 +11,7 @@ use servoplot::status::RunState;
 fn planned_end(line: &str) -> Point {
     let mut g = GcodeState::new();
     let commands = g.execute(line, &Settings::default(), RunState::Idle).expect("a valid line");
-    assert!(commands.into_iter().any(|c| matches!(c, Command::Job(_) | Command::Curve { .. })));
+    assert!(commands.into_iter().any(|c| matches!(c, Command::Job(_))));
     g.planned_position()
 }
 
@@ -95,55 +95,40 @@ fn an_expression_syntax_error_names_its_column_and_moves_nothing() {
 }
 
 #[test]
-fn a_function_with_a_hole_the_parser_cannot_see_stops_at_the_hole_and_tells_the_host() {
-    // Undefined only for |x - 2| < 0.0001 mm: between the parser's samples, but a column of the
-    // interpolator (every 0.01 mm) falls in it. The pen stops at the last column before it, and
-    // the move queued behind the curve is dropped, with a message saying so.
-    let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG1 X0 Y0\n");
+fn a_function_with_a_hole_is_refused_with_where_before_anything_moves() {
+    // Undefined only for |x - 2| < 0.0001 mm, where a column of the interpolator (every
+    // 0.01 mm) falls: the builder walks the whole curve before it moves and finds the hole.
+    let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG1 X1 Y0\n");
     let answers = report.answers();
-    assert!(answers.contains("[MSG:Curve stopped: Domain; queued moves dropped]"), "{answers}");
-    assert_eq!(report.position.x, 199, "stopped at x = 1.99 mm");
-    assert_eq!(report.position, *report.path().last().unwrap());
-    // The machine is usable again, from where it stopped.
-    let report = sim::run_serial("$F X0 U4.1 F1500 Y=sqrt(abs(x-2)-0.0001)\nG4 P0.5\nG1 X0 Y0\n");
-    assert_eq!(report.position, Point::ORIGIN, "{}", report.answers());
+    assert!(answers.contains("[MSG:Function is undefined after x=1.990]\r\nerror:33"), "{answers}");
+    // Nothing of the curve was drawn; the next line is planned from where the pen is.
+    assert_eq!(report.position, Point::new(100, 0), "{answers}");
+    assert_eq!(report.path().iter().map(|p| p.y).max(), Some(0));
 }
 
 #[test]
-fn a_function_leaving_the_travel_between_the_parsers_samples_stops_at_the_edge() {
-    // 250·sin²(πx/2) is 0 at every even x, so the parser's samples (every 2 mm) and the end all
-    // lie at Y = 0; the humps between them reach 250 mm, beyond the ±200 mm travel. The pen
-    // stops at the last column inside, the move queued behind is dropped, and no step is ever
-    // taken outside the travel.
-    let report = sim::run_serial("$F X0 U128 F3000 Y=250*sin(pi*x/2)^2\nG1 X0 Y0\n");
+fn a_function_leaving_the_travel_anywhere_is_refused_before_anything_moves() {
+    // 250·sin²(πx/2) is 0 at every even x; the humps between reach 250 mm, beyond the ±200 mm
+    // travel. The builder's box is the lattice path's own, so the first hump is seen.
+    let report = sim::run_serial("$F X0 U128 F3000 Y=250*sin(pi*x/2)^2\nG1 X1 Y0\n");
     let answers = report.answers();
-    assert!(answers.contains("[MSG:Curve stopped: Travel; queued moves dropped]"), "{answers}");
-    let path = report.path();
-    assert!(path.iter().all(|p| p.x.abs() <= 20_000 && p.y.abs() <= 20_000), "a step outside the travel");
-    assert_eq!(report.position, *path.last().unwrap());
-    // The column rows at 100 steps/mm; the first hump passes 200 mm at x ≈ 0.70 mm.
-    let row = |k: i32| {
-        let s = (std::f64::consts::PI * (k as f64 / 100.0) / 2.0).sin();
-        (250.0 * s * s * 100.0 + 0.5).floor() as i32
-    };
-    let last_in = (0..).take_while(|&k| row(k) <= 20_000).last().unwrap();
-    assert_eq!(report.position, Point::new(last_in, row(last_in)));
-    assert!(report.position.y.abs() <= 20_000);
+    assert!(answers.contains("error:15\r\nok"), "{answers}");
+    assert_eq!(report.position, Point::new(100, 0));
 }
 
 #[test]
 fn no_curve_steps_outside_the_travel() {
-    // From 10 mm inside the top and the bottom edge, functions whose humps (30 and 20 mm) fall
-    // between the parser's samples (every 2 and every 1 mm, where they are 0): the interpolator
-    // stops them at the edge, with either method.
+    // From 10 mm inside the top and the bottom edge, functions whose humps (30 and 20 mm) pass
+    // the edge between their zeros: refused, with either method, and nothing moves past the
+    // edge.
     for method in [0, 1] {
         for (start, line) in [(190, "$F X0 U128 F3000 Y=30*sin(pi*x/2)^2"), (-190, "$F X0 U64 F3000 Y=-20*sin(pi*x)^2")]
         {
             let report = sim::run_serial(&format!("$202={method}\nG0 Y{start}\n{line}\n"));
             let answers = report.answers();
-            assert!(answers.contains("[MSG:Curve stopped: Travel; queued moves dropped]"), "{line}: {answers}");
+            assert!(answers.ends_with("ok\r\nok\r\nerror:15\r\n"), "{line}: {answers}");
             assert!(report.path().iter().all(|p| p.y.abs() <= 20_000), "{line}: a step outside the travel");
-            assert!(report.position.y.abs() >= 19_900, "{line}: stopped at {:?}", report.position);
+            assert_eq!(report.position, Point::new(0, start * 100), "{line}");
         }
     }
 }

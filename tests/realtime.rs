@@ -111,18 +111,20 @@ fn inside_the_travel(report: &SimReport) -> bool {
 }
 
 #[test]
-fn lines_planned_before_a_curve_stopped_part_way_are_planned_again_from_where_it_stopped() {
-    // The function jumps 6 mm at x = 10 mm (over the 5 mm limit) and stops there; lines
-    // streamed behind it were planned from its end, 40 mm further right.
+fn lines_streamed_behind_a_refused_curve_are_planned_from_where_the_pen_is() {
+    // The function jumps 6 mm at x = 10 mm (over the 5 mm limit): it is refused before it
+    // moves, so the lines streamed behind it start from where the pen really is.
     let mut g = String::from("$F X0 U50 F3000 Y=floor(x/10)*6\n");
     for k in 0..19 {
         g += if k % 2 == 0 { "G1 X50 Y31\n" } else { "G1 X50 Y30\n" };
     }
-    g += "$S A1 W0.5 L-245 F3000\n"; // from X50 it would end at X-195; from X10, at X-235
+    g += "$S A1 W0.5 L-245 F3000\n"; // from X50 it ends at X-195
     let report = run_timed(&g, &[], None);
     let answers = report.answers();
-    assert!(answers.contains("[MSG:Curve stopped: Jump; queued moves dropped]"), "{answers}");
+    assert!(answers.contains("[MSG:Function jumps more than $204 after x=9.990]\r\nerror:33"), "{answers}");
+    assert_eq!(answers.matches("ok").count(), 20, "{answers}");
     assert!(inside_the_travel(&report), "a step outside the travel");
+    assert_eq!(report.position.x, -19_500);
 }
 
 #[test]

@@ -92,7 +92,7 @@ fn chain(a: &[Point], b: &[Point]) -> Vec<Point> {
 }
 
 fn line_to(to: Point, at: Point, settings: &Settings) -> Curve {
-    match Curve::for_job(&Job::draw(Shape::Line { to }, DRAW_FEED), at, settings) {
+    match Curve::new(&Shape::Line { to }, at, settings) {
         Ok(c) => c,
         Err(e) => panic!("a line to {to:?} was refused: {e:?}"),
     }
@@ -108,7 +108,7 @@ fn draw_lookahead(points: &[Point], settings: &Settings) -> (u64, u64, Point) {
     loop {
         while next < points.len() && !p.is_full() {
             let curve = line_to(points[next], planned_end, settings);
-            planned_end = curve.end();
+            planned_end = points[next];
             if p.push(curve, DRAW_FEED, settings.method).is_err() {
                 panic!("the planner refused a segment it had room for");
             }
@@ -134,7 +134,7 @@ fn draw_one_by_one(points: &[Point], settings: &Settings) -> (u64, u64, Point) {
     let (mut n, mut ticks, mut at) = (0u64, 0u64, points[0]);
     for &to in &points[1..] {
         let curve = line_to(to, at, settings);
-        at = curve.end();
+        at = to;
         if p.push(curve, DRAW_FEED, settings.method).is_err() {
             panic!("an idle planner refused a segment");
         }

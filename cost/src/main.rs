@@ -11,8 +11,8 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use defmt_rtt as _;
 use servoplot::geom::Point;
-use servoplot::interp::{Curve, Interpolator, Method};
-use servoplot::job::{Feed, Job, Shape};
+use servoplot::interp::{Curve, Interpolator, Method, Shape};
+use servoplot::job::{Feed, Job};
 
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::settings::Settings;
@@ -97,7 +97,7 @@ fn cases() -> [(&'static str, Shape); 10] {
 }
 
 fn curve(shape: &Shape, settings: &Settings) -> Curve {
-    match Curve::for_job(&Job::draw(shape.clone(), FEED), Point::ORIGIN, settings) {
+    match Curve::new(shape, Point::ORIGIN, settings) {
         Ok(c) => c,
         Err(_) => panic!("curve setup"),
     }
@@ -179,7 +179,11 @@ fn main() -> ! {
             let n = with_planner(c, method, limits);
             cost_mark();
             report("planner", name, method, n);
-            let emitted = task::measure(name, method_name(method), Job::draw(shape.clone(), FEED), &settings);
+            let drawing = match servoplot::drawing::from_shape(shape.clone(), Point::ORIGIN, &settings) {
+                Ok(d) => d,
+                Err(_) => panic!("drawing refused"),
+            };
+            let emitted = task::measure(name, method_name(method), Job::draw(drawing, FEED), &settings);
             if emitted != n {
                 panic!("the motion task emitted another number of steps");
             }

@@ -42,12 +42,10 @@
 //!
 //! * A jump is an error, never a travel: the machine has no pen lift, so crossing a pole would
 //!   draw a line the function does not contain.
-//! * The row range is the machine's travel seen from the start (`Curve::for_job` derives it with
-//!   [`RowRange::within_travel`]). Every step of a chord lies between the rows of its two
-//!   columns, so a curve that starts inside the travel never takes a step outside it, and one
-//!   that leaves the travel part way stops at the last column inside. This check is exact, at
-//!   every column; the G-code parser only samples a function to refuse most such curves before
-//!   anything moves.
+//! * A row range ([`RowRange`]) bounds the rows a curve may reach: every step of a chord lies
+//!   between the rows of its two columns, so a curve stops at the last column inside it. The
+//!   machine passes [`RowRange::ANY`]: its travel is kept by the drawing builder, which refuses a
+//!   curve whose lattice path leaves it, and by the guard of [`crate::interp::Curve`].
 //!
 //! [`Interpolator::tangent`] is the direction of the current chord, `(1, h(k+1) - h(k))`
 //! normalised and pointing in the direction of travel (the derivative by finite difference). It

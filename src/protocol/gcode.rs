@@ -56,24 +56,15 @@
 //! | `$F X<x0> U<x1> [F] Y=<expression>` | y = f(x) for x from x0 to x1, moved so that (x0, f(x0)) is at the pen; everything after `Y=` (up to a `;`) is the expression ([`crate::expr`]) |
 //!
 //! `$O` rather than `$C`, and `$SLP` kept apart from `$S`, so that a sender's check-mode or
-//! sleep button never draws. Every point of the curve must lie inside the travel limits, else
-//! error 15 and nothing moves. The check is exact for arcs, ellipses and sines, and for the X
-//! range of a function (it is linear); the Y of a function is checked on
-//! [`FUNCTION_CHECK_SAMPLES`] samples plus the end, an early refusal that catches most curves
-//! before anything moves. The interpolator enforces the travel exactly, at every column: a
-//! function that leaves it between the samples stops at its last column inside
-//! (`CurveError::Travel`, reported by the motion as the curve stopping).
+//! sleep button never draws.
 //!
-//! What the parser accepts, the interpolators accept: every arc or ellipse is set up here with
-//! the very steps it hands out (`ArcInterp::new`, `EllipseInterp::new`) and refused with error 33
-//! if its interpolator would refuse it (a radius that rounds to a centre on the start or the
-//! end, say), and so is a sine (`SineInterp::new`). A sine whose steepest rise between
-//! neighbouring X steps, |A·ω| in steps, exceeds the jump limit (`$204`, as for functions) is
-//! error 33 too: its interpolator would stop at the first such chord.
-//!
-//! Curves end on a step: the planned position afterwards is the [`Command::Curve`]'s `end`. A
-//! curve that ends on its own start step is a full turn if it sweeps more than half a turn, and
-//! draws nothing otherwise (it is shorter than a step).
+//! Every move and curve is built by the drawing builder ([`crate::drawing`]) from the planned
+//! position, exactly as it will be drawn: what would leave the travel limits is error 15, what
+//! cannot be drawn as asked (a curve finer than the step lattice, a sine steeper than the jump
+//! limit `$204`, a function undefined or jumping part way) is error 33 with a message, and
+//! nothing moves. The planned position afterwards is the curve's last lattice point (for a G-code
+//! target that rounds to it, the target in millimetres). A curve that ends on its own start step
+//! is a full turn if it sweeps at least half a turn, and draws nothing otherwise.
 
 // Limits are written `!(value <= limit)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -84,8 +75,9 @@ mod system;
 mod words;
 
 use super::GrblError;
+use crate::drawing::{self, Request};
 use crate::geom::{Axis, Point};
-use crate::job::{Feed, Job, Shape};
+use crate::job::{Feed, Job, JobKind};
 use crate::settings::Settings;
 use crate::status::RunState;
 
@@ -156,19 +148,6 @@ pub const ARC_RADIUS_SLACK_MM: f32 = 0.005;
 pub const ARC_RADIUS_ERROR_MAX_MM: f32 = 0.5;
 pub const ARC_RADIUS_ERROR_MAX_RATIO: f32 = 0.001;
 
-/// Largest radius or semi-axis of an arc or ellipse: 1_000_000 steps at 200 steps/mm, the
-/// circle interpolator's limit. Ellipses (and circles on axes of different steps/mm, which are
-/// ellipses in steps) are held to their interpolator's smaller limit, 262_144 steps
-/// (`MAX_ELLIPSE_AXIS_STEPS`), by the setup check: beyond it they are error 33.
-pub const CURVE_RADIUS_MAX_MM: f32 = 5_000.0;
-
-/// Rounding allowance when a target is compared with the travel limits.
-pub const TRAVEL_SLACK_MM: f32 = 0.0005;
-
-/// Samples of a `$F` function checked against the travel limits (plus both ends): an early
-/// refusal only; the interpolator holds every column to the travel.
-pub const FUNCTION_CHECK_SAMPLES: u32 = 64;
-
 /// Arc sweeps closer than this to zero count as a full turn (GRBL's epsilon).
 const ARC_ANGLE_EPSILON_RAD: f32 = 5e-7;
 
@@ -238,14 +217,10 @@ pub enum Report {
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
-    /// A straight move (G0, G1): a `Shape::Line` job.
-    Job(Job),
-    /// A curve (G2/G3, `$E`, `$O`, `$S`, `$F`) at a feed rate; it ends at `end`, where the parser
-    /// planned it (the interpolator must end there too).
-    Curve { shape: Shape, feed: Feed, end: Point },
-    /// A `$J=` jog: a straight line; a jog cancel (0x85) aborts it, then
+    /// A drawing (G0, G1, G2/G3, `$E`, `$O`, `$S`, `$F`) or a `$J=` jog, built and checked;
+    /// the parser's planned position is its end. A jog cancel (0x85) aborts a jog, then
     /// [`GcodeState::sync_position`].
-    Jog(Job),
+    Job(Job),
     /// G4: wait this long once the motion before it has finished.
     Dwell { ms: u32 },
     /// M0: finish the queued motion, then hold until cycle start (`~`).
@@ -385,21 +360,39 @@ impl GcodeState {
     }
 }
 
-// ----- geometry helpers --------------------------------------------------------------------
-
-/// Error 15 unless the point (machine mm) is inside the travel limits; NaN is outside.
-fn check_travel(settings: &Settings, mm: [f32; 2]) -> Result<(), GrblError> {
-    for (v, limit) in mm.iter().zip(settings.max_travel_mm) {
-        if !(v.abs() <= limit + TRAVEL_SLACK_MM) {
-            return Err(GrblError::TravelExceeded);
-        }
-    }
-    Ok(())
+/// Machine millimetres to the nearest step; `None` for a target no lattice point is near.
+fn to_steps(settings: &Settings, mm: [f32; 2]) -> Option<Point> {
+    let finite = mm.iter().zip(settings.max_travel_mm).all(|(v, limit)| v.abs() <= 2.0 * limit);
+    finite.then(|| Point::new(settings.mm_to_steps(Axis::X, mm[0]), settings.mm_to_steps(Axis::Y, mm[1])))
 }
 
-/// Machine millimetres (inside the travel limits) to the nearest step.
-fn to_steps(settings: &Settings, mm: [f32; 2]) -> Point {
-    Point::new(settings.mm_to_steps(Axis::X, mm[0]), settings.mm_to_steps(Axis::Y, mm[1]))
+impl GcodeState {
+    /// Builds `request` from the planned position and plans the pen at its end: `target_mm`
+    /// (the G-code target, kept in millimetres so relative moves never drift by rounding) when
+    /// the curve ends on the step it rounds to, else the curve's own last lattice point.
+    fn draw(
+        &mut self,
+        request: Request,
+        feed: Feed,
+        kind: JobKind,
+        target_mm: Option<[f32; 2]>,
+        settings: &Settings,
+    ) -> Result<Option<Command>, GrblError> {
+        let built = drawing::build(&request, self.position, settings)?;
+        let Some(drawing) = built else {
+            if let Some(target) = target_mm {
+                self.position_mm = target;
+            }
+            return Ok(None);
+        };
+        let end = drawing.end();
+        self.position_mm = match target_mm {
+            Some(target) if to_steps(settings, target) == Some(end) => target,
+            _ => [settings.steps_to_mm(Axis::X, end.x), settings.steps_to_mm(Axis::Y, end.y)],
+        };
+        self.position = end;
+        Ok(Some(Command::Job(Job { drawing, feed, kind, aborts_before: 0 })))
+    }
 }
 
 #[cfg(test)]

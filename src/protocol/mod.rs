@@ -43,7 +43,8 @@
 //! | 30 | `G53InvalidMotionMode`    | G53 while G2/G3/G80 is the motion mode |
 //! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode |
 //! | 32 | `NoAxisWordsInPlane`      | G2/G3 with only a Z word |
-//! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, a curve of less than one step radius, sweep above 360°, a sine steeper than the max function jump (`$204`) |
+//! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, sweep above 360° |
+//! | 33 | `Drawing`                 | the drawing cannot be drawn as asked: finer than the step lattice (an axis under a step, a sine of fewer than 8 steps per wave), a sine steeper than the max function jump (`$204`), a function undefined or jumping part way (an info line says which and where); as `Drawing(Travel)`: error 15 |
 //! | 33 | `FunctionUndefined`       | the `$F` function cannot be evaluated on its range (an info line gives x) |
 //! | 34 | `ArcRadius`               | R arc whose radius is shorter than half the chord |
 //! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |
@@ -107,6 +108,17 @@ pub enum GrblError {
         x_mm: f32,
         error: crate::expr::EvalError,
     },
+    /// The drawing builder refused the drawing.
+    Drawing(crate::drawing::DrawError),
+}
+
+impl From<crate::drawing::DrawError> for GrblError {
+    fn from(e: crate::drawing::DrawError) -> Self {
+        match e {
+            crate::drawing::DrawError::Travel => GrblError::TravelExceeded,
+            e => GrblError::Drawing(e),
+        }
+    }
 }
 
 impl GrblError {
@@ -136,6 +148,8 @@ impl GrblError {
             GrblError::AxisWordsExist => 31,
             GrblError::NoAxisWordsInPlane => 32,
             GrblError::InvalidTarget | GrblError::FunctionUndefined { .. } => 33,
+            GrblError::Drawing(crate::drawing::DrawError::Travel) => 15,
+            GrblError::Drawing(_) => 33,
             GrblError::ArcRadius => 34,
             GrblError::NoOffsetsInPlane => 35,
             GrblError::UnusedWords => 36,

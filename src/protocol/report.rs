@@ -12,7 +12,9 @@ use core::fmt::{self, Write};
 
 use super::GrblError;
 use super::gcode::{Distance, GcodeState, MotionMode, Spindle, Units};
+use crate::drawing::DrawError;
 use crate::geom::Axis;
+use crate::interp::CurveError;
 use crate::settings::{SETTING_INFO, Settings};
 use crate::status::{RunState, Status};
 
@@ -45,9 +47,32 @@ pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
             mm(out, x_mm)?;
             write!(out, ": {}]\r\n", error.message())?;
         }
+        GrblError::Drawing(e) => drawing_refused(out, e)?,
         _ => {}
     }
     write!(out, "error:{}\r\n", error.code())
+}
+
+/// Why the drawing builder refused a drawing, as an info line.
+fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
+    out.write_str("[MSG:")?;
+    match e {
+        DrawError::BadParameter => out.write_str("Curve parameter out of range")?,
+        DrawError::Travel => out.write_str("Curve leaves the travel")?,
+        DrawError::Setup(_) => out.write_str("Curve cannot start at the pen")?,
+        DrawError::TooSteep => out.write_str("Sine steeper than the max function jump ($204)")?,
+        DrawError::TooFine => out.write_str("Curve finer than the step lattice can draw")?,
+        DrawError::Fails { x_mm, error } => {
+            let why = match error {
+                CurveError::Jump => "jumps more than $204",
+                CurveError::Travel => "leaves the travel",
+                _ => "is undefined",
+            };
+            write!(out, "Function {why} after x=")?;
+            mm(out, x_mm)?;
+        }
+    }
+    out.write_str("]\r\n")
 }
 
 /// The banner after power-up and every soft reset.

@@ -11,7 +11,7 @@ use embassy_time::{Duration, Timer};
 
 use crate::geom::TICK_HZ;
 use crate::interp::Method;
-use crate::job::ShapeKind;
+use crate::interp::ShapeKind;
 use crate::machine::Machine;
 use crate::planner::Emitted;
 use crate::tasks::motion::WorkTime;

@@ -54,13 +54,11 @@ fn act(machine: &Machine, action: MenuAction) {
     match action {
         MenuAction::None => {}
         MenuAction::Start(job) => queue(machine, job),
-        MenuAction::StartCurve(curve) => match curve.to_job(&machine.settings()) {
-            Ok(job) => queue(machine, job),
-            Err(_) => refuse(machine, UiError::Domain),
-        },
         MenuAction::JogStart(direction) => {
-            let job = Job::jog(direction, machine.status().position, &machine.settings());
-            queue(machine, job);
+            // At the edge already, a jog outwards goes nowhere.
+            if let Some(job) = Job::jog(direction, machine.status().position, &machine.settings()) {
+                queue(machine, job);
+            }
         }
         MenuAction::JogStop => machine.request(Control::Abort),
         MenuAction::Control(control) => machine.request(control),

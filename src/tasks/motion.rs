@@ -1,8 +1,8 @@
 //! The motion task: turns jobs into curves, curves into timed step commands through the
 //! planner, and feeds them to the pulse engine through the step queue.
 //!
-//! It only moves values: which curve a job is, and how fast each step goes, are decided by the
-//! core (`interp::Curve::for_job`, `planner::Planner`). Each time it runs it takes controls and
+//! It only moves values: each job arrives with its curve built and checked (`drawing::build`),
+//! and how fast each step goes is decided by the core (`planner::Planner`). Each time it runs it takes controls and
 //! jobs, then fills the step queue in one tight loop — as many steps as fit, up to
 //! `STEP_QUEUE_MAX_US` of motion, so a hold acts within that time even at the slowest feed —
 //! publishes what it queued, and wakes the pulse engine. Then it waits for exactly one of three
@@ -75,19 +75,14 @@ impl WorkTime for RealTime {
 pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl FnMut(), mut work: impl WorkTime) -> ! {
     let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
     let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
-    // Where the pen will be once everything planned so far has been emitted.
-    let mut planned_end = queued.end;
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
+    // The travel guard stopped a curve: the machine goes into alarm once at rest.
+    let mut alarm = false;
     loop {
         if let Some(control) = machine.take_control() {
             apply(machine, &mut planner, control);
-        }
-        if planner.is_idle() {
-            // Nothing planned (after an abort, a curve error, or at rest): the next job starts
-            // where the pen stops, not where an abandoned plan would have ended.
-            planned_end = queued.end;
         }
         while !planner.is_full() {
             let Ok(job) = machine.jobs.try_receive() else { break };
@@ -101,9 +96,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
             }
-            if let Some(kind) = plan(machine, &mut planner, &mut planned_end, &job, &settings) {
-                moving = kind;
-            }
+            moving = plan(machine, &mut planner, job, &settings);
         }
         let steps_before = queued.steps;
         let filled = fill(machine, &mut planner, &mut steps, &mut queued, &mut work).await;
@@ -112,12 +105,14 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             machine.set_run_state(moving);
         }
         if let FillEnd::CurveFailed(e) = filled {
-            // The curve left its domain or the travel area part way: stop there and drop what
-            // was planned after it, since it was planned from a point the pen never reached.
+            // The travel guard stopped a curve at the edge: a defect upstream, since the builder
+            // refuses what leaves the travel. Stop there, drop what was planned after it (it
+            // was planned from a point the pen never reached) and raise an alarm once at rest.
             // The host is told (see the serial task).
-            warn!("curve ended early: {:?}", e);
+            error!("curve stopped at the travel limit: {:?}", e);
             machine.set_fault(Some(MotionFault::Curve(e)));
             abort(machine, &mut planner);
+            alarm = true;
         }
         if !matches!(filled, FillEnd::QueueFull) && planner.is_idle() && !queued.resting {
             // The motion comes to rest after the steps queued.
@@ -145,7 +140,12 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                         if machine.run_state() != RunState::Idle {
                             info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
                         }
-                        machine.set_run_state(RunState::Idle);
+                        if core::mem::take(&mut alarm) {
+                            // Cleared by `$X`.
+                            machine.set_run_state(RunState::Alarm);
+                        } else if machine.run_state() != RunState::Alarm {
+                            machine.set_run_state(RunState::Idle);
+                        }
                         wait_for_work(machine, &planner).await;
                     }
                     PlannerState::Held => {
@@ -195,35 +195,19 @@ async fn fill(
     }
 }
 
-/// Turns `job` into a curve from `planned_end` and queues it in the planner; the kind of
-/// motion it is when it was planned.
-fn plan(
-    machine: &Machine,
-    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
-    planned_end: &mut Point,
-    job: &Job,
-    settings: &Settings,
-) -> Option<RunState> {
-    match Curve::for_job(job, *planned_end, settings) {
-        Ok(curve) => {
-            *planned_end = curve.end();
-            info!("job planned to ({}, {}) steps", planned_end.x, planned_end.y);
-            machine.set_drawing(job.shape.kind());
-            machine.set_fault(None);
-            if planner.push(curve, job.feed, settings.method).is_err() {
-                // is_full() was false just now and nothing else pushes.
-                error!("planner refused a segment it had room for");
-            }
-            Some(match job.kind {
-                JobKind::Draw => RunState::Run,
-                JobKind::Jog => RunState::Jog,
-            })
-        }
-        Err(e) => {
-            warn!("job refused: {:?}", e);
-            machine.set_fault(Some(MotionFault::Setup(e)));
-            None
-        }
+/// Queues the curve of `job` in the planner; the kind of motion it is.
+fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: Job, settings: &Settings) -> RunState {
+    let end = job.drawing.end();
+    info!("job planned to ({}, {}) steps", end.x, end.y);
+    machine.set_drawing(job.drawing.kind());
+    machine.set_fault(None);
+    if planner.push(job.drawing.into_curve(), job.feed, settings.method).is_err() {
+        // is_full() was false just now and nothing else pushes.
+        error!("planner refused a segment it had room for");
+    }
+    match job.kind {
+        JobKind::Draw => RunState::Run,
+        JobKind::Jog => RunState::Jog,
     }
 }
 

@@ -272,8 +272,7 @@ async fn carry_out<W: Write>(
 ) -> Result<(), Stop> {
     let machine = link.machine;
     match command {
-        Command::Job(job) | Command::Jog(job) => queue(link, job, planned_after).await?,
-        Command::Curve { shape, feed, .. } => queue(link, Job::draw(shape, feed), planned_after).await?,
+        Command::Job(job) => queue(link, job, planned_after).await?,
         Command::Dwell { ms } => {
             link.unless_reset(async {
                 link.machine_at_rest().await;
@@ -346,7 +345,6 @@ async fn faults<W: Write>(link: &Link<'_, W>) -> ! {
         let fault = link.machine.faults.wait().await;
         let mut text: String<REPORT_LINE_MAX_BYTES> = String::new();
         let _ = match fault {
-            MotionFault::Setup(e) => write!(text, "Curve refused: {:?}", e),
             MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}; queued moves dropped", e),
         };
         link.send(|a| report::message(a, &text)).await;

@@ -18,19 +18,19 @@
 //! - Jog: hold `1`-`4`, `6`-`9` to move (see [`JOG_KEYS`]); releasing the key stops.
 //!
 //! Every keypad drawing starts at the pen and is typed relative to it: a line is typed as its
-//! offset (dX, dY) from the pen; curves are placed as described in [`crate::ui::curves`]. So
+//! offset (dX, dY) from the pen; curves are placed as described in [`crate::drawing`]. So
 //! that "the pen" is where the job will really start, the menu starts a job only while the
 //! machine is idle with nothing queued.
 //!
 //! The forms of the drawing modes (their fields, the ranges and checks of what is typed, and
 //! the job built from it) are [`Form`] and [`Field`]; this module routes the keys to them.
 
+use crate::drawing::DrawError;
 use crate::geom::Step;
 use crate::job::{Control, Job};
 use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::ui::curves::CurveJob;
 use crate::ui::entry::EntryError;
 
 mod form;
@@ -65,7 +65,7 @@ pub fn jog_step(key: Key) -> Option<Step> {
 }
 
 /// What the menu asks the machine to do.
-// A started job carries its shape by value (no heap).
+// A started job carries its curve by value (no heap).
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -73,8 +73,6 @@ pub enum MenuAction {
     None,
     /// Queue a job.
     Start(Job),
-    /// Queue a curve, starting at the pen (circle, ellipse, sine, function).
-    StartCurve(CurveJob),
     /// Hold, resume or abort the motion in progress.
     Control(Control),
     /// Start jogging in one of the 8 step directions until [`MenuAction::JogStop`].
@@ -160,12 +158,9 @@ pub enum UiError {
     Zero,
     /// A function's x1 equals its x0.
     SameEnds,
-    /// The function is undefined somewhere between x0 and x1.
-    Domain,
-    /// A sine rises faster between two steps than the max function jump (`$204`) allows.
-    TooSteep,
-    /// The drawing would leave the travel area ($130, $131).
-    Travel,
+    /// The drawing builder refused the drawing (beyond the travel, too steep, too fine, a
+    /// function undefined part way...).
+    Drawing(DrawError),
     /// The machine is moving or has jobs queued.
     Busy,
     /// An alarm locks motion.
@@ -265,7 +260,7 @@ impl Menu {
                 _ => MenuAction::None,
             },
         };
-        if action != MenuAction::None {
+        if !matches!(action, MenuAction::None) {
             debug!("menu: {:?}", action);
         }
         action

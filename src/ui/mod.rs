@@ -1,14 +1,14 @@
 //! The machine's own user interface: the keypad menu and the LCD screen.
 //!
 //! [`menu`] turns key events (from [`crate::keypad`]) into jobs, controls and jogs; [`entry`]
-//! holds the number being typed; [`curves`] describes the curves the keypad draws; [`screen`]
+//! holds the number being typed; [`presets`] names the functions the keypad offers; [`screen`]
 //! draws it all on the 122x32 LCD. Everything here is pure: no clock, no pins, no waiting.
 
-pub mod curves;
 pub mod entry;
 pub mod menu;
+pub mod presets;
 pub mod screen;
 
-pub use curves::{CircleParams, CurveJob, CurveParams, EllipseParams, FunctionParams, FunctionPreset, SineParams};
 pub use menu::{Menu, MenuAction};
+pub use presets::FunctionPreset;
 pub use screen::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX, ScreenView};

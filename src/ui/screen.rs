@@ -28,8 +28,9 @@ use embedded_graphics::primitives::Rectangle;
 use embedded_graphics::text::{Baseline, Text};
 use heapless::String;
 
+use crate::drawing::DrawError;
 use crate::geom::{Axis, Step};
-use crate::interp::{CurveError, CurveSetupError, Method};
+use crate::interp::{CurveError, Method};
 use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::settings::Settings;
 use crate::status::{MotionFault, RunState, Status};
@@ -290,9 +291,13 @@ impl fmt::Display for ErrorText {
             UiError::OutOfRange { min, max, unit } => write!(f, "Range {}..{} {}", Num(min), Num(max), unit.symbol()),
             UiError::Zero => f.write_str("Must not be 0"),
             UiError::SameEnds => f.write_str("x1 must differ from x0"),
-            UiError::Domain => f.write_str("f(x) undefined there"),
-            UiError::TooSteep => f.write_str("too steep: A or 1/P"),
-            UiError::Travel => f.write_str("Beyond travel limits"),
+            UiError::Drawing(DrawError::Travel) => f.write_str("Beyond travel limits"),
+            UiError::Drawing(DrawError::TooSteep) => f.write_str("too steep: A or 1/P"),
+            UiError::Drawing(DrawError::TooFine) => f.write_str("Finer than a step"),
+            UiError::Drawing(DrawError::BadParameter) => f.write_str("Bad parameter"),
+            UiError::Drawing(DrawError::Setup(_)) => f.write_str("Cannot start here"),
+            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => f.write_str("f(x) jumps too far"),
+            UiError::Drawing(DrawError::Fails { .. }) => f.write_str("f(x) undefined there"),
             UiError::Busy => f.write_str("Busy: wait, or D abort"),
             UiError::Alarm => f.write_str("Alarm: motion locked"),
         }
@@ -305,9 +310,6 @@ struct FaultText(MotionFault);
 impl fmt::Display for FaultText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let why = match self.0 {
-            MotionFault::Setup(CurveSetupError::Start(_)) => "undefined at start",
-            MotionFault::Setup(CurveSetupError::OutOfRange) => "too large",
-            MotionFault::Setup(CurveSetupError::BadParameter) => "bad parameter",
             MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
             MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
             MotionFault::Curve(CurveError::Overflow) => "value too large",

@@ -1,17 +1,16 @@
 //! G-code blocks carried out on the parser state: modal groups, G92 offsets, and the straight
 //! moves and G2/G3 arcs a block hands out, each checked against the travel and its interpolator.
 
-use core::f32::consts::{FRAC_PI_2, PI, TAU};
+use core::f32::consts::TAU;
 
 use super::words::{Block, NonModal, Stop};
 use super::{
-    ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM,
-    CURVE_RADIUS_MAX_MM, Command, Commands, DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
-    check_travel, to_steps,
+    ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM, Command, Commands,
+    DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle, to_steps,
 };
+use crate::drawing::{EllipseParams, Request};
 use crate::geom::Rotation;
-use crate::interp::{ArcInterp, EllipseInterp};
-use crate::job::{Feed, Job, Shape};
+use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
 use crate::settings::Settings;
 
@@ -169,12 +168,8 @@ impl GcodeState {
 
     /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
     fn line(&mut self, target_mm: [f32; 2], feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
-        check_travel(settings, target_mm)?;
-        let from = self.position;
-        let to = to_steps(settings, target_mm);
-        self.position_mm = target_mm;
-        self.position = to;
-        Ok((to != from).then_some(Command::Job(Job::draw(Shape::Line { to }, feed))))
+        let to = to_steps(settings, target_mm).ok_or(GrblError::TravelExceeded)?;
+        self.draw(Request::Line { to }, feed, JobKind::Draw, Some(target_mm), settings)
     }
 
     /// G2/G3 from the planned position to `end` (mm).
@@ -228,82 +223,8 @@ impl GcodeState {
             Rotation::CounterClockwise if sweep <= ARC_ANGLE_EPSILON_RAD => sweep += TAU,
             _ => {}
         }
-        let conic = Conic {
-            center,
-            semi_axes_mm: [radius, radius],
-            start_rad: crate::math::atan2(sy, sx),
-            sweep_rad: sweep,
-            end,
-        };
-        self.conic(conic, Feed::MmPerMin(feed_mm_per_min), settings)
-    }
-
-    /// An arc of a circle or an axis-aligned ellipse from the planned position to `c.end`.
-    pub(super) fn conic(&mut self, c: Conic, feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
-        if !(c.start_rad.is_finite() && c.sweep_rad.is_finite()) {
-            return Err(GrblError::InvalidTarget);
-        }
-        for r in c.semi_axes_mm {
-            if !(r <= CURVE_RADIUS_MAX_MM) {
-                return Err(GrblError::InvalidTarget);
-            }
-        }
-        check_travel(settings, c.end)?;
-        // The extremes of each axis lie at parametric angles k·90°: check those the sweep passes.
-        let (lo, hi) = if c.sweep_rad >= 0.0 {
-            (c.start_rad, c.start_rad + c.sweep_rad)
-        } else {
-            (c.start_rad + c.sweep_rad, c.start_rad)
-        };
-        let first = crate::math::ceil(lo / FRAC_PI_2) as i32;
-        let last = crate::math::floor(hi / FRAC_PI_2) as i32;
-        // A sweep of at most a full turn passes at most five such angles.
-        for k in first..=last.min(first.saturating_add(4)) {
-            let (cos, sin) = match k.rem_euclid(4) {
-                0 => (1.0, 0.0),
-                1 => (0.0, 1.0),
-                2 => (-1.0, 0.0),
-                _ => (0.0, -1.0),
-            };
-            let p = [c.center[0] + c.semi_axes_mm[0] * cos, c.center[1] + c.semi_axes_mm[1] * sin];
-            check_travel(settings, p)?;
-        }
-
-        let from = self.position;
-        let to = to_steps(settings, c.end);
-        if to == from && c.sweep_rad.abs() < PI {
-            // Shorter than one step: nothing to draw.
-            self.position_mm = c.end;
-            return Ok(None);
-        }
-        let spm = settings.steps_per_mm;
-        let semi = [crate::math::round(c.semi_axes_mm[0] * spm[0]), crate::math::round(c.semi_axes_mm[1] * spm[1])];
-        if !(semi[0] >= 1.0 && semi[1] >= 1.0) {
-            return Err(GrblError::InvalidTarget);
-        }
-        let center = to_steps(settings, c.center);
-        let rotation = if c.sweep_rad > 0.0 { Rotation::CounterClockwise } else { Rotation::Clockwise };
-        let shape = if c.semi_axes_mm[0] == c.semi_axes_mm[1] && spm[0] == spm[1] {
-            Shape::Arc { center, to, rotation }
-        } else {
-            Shape::Ellipse { center, a_steps: semi[0] as i32, b_steps: semi[1] as i32, to, rotation }
-        };
-        // Set up as the motion will set it up, from the same steps: a curve its interpolator
-        // would refuse (a tiny radius whose rounded centre falls on the start or the end) is
-        // refused here, before the planned position moves.
-        let accepted = match shape {
-            Shape::Arc { center, to, rotation } => ArcInterp::new(from, center, to, rotation, settings.method).is_ok(),
-            Shape::Ellipse { center, a_steps, b_steps, to, rotation } => {
-                EllipseInterp::new(from, center, a_steps, b_steps, to, rotation, settings.method).is_ok()
-            }
-            _ => true,
-        };
-        if !accepted {
-            return Err(GrblError::InvalidTarget);
-        }
-        self.position_mm = c.end;
-        self.position = to;
-        Ok(Some(Command::Curve { shape, feed, end: to }))
+        let circle = EllipseParams::circle(radius, crate::math::atan2(sy, sx).to_degrees(), sweep.to_degrees());
+        self.draw(Request::Ellipse(circle), Feed::MmPerMin(feed_mm_per_min), JobKind::Draw, Some(end), settings)
     }
 }
 
@@ -317,13 +238,4 @@ enum AxisCommand {
 enum ArcForm {
     Radius(f32),
     Offsets([f32; 2]),
-}
-
-/// An elliptic (or circular) arc in machine millimetres.
-pub(super) struct Conic {
-    pub(super) center: [f32; 2],
-    pub(super) semi_axes_mm: [f32; 2],
-    pub(super) start_rad: f32,
-    pub(super) sweep_rad: f32,
-    pub(super) end: [f32; 2],
 }

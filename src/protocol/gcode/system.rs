@@ -2,8 +2,9 @@
 //! commands are handed on to [`super::curves`].
 
 use super::words::{Group, NonModal, compact, parse_block, parse_number};
-use super::{Command, Commands, Distance, GcodeState, Report, check_travel, to_steps};
-use crate::job::{Feed, Job};
+use super::{Command, Commands, Distance, GcodeState, Report, to_steps};
+use crate::drawing::Request;
+use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
@@ -145,14 +146,8 @@ impl GcodeState {
                 };
             }
         }
-        check_travel(settings, target)?;
-        let from = self.position;
-        let to = to_steps(settings, target);
-        self.position_mm = target;
-        self.position = to;
-        if to == from {
-            return Ok(Commands::default());
-        }
-        Ok(Commands::one(Command::Jog(Job::jog_to(to, Feed::MmPerMin(feed)))))
+        let to = to_steps(settings, target).ok_or(GrblError::TravelExceeded)?;
+        let jog = self.draw(Request::Line { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
+        Ok(jog.map(Commands::one).unwrap_or_default())
     }
 }

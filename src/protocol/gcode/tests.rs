@@ -5,6 +5,7 @@ extern crate std;
 
 use super::*;
 use crate::geom::Rotation;
+use crate::interp::Shape;
 use std::vec::Vec;
 
 /// Default settings: 100 steps/mm on both axes, ±200 mm travel, default feed 3000 mm/min.
@@ -43,17 +44,17 @@ fn refused(g: &mut GcodeState, line: &str, code: u8) {
     refused_in(g, line, RunState::Idle, code);
 }
 
-fn line(x: i32, y: i32, feed: Feed) -> Command {
-    Command::Job(Job::draw(Shape::Line { to: Point::new(x, y) }, feed))
+/// A straight job from `from` to (`x`, `y`) steps.
+fn line_from(from: Point, x: i32, y: i32, feed: Feed, kind: JobKind) -> Command {
+    let drawing = crate::drawing::build(&Request::Line { to: Point::new(x, y) }, from, &settings());
+    Command::Job(Job { drawing: drawing.unwrap().unwrap(), feed, kind, aborts_before: 0 })
 }
 
-/// Where a straight job ends (the parser hands out no other shape in a `Job`).
-#[allow(unreachable_patterns)]
-fn line_end(job: &Job) -> Option<Point> {
-    match job.shape {
-        Shape::Line { to } => Some(to),
-        _ => None,
-    }
+/// Runs `l` and asserts that it hands out exactly one straight job, from where the parser
+/// planned the pen, to (`x`, `y`) steps at `feed`.
+fn assert_line(g: &mut GcodeState, l: &str, x: i32, y: i32, feed: Feed) {
+    let from = g.planned_position();
+    assert_eq!(run(g, l), Ok(std::vec![line_from(from, x, y, feed, JobKind::Draw)]), "{l:?}");
 }
 
 fn feed(f: f32) -> Feed {
@@ -64,7 +65,7 @@ fn feed(f: f32) -> Feed {
 fn curve(g: &mut GcodeState, l: &str) -> (Shape, Feed, Point) {
     match run(g, l) {
         Ok(mut c) if c.len() == 1 => match c.remove(0) {
-            Command::Curve { shape, feed, end } => (shape, feed, end),
+            Command::Job(job) => (job.drawing.shape().clone(), job.feed, job.drawing.end()),
             other => panic!("{l:?} gave {other:?}"),
         },
         other => panic!("{l:?} gave {other:?}"),
@@ -76,9 +77,9 @@ fn curve(g: &mut GcodeState, l: &str) -> (Shape, Feed, Point) {
 #[test]
 fn words_ignore_case_spaces_comments_and_line_numbers() {
     let mut g = GcodeState::new();
-    assert_eq!(run(&mut g, "n10 g1x10 y-1.5 (pen down) f600 ; go"), Ok(std::vec![line(1000, -150, feed(600.0))]));
-    assert_eq!(run(&mut g, "G 0 X 1 0 Y.5"), Ok(std::vec![line(1000, 50, Feed::Rapid)]));
-    assert_eq!(run(&mut g, "G0X+2(unclosed comment runs to the end Y9"), Ok(std::vec![line(200, 50, Feed::Rapid)]));
+    assert_line(&mut g, "n10 g1x10 y-1.5 (pen down) f600 ; go", 1000, -150, feed(600.0));
+    assert_line(&mut g, "G 0 X 1 0 Y.5", 1000, 50, Feed::Rapid);
+    assert_line(&mut g, "G0X+2(unclosed comment runs to the end Y9", 200, 50, Feed::Rapid);
     assert_eq!(g.planned_position(), Point::new(200, 50));
 }
 
@@ -161,11 +162,11 @@ fn modal_group_and_command_rules() {
 fn motion_mode_and_feed_are_modal() {
     let mut g = GcodeState::new();
     // No F yet: the default feed rate ($203) applies.
-    assert_eq!(run(&mut g, "G1 X10"), Ok(std::vec![line(1000, 0, feed(3000.0))]));
-    assert_eq!(run(&mut g, "Y5 F600"), Ok(std::vec![line(1000, 500, feed(600.0))]));
-    assert_eq!(run(&mut g, "X0"), Ok(std::vec![line(0, 500, feed(600.0))]));
-    assert_eq!(run(&mut g, "G0 Y0"), Ok(std::vec![line(0, 0, Feed::Rapid)]));
-    assert_eq!(run(&mut g, "X3"), Ok(std::vec![line(300, 0, Feed::Rapid)]));
+    assert_line(&mut g, "G1 X10", 1000, 0, feed(3000.0));
+    assert_line(&mut g, "Y5 F600", 1000, 500, feed(600.0));
+    assert_line(&mut g, "X0", 0, 500, feed(600.0));
+    assert_line(&mut g, "G0 Y0", 0, 0, Feed::Rapid);
+    assert_line(&mut g, "X3", 300, 0, Feed::Rapid);
     // G1 alone only selects the mode.
     assert_eq!(run(&mut g, "G1"), Ok(Vec::new()));
     assert_eq!(g.motion_mode(), MotionMode::Linear);
@@ -181,8 +182,8 @@ fn an_explicit_zero_feed_is_undefined() {
     ok_all(&mut g, &["G0 F0"]);
     refused(&mut g, "G1 X1", 22);
     refused(&mut g, "G2 X1 I1", 22);
-    assert_eq!(run(&mut g, "G0 X1"), Ok(std::vec![line(100, 0, Feed::Rapid)]));
-    assert_eq!(run(&mut g, "G1 X2 F100"), Ok(std::vec![line(200, 0, feed(100.0))]));
+    assert_line(&mut g, "G0 X1", 100, 0, Feed::Rapid);
+    assert_line(&mut g, "G1 X2 F100", 200, 0, feed(100.0));
 }
 
 #[test]
@@ -196,20 +197,20 @@ fn g91_moves_are_relative_and_do_not_drift() {
         handed_out.extend(run(&mut g, "G1 X0.004 F100").unwrap());
     }
     assert_eq!(g.planned_position(), Point::new(2004, 500));
-    assert_eq!(handed_out.last(), Some(&line(2004, 500, feed(100.0))));
+    assert_eq!(handed_out.last(), Some(&line_from(Point::new(2003, 500), 2004, 500, feed(100.0), JobKind::Draw)));
     assert_eq!(handed_out.len(), 4, "one job per step reached");
 }
 
 #[test]
 fn g20_converts_inches_for_axes_offsets_and_feed() {
     let mut g = GcodeState::new();
-    assert_eq!(run(&mut g, "G20 G1 X1 Y-0.5 F10"), Ok(std::vec![line(2540, -1270, feed(254.0))]));
+    assert_line(&mut g, "G20 G1 X1 Y-0.5 F10", 2540, -1270, feed(254.0));
     assert_eq!(g.units(), Units::Inch);
     let (shape, _, end) = curve(&mut g, "G2 X1.5 Y-0.5 I0.25");
     assert_eq!(shape, Shape::Arc { center: Point::new(3175, -1270), to: end, rotation: Rotation::Clockwise });
     assert_eq!(end, Point::new(3810, -1270));
     // Back to millimetres: the planned position is where the inches left it.
-    assert_eq!(run(&mut g, "G21 G91 G0 X1"), Ok(std::vec![line(3910, -1270, Feed::Rapid)]));
+    assert_line(&mut g, "G21 G91 G0 X1", 3910, -1270, Feed::Rapid);
 }
 
 #[test]
@@ -218,7 +219,7 @@ fn z_words_are_accepted_and_move_nothing() {
     assert_eq!(run(&mut g, "G0 Z5"), Ok(Vec::new()));
     assert_eq!(run(&mut g, "G1 Z-1 F300"), Ok(Vec::new()));
     assert_eq!(g.feed_mm_per_min(&settings()), 300.0);
-    assert_eq!(run(&mut g, "G1 X10 Z-1"), Ok(std::vec![line(1000, 0, feed(300.0))]));
+    assert_line(&mut g, "G1 X10 Z-1", 1000, 0, feed(300.0));
     assert_eq!(run(&mut g, "G92 Z0"), Ok(Vec::new()));
     assert_eq!(g.work_offset_mm(), [0.0, 0.0]);
     refused(&mut g, "G2 Z1 I1", 32);
@@ -228,7 +229,7 @@ fn z_words_are_accepted_and_move_nothing() {
 #[test]
 fn travel_limits_refuse_targets_and_change_nothing() {
     let mut g = GcodeState::new();
-    assert_eq!(run(&mut g, "G0 X200 Y-200"), Ok(std::vec![line(20_000, -20_000, Feed::Rapid)]));
+    assert_line(&mut g, "G0 X200 Y-200", 20_000, -20_000, Feed::Rapid);
     refused(&mut g, "G0 X200.1", 15);
     refused(&mut g, "G1 Y-250", 15);
     refused(&mut g, "G91 G0 X0.01", 15);
@@ -319,10 +320,13 @@ fn circles_become_ellipses_in_steps_when_the_axes_differ() {
         to: Point::new(2000, 0),
         rotation: Rotation::Clockwise,
     };
-    assert_eq!(
-        cmds.collect::<Vec<_>>(),
-        std::vec![Command::Curve { shape: expected, feed: feed(500.0), end: Point::new(2000, 0) }]
-    );
+    match cmds.collect::<Vec<_>>().as_slice() {
+        [Command::Job(job)] => {
+            assert_eq!(job.drawing.shape(), &expected);
+            assert_eq!((job.feed, job.drawing.end()), (feed(500.0), Point::new(2000, 0)));
+        }
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
@@ -331,14 +335,14 @@ fn g92_offsets_the_work_coordinates_and_g53_bypasses_them() {
     ok_all(&mut g, &["G0 X10 Y-5", "G92 X0 Y0"]);
     assert_eq!(g.work_offset_mm(), [10.0, -5.0]);
     assert_eq!(g.planned_position(), Point::new(1000, -500));
-    assert_eq!(run(&mut g, "G0 X1"), Ok(std::vec![line(1100, -500, Feed::Rapid)]));
-    assert_eq!(run(&mut g, "G53 G0 X0 Y0"), Ok(std::vec![line(0, 0, Feed::Rapid)]));
+    assert_line(&mut g, "G0 X1", 1100, -500, Feed::Rapid);
+    assert_line(&mut g, "G53 G0 X0 Y0", 0, 0, Feed::Rapid);
     // G53 lasts one line.
-    assert_eq!(run(&mut g, "X0"), Ok(std::vec![line(1000, 0, Feed::Rapid)]));
+    assert_line(&mut g, "X0", 1000, 0, Feed::Rapid);
     // The travel limits are the machine's, not the work coordinates'.
     refused(&mut g, "G0 X195", 15);
     assert_eq!(run(&mut g, "G92.1"), Ok(Vec::new()));
-    assert_eq!(run(&mut g, "G0 X195"), Ok(std::vec![line(19_500, 0, Feed::Rapid)]));
+    assert_line(&mut g, "G0 X195", 19_500, 0, Feed::Rapid);
 }
 
 #[test]
@@ -347,7 +351,11 @@ fn dwell_motion_and_stop_of_one_line_come_out_in_order() {
     ok_all(&mut g, &["G91"]);
     assert_eq!(
         run(&mut g, "G4 P0.25 G1 X10 F300 M2"),
-        Ok(std::vec![Command::Dwell { ms: 250 }, line(1000, 0, feed(300.0)), Command::ProgramEnd])
+        Ok(std::vec![
+            Command::Dwell { ms: 250 },
+            line_from(Point::ORIGIN, 1000, 0, feed(300.0), JobKind::Draw),
+            Command::ProgramEnd
+        ])
     );
     // Program end restores G90 and G1 (GRBL's rule) but keeps F.
     assert_eq!(g.distance(), Distance::Absolute);
@@ -376,7 +384,11 @@ fn alarm_and_jog_lock_out_gcode_but_not_system_commands() {
     assert_eq!(run_in(&mut g, "$$", RunState::Alarm), Ok(std::vec![Command::Report(Report::Settings)]));
     assert_eq!(run_in(&mut g, "$100=80", RunState::Alarm), Ok(std::vec![Command::SetSetting { id: 100, value: 80.0 }]));
     // Streaming continues while a job runs or is held.
-    assert_eq!(run_in(&mut g, "G0 X1", RunState::Hold), Ok(std::vec![line(100, 0, Feed::Rapid)]));
+    let from = g.planned_position();
+    assert_eq!(
+        run_in(&mut g, "G0 X1", RunState::Hold),
+        Ok(std::vec![line_from(from, 100, 0, Feed::Rapid, JobKind::Draw)])
+    );
 }
 
 // ----- $ commands --------------------------------------------------------------------------
@@ -425,7 +437,9 @@ fn changing_steps_per_mm_keeps_the_pen_on_its_step() {
     assert_eq!(g.planned_position(), Point::new(1000, 0));
     assert_eq!(g.planned_position_mm(), [12.5, 0.0]);
     let cmds = g.execute("G91 G0 X1", &s, RunState::Idle).unwrap();
-    assert_eq!(cmds.collect::<Vec<_>>(), std::vec![line(1080, 0, Feed::Rapid)]);
+    let from = Point::new(1000, 0);
+    let drawing = crate::drawing::build(&Request::Line { to: Point::new(1080, 0) }, from, &s).unwrap().unwrap();
+    assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::Job(Job::draw(drawing, Feed::Rapid))]);
 }
 
 #[test]
@@ -446,11 +460,11 @@ fn restoring_defaults() {
 #[test]
 fn jogs_follow_grbls_rules_and_leave_the_modes_alone() {
     let mut g = GcodeState::new();
-    let jog = |x, y, f| Command::Jog(Job::jog_to(Point::new(x, y), feed(f)));
-    assert_eq!(run(&mut g, "$J=G91 X1 F600"), Ok(std::vec![jog(100, 0, 600.0)]));
-    assert_eq!(run_in(&mut g, "$J=G91 Y-2 F600", RunState::Jog), Ok(std::vec![jog(100, -200, 600.0)]));
-    assert_eq!(run(&mut g, "$J=X5 Y5 F100"), Ok(std::vec![jog(500, 500, 100.0)]));
-    assert_eq!(run(&mut g, "$J=G20 G91 X1 F10"), Ok(std::vec![jog(3040, 500, 254.0)]));
+    let jog = |from: (i32, i32), x, y, f| line_from(Point::new(from.0, from.1), x, y, feed(f), JobKind::Jog);
+    assert_eq!(run(&mut g, "$J=G91 X1 F600"), Ok(std::vec![jog((0, 0), 100, 0, 600.0)]));
+    assert_eq!(run_in(&mut g, "$J=G91 Y-2 F600", RunState::Jog), Ok(std::vec![jog((100, 0), 100, -200, 600.0)]));
+    assert_eq!(run(&mut g, "$J=X5 Y5 F100"), Ok(std::vec![jog((100, -200), 500, 500, 100.0)]));
+    assert_eq!(run(&mut g, "$J=G20 G91 X1 F10"), Ok(std::vec![jog((500, 500), 3040, 500, 254.0)]));
     assert_eq!((g.distance(), g.units()), (Distance::Absolute, Units::Mm));
     assert_eq!(g.feed_mm_per_min(&settings()), 3000.0, "a jog's F is not modal");
     assert_eq!(run(&mut g, "$J=G91 Z1 F100"), Ok(Vec::new()));
@@ -463,7 +477,7 @@ fn jogs_follow_grbls_rules_and_leave_the_modes_alone() {
     refused(&mut g, "$J=F100", 26);
     refused(&mut g, "$J=G91 X300 F100", 15);
     ok_all(&mut g, &["G92 X0"]);
-    assert_eq!(run(&mut g, "$J=G53 X5 F100"), Ok(std::vec![jog(500, 500, 100.0)]));
+    assert_eq!(run(&mut g, "$J=G53 X5 F100"), Ok(std::vec![jog((3040, 500), 500, 500, 100.0)]));
 }
 
 // ----- plotter curves ----------------------------------------------------------------------
@@ -583,7 +597,10 @@ fn a_sine_steeper_than_the_jump_limit_is_refused() {
     assert!(g.execute("$S A100 W5.1 L10", &s, RunState::Idle).is_ok());
     s.max_jump_mm = 1.0;
     let before = g.clone();
-    assert_eq!(g.execute("$S A10 W11 L10", &s, RunState::Idle).map(|_| ()), Err(GrblError::InvalidTarget));
+    assert_eq!(
+        g.execute("$S A10 W11 L10", &s, RunState::Idle).map(|_| ()),
+        Err(GrblError::Drawing(crate::drawing::DrawError::TooSteep))
+    );
     assert_eq!(g, before);
     // Nothing to draw, nothing to refuse.
     assert_eq!(run(&mut GcodeState::new(), "$S A200 W1000 L0.001"), Ok(Vec::new()));
@@ -604,11 +621,14 @@ fn arcs_too_small_for_their_interpolator_are_refused() {
     assert_eq!(end, Point::new(2, 0));
     let (_, _, end) = curve(&mut g, "$O R0.01");
     assert_eq!(end, Point::new(2, 0));
-    // An I/J end within GRBL's radius tolerance (0.1 % of r) but farther from the circle, in
-    // steps, than the interpolator follows: 0.08 mm off at r = 90 mm is 8 steps.
+    // An I/J end within GRBL's radius tolerance (0.1 % of r) but off the circle: 0.08 mm at
+    // r = 90 mm. GRBL accepts it; the arc is drawn on its circle and the pen ends there, where
+    // the parser then plans it.
     ok_all(&mut g, &["G0 X0 Y0"]);
-    refused(&mut g, "G91 G2 X180.08 Y0 I90", 33);
-    assert!(run(&mut g, "G91 G2 X180.01 Y0 I90").is_ok());
+    let (_, _, end) = curve(&mut g, "G91 G2 X180.08 Y0 I90");
+    assert_eq!(end, Point::new(18_000, 0));
+    assert_eq!(g.planned_position(), end);
+    refused(&mut g, "G91 G2 X181 Y0 I90", 33);
 }
 
 #[test]
@@ -681,7 +701,7 @@ fn sync_and_reset_take_the_machines_position() {
     assert_eq!(g.planned_position(), Point::new(1234, -5));
     assert_eq!(
         g.execute("X1", &s, RunState::Idle).unwrap().collect::<Vec<_>>(),
-        std::vec![line(1334, -5, feed(100.0))]
+        std::vec![line_from(Point::new(1234, -5), 1334, -5, feed(100.0), JobKind::Draw)]
     );
     g.reset(Point::new(7, 8), &s);
     assert_eq!(g.planned_position(), Point::new(7, 8));
@@ -709,8 +729,7 @@ fn no_line_panics_and_a_refused_line_changes_nothing() {
                 let limit = 20_000;
                 for c in cmds {
                     let to = match &c {
-                        Command::Job(j) | Command::Jog(j) => line_end(j),
-                        Command::Curve { end, .. } => Some(*end),
+                        Command::Job(j) => Some(j.drawing.end()),
                         _ => None,
                     };
                     if let Some(to) = to {
@@ -749,16 +768,17 @@ fn random_gcode_blocks_keep_the_plan_consistent() {
                     accepted.set(accepted.get() + 1);
                     for c in cmds {
                         let end = match &c {
-                            Command::Job(j) => line_end(j),
-                            Command::Curve { end, .. } => Some(*end),
+                            Command::Job(j) => Some(j.drawing.end()),
                             _ => None,
                         };
                         if let Some(end) = end {
                             prop_assert!(end.x.abs() <= 20_000 && end.y.abs() <= 20_000, "{} -> {:?}", text, end);
                             prop_assert_eq!(end, g.planned_position(), "{}", text);
                         }
-                        if let Command::Curve { shape: Shape::Arc { to, .. }, end, .. } = &c {
-                            prop_assert_eq!(to, end);
+                        if let Command::Job(j) = &c
+                            && let Shape::Arc { to, .. } = j.drawing.shape()
+                        {
+                            prop_assert_eq!(*to, j.drawing.end());
                         }
                     }
                 }

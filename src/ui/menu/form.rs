@@ -4,16 +4,17 @@
 
 use core::ops::RangeInclusive;
 
+use core::f32::consts::TAU;
+
 use super::{MenuAction, Mode, UiError};
+use crate::drawing::{self, EllipseParams, Request, SineParams};
 use crate::geom::{Axis, Point};
-use crate::job::{Feed, Job, Shape};
+use crate::job::{Feed, Job};
 use crate::keypad::Key;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::ui::curves::{
-    CircleParams, CurveJob, CurveParams, EllipseParams, Extent, FunctionParams, FunctionPreset, SineParams,
-};
 use crate::ui::entry::NumberEntry;
+use crate::ui::presets::FunctionPreset;
 
 /// Line: offset of the end point from the pen, per axis.
 pub const LINE_DELTA_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
@@ -237,23 +238,28 @@ impl Form {
         Ok(if sweep == 0.0 { 360.0 } else { sweep })
     }
 
-    /// The typed curve (every mode but line).
-    pub fn curve(&self) -> Result<CurveParams, UiError> {
+    /// The typed drawing, from the pen at `start`.
+    pub fn request(&self, start: Point, settings: &Settings) -> Result<Request, UiError> {
         Ok(match self.mode {
-            Mode::Circle => CurveParams::Circle(CircleParams {
-                radius_mm: self.number(0)?,
-                start_deg: self.number(1)?,
-                sweep_deg: self.sweep(2)?,
-            }),
-            Mode::Ellipse => CurveParams::Ellipse(EllipseParams {
+            Mode::Line => {
+                let (dx, dy) = (self.number(0)?, self.number(1)?);
+                Request::Line {
+                    to: Point::new(
+                        start.x.saturating_add(settings.mm_to_steps(Axis::X, dx)),
+                        start.y.saturating_add(settings.mm_to_steps(Axis::Y, dy)),
+                    ),
+                }
+            }
+            Mode::Circle => Request::Ellipse(EllipseParams::circle(self.number(0)?, self.number(1)?, self.sweep(2)?)),
+            Mode::Ellipse => Request::Ellipse(EllipseParams {
                 a_mm: self.number(0)?,
                 b_mm: self.number(1)?,
                 start_deg: self.number(2)?,
                 sweep_deg: self.sweep(3)?,
             }),
-            Mode::Sine => CurveParams::Sine(SineParams {
+            Mode::Sine => Request::Sine(SineParams {
                 amplitude_mm: self.number(0)?,
-                period_mm: self.number(1)?,
+                omega_rad_per_mm: TAU / self.number(1)?,
                 phase_deg: self.number(2)?,
                 length_mm: self.number(3)?,
             }),
@@ -262,66 +268,26 @@ impl Form {
                 if x0_mm == x1_mm {
                     return Err(UiError::SameEnds);
                 }
-                CurveParams::Function(FunctionParams { preset: self.preset, x0_mm, x1_mm })
+                // The presets are written in the expression language and parse (a unit test
+                // checks every one).
+                let expr = crate::expr::parse(self.preset.expression()).map_err(|_| UiError::Empty)?;
+                Request::Function { expr, x0_mm, x1_mm }
             }
-            Mode::Jog | Mode::Line | Mode::Settings => return Err(UiError::Empty),
+            Mode::Jog | Mode::Settings => return Err(UiError::Empty),
         })
     }
 
     /// The job the form describes, from the pen at `status.position`.
     fn build(&self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
         let feed = Feed::MmPerMin(settings.default_feed_mm_per_min);
-        let start = status.position;
-        let action = if self.mode == Mode::Line {
-            let to = offset(start, self.number(0)?, self.number(1)?, settings);
-            if !within_travel(to, settings) {
-                return Err(UiError::Travel);
-            }
-            MenuAction::Start(Job::draw(Shape::Line { to }, feed))
-        } else {
-            let curve = self.curve()?;
-            let extent = curve.extent().ok_or(UiError::Domain)?;
-            if !extent_within_travel(start, &extent, settings) {
-                return Err(UiError::Travel);
-            }
-            let job = CurveJob { start, curve, feed };
-            if let Ok(Job { shape: Shape::Sine { amplitude_steps, omega_rad_per_step, .. }, .. }) = job.to_job(settings)
-                && !crate::interp::sine::fits_jump_limit(amplitude_steps, omega_rad_per_step, settings)
-            {
-                return Err(UiError::TooSteep);
-            }
-            MenuAction::StartCurve(job)
-        };
+        let request = self.request(status.position, settings)?;
+        let drawing = drawing::build(&request, status.position, settings).map_err(UiError::Drawing)?;
+        // Shorter than a step: nothing to draw.
+        let drawing = drawing.ok_or(UiError::Zero)?;
         match status.state {
             RunState::Alarm => Err(UiError::Alarm),
-            RunState::Idle if status.queued_jobs == 0 => Ok(action),
+            RunState::Idle if status.queued_jobs == 0 => Ok(MenuAction::Start(Job::draw(drawing, feed))),
             _ => Err(UiError::Busy),
         }
     }
-}
-
-/// `start` moved by (`dx_mm`, `dy_mm`), in steps.
-fn offset(start: Point, dx_mm: f32, dy_mm: f32, settings: &Settings) -> Point {
-    Point::new(
-        start.x.saturating_add(settings.mm_to_steps(Axis::X, dx_mm)),
-        start.y.saturating_add(settings.mm_to_steps(Axis::Y, dy_mm)),
-    )
-}
-
-/// True when `p` is inside the travel area: |x|, |y| within max travel ($130, $131).
-fn within_travel(p: Point, settings: &Settings) -> bool {
-    Axis::ALL.into_iter().all(|axis| {
-        let limit = settings.mm_to_steps(axis, settings.max_travel_mm[axis.index()]);
-        let v = match axis {
-            Axis::X => p.x,
-            Axis::Y => p.y,
-        };
-        (-limit..=limit).contains(&v)
-    })
-}
-
-/// True when a drawing covering `extent` from `start` stays inside the travel area.
-fn extent_within_travel(start: Point, extent: &Extent, settings: &Settings) -> bool {
-    within_travel(offset(start, extent.x_min_mm, extent.y_min_mm, settings), settings)
-        && within_travel(offset(start, extent.x_max_mm, extent.y_max_mm, settings), settings)
 }

@@ -3,9 +3,11 @@
 
 extern crate std;
 use super::*;
-use crate::geom::Point;
-use crate::job::{Feed, Shape};
-use crate::ui::curves::{CircleParams, CurveParams, EllipseParams, FunctionParams, FunctionPreset, SineParams};
+use crate::drawing::{DrawError, Request};
+use crate::geom::{Point, Rotation};
+use crate::interp::Shape;
+use crate::job::Feed;
+use crate::ui::presets::FunctionPreset;
 use std::vec::Vec;
 
 fn key(ch: char) -> Key {
@@ -34,8 +36,14 @@ fn idle() -> Status {
     Status::default()
 }
 
+/// A line started from the pen at `from` to (`x`, `y`) steps.
+fn line_from(from: Point, x: i32, y: i32) -> MenuAction {
+    let drawing = crate::drawing::build(&Request::Line { to: Point::new(x, y) }, from, &Settings::default());
+    MenuAction::Start(Job::draw(drawing.unwrap().unwrap(), Feed::MmPerMin(3_000.0)))
+}
+
 fn line(x: i32, y: i32) -> MenuAction {
-    MenuAction::Start(Job::draw(Shape::Line { to: Point::new(x, y) }, Feed::MmPerMin(3_000.0)))
+    line_from(Point::ORIGIN, x, y)
 }
 
 fn form(menu: &Menu) -> &Form {
@@ -58,7 +66,7 @@ fn line_mode_starts_a_line_in_steps() {
 fn line_is_relative_to_the_pen() {
     let mut m = Menu::new();
     let status = Status { position: Point::new(200, -300), ..Status::default() };
-    assert_eq!(type_keys(&mut m, "2 10# 5#", &status), [line(1200, 200)]);
+    assert_eq!(type_keys(&mut m, "2 10# 5#", &status), [line_from(status.position, 1200, 200)]);
 }
 
 #[test]
@@ -99,11 +107,11 @@ fn beyond_travel_nothing_starts() {
     // Pen at X 100 mm; 150 mm further is past the 200 mm travel.
     let status = Status { position: Point::new(10_000, 0), ..Status::default() };
     assert_eq!(type_keys(&mut m, "2 150# 0#", &status), []);
-    assert_eq!(m.message(), Some(UiError::Travel));
+    assert_eq!(m.message(), Some(UiError::Drawing(DrawError::Travel)));
     // The last field keeps its text; delete it, go back to dX and correct that.
     assert_eq!(form(&m).field_index(), 1);
     assert_eq!(form(&m).entry().digits(), "0");
-    assert_eq!(type_keys(&mut m, "B B BBB 100# 0#", &status), [line(20_000, 0)]);
+    assert_eq!(type_keys(&mut m, "B B BBB 100# 0#", &status), [line_from(status.position, 20_000, 0)]);
 }
 
 #[test]
@@ -203,10 +211,11 @@ fn mode_list_by_digit_and_by_navigation() {
     assert_eq!(*m.screen(), Screen::Settings { first_line: 0 });
 }
 
-fn curve(action: &MenuAction) -> CurveParams {
+/// The shape (in steps) and start of the drawing an action starts.
+fn curve(action: &MenuAction) -> (Shape, Point) {
     match action {
-        MenuAction::StartCurve(job) => job.curve,
-        a => panic!("not a curve: {a:?}"),
+        MenuAction::Start(job) => (job.drawing.shape().clone(), job.drawing.start()),
+        a => panic!("not a drawing: {a:?}"),
     }
 }
 
@@ -216,65 +225,72 @@ fn circle_defaults_to_a_full_turn() {
     let status = Status { position: Point::new(1000, 0), ..Status::default() };
     let actions = type_keys(&mut m, "3 10# # #", &status);
     assert_eq!(actions.len(), 1);
-    assert_eq!(
-        curve(&actions[0]),
-        CurveParams::Circle(CircleParams { radius_mm: 10.0, start_deg: 0.0, sweep_deg: 360.0 })
-    );
-    let MenuAction::StartCurve(job) = &actions[0] else { unreachable!() };
-    assert_eq!(job.start, Point::new(1000, 0));
+    let full = Shape::Arc { center: Point::ORIGIN, to: Point::new(1000, 0), rotation: Rotation::CounterClockwise };
+    assert_eq!(curve(&actions[0]), (full, Point::new(1000, 0)));
     // A half turn clockwise from the top.
     let actions = type_keys(&mut m, "3# 90# A180#", &status);
-    assert_eq!(
-        curve(&actions[0]),
-        CurveParams::Circle(CircleParams { radius_mm: 3.0, start_deg: 90.0, sweep_deg: -180.0 })
-    );
+    let half = Shape::Arc { center: Point::new(1000, -300), to: Point::new(1000, -600), rotation: Rotation::Clockwise };
+    assert_eq!(curve(&actions[0]), (half, Point::new(1000, 0)));
     // Radius 0 is refused; a circle leaving the travel area too.
     assert_eq!(type_keys(&mut m, "0#", &status), []);
     assert_eq!(m.message(), Some(UiError::OutOfRange { min: 0.1, max: 500.0, unit: Unit::Mm }));
     assert_eq!(type_keys(&mut m, "C150# # #", &status), []);
-    assert_eq!(m.message(), Some(UiError::Travel), "a full circle of r 150 from x 10 reaches x -290");
+    assert_eq!(
+        m.message(),
+        Some(UiError::Drawing(DrawError::Travel)),
+        "a full circle of r 150 from x 10 reaches x -290"
+    );
 }
 
 #[test]
 fn ellipse_and_sine_forms() {
     let mut m = Menu::new();
     let a = type_keys(&mut m, "4 20# 10# 45# 90#", &idle());
-    assert_eq!(
-        curve(&a[0]),
-        CurveParams::Ellipse(EllipseParams { a_mm: 20.0, b_mm: 10.0, start_deg: 45.0, sweep_deg: 90.0 })
-    );
+    let ellipse = Shape::Ellipse {
+        center: Point::new(-1414, -707),
+        a_steps: 2000,
+        b_steps: 1000,
+        to: Point::new(-2828, 0),
+        rotation: Rotation::CounterClockwise,
+    };
+    assert_eq!(curve(&a[0]), (ellipse, Point::ORIGIN));
     type_keys(&mut m, "D", &idle());
     let a = type_keys(&mut m, "5 A5# 20# # 40#", &idle());
-    assert_eq!(
-        curve(&a[0]),
-        CurveParams::Sine(SineParams { amplitude_mm: -5.0, period_mm: 20.0, phase_deg: 0.0, length_mm: 40.0 })
-    );
+    let sine = Shape::Sine {
+        amplitude_steps: -500.0,
+        omega_rad_per_step: core::f32::consts::TAU / 20.0 / 100.0,
+        phase_rad: 0.0,
+        length_steps: 4000,
+    };
+    assert_eq!(curve(&a[0]), (sine, Point::ORIGIN));
     assert_eq!(type_keys(&mut m, "5# 20# # 0#", &idle()), []);
     assert_eq!(m.message(), Some(UiError::Zero));
     // A 100 mm amplitude over a 1 mm period rises 628 mm per mm: far over the 5 mm jump limit.
     type_keys(&mut m, "D", &idle());
     assert_eq!(type_keys(&mut m, "5 100# 1# # 10#", &idle()), []);
-    assert_eq!(m.message(), Some(UiError::TooSteep));
+    assert_eq!(m.message(), Some(UiError::Drawing(DrawError::TooSteep)));
 }
 
 #[test]
 fn function_presets_and_their_domains() {
     let mut m = Menu::new();
     let a = type_keys(&mut m, "6 2# 0# 20#", &idle());
-    assert_eq!(
-        curve(&a[0]),
-        CurveParams::Function(FunctionParams { preset: FunctionPreset::Wave, x0_mm: 0.0, x1_mm: 20.0 })
-    );
+    let wave = Shape::Function { expr: crate::expr::parse("10*sin(x/5)").unwrap(), x0_mm: 0.0, x1_mm: 20.0 };
+    assert_eq!(curve(&a[0]), (wave, Point::ORIGIN));
     // The preset choice is kept for the next drawing; B steps to the next one.
     assert_eq!(form(&m).preset(), FunctionPreset::Wave);
     let a = type_keys(&mut m, "B# 0# 9#", &idle());
-    assert_eq!(
-        curve(&a[0]),
-        CurveParams::Function(FunctionParams { preset: FunctionPreset::Root, x0_mm: 0.0, x1_mm: 9.0 })
-    );
-    // sqrt of negative x, and an empty interval, are refused.
+    let root = Shape::Function { expr: crate::expr::parse("5*sqrt(x)").unwrap(), x0_mm: 0.0, x1_mm: 9.0 };
+    assert_eq!(curve(&a[0]), (root, Point::ORIGIN));
+    // sqrt of negative x is refused before anything moves, and an empty interval too.
     assert_eq!(type_keys(&mut m, "# A4# 9#", &idle()), []);
-    assert_eq!(m.message(), Some(UiError::Domain));
+    assert!(matches!(m.message(), Some(UiError::Drawing(DrawError::Setup(_)))), "{:?}", m.message());
+    assert_eq!(type_keys(&mut m, "D 6 B B # 4# A9#", &idle()), []);
+    assert!(
+        matches!(m.message(), Some(UiError::Drawing(DrawError::Fails { .. }))),
+        "undefined part way: {:?}",
+        m.message()
+    );
     assert_eq!(type_keys(&mut m, "BBBB 9# 9#", &idle()), []);
     assert_eq!(m.message(), Some(UiError::SameEnds));
 }

@@ -1,0 +1,158 @@
+//! The builder: exact ends and boxes taken from the curve, the travel, and what the lattice
+//! cannot draw.
+
+extern crate std;
+
+use super::*;
+use proptest::prelude::*;
+
+fn settings() -> Settings {
+    Settings::default() // 100 steps/mm, ±200 mm travel, 5 mm jump limit
+}
+
+fn ellipse(a_mm: f32, b_mm: f32, start_deg: f32, sweep_deg: f32) -> Request {
+    Request::Ellipse(EllipseParams { a_mm, b_mm, start_deg, sweep_deg })
+}
+
+fn sine(amplitude_mm: f32, omega_rad_per_mm: f32, length_mm: f32) -> Request {
+    Request::Sine(SineParams { amplitude_mm, omega_rad_per_mm, phase_deg: 0.0, length_mm })
+}
+
+fn function(text: &str, x0_mm: f32, x1_mm: f32) -> Request {
+    Request::Function { expr: crate::expr::parse(text).unwrap(), x0_mm, x1_mm }
+}
+
+/// Every lattice point the drawing's own curve visits, from its start.
+fn walk(d: &Drawing) -> std::vec::Vec<Point> {
+    let mut curve = d.clone().into_curve();
+    let mut at = d.start();
+    let mut points = std::vec![at];
+    while let Some(step) = curve.next_step().expect("a built drawing runs to its end") {
+        at = at.stepped(step);
+        points.push(at);
+    }
+    points
+}
+
+#[test]
+fn the_end_and_the_box_are_the_curves_own() {
+    let s = settings();
+    let start = Point::new(1234, -567);
+    for request in [
+        Request::Line { to: Point::new(-3000, 4000) },
+        ellipse(20.0, 20.0, 30.0, 250.0),
+        ellipse(30.0, 15.0, 0.0, 360.0),
+        sine(10.0, 0.3, 60.0),
+        function("sqrt(x)", 0.0, 10.005),
+        function("acos(x/20)*5", 0.0, 0.005),
+    ] {
+        let d = build(&request, start, &s).unwrap().unwrap();
+        let points = walk(&d);
+        assert_eq!(d.start(), start);
+        assert_eq!(d.end(), *points.last().unwrap(), "{request:?}");
+        assert_eq!(d.steps(), points.len() as u64 - 1);
+        let min = Point::new(points.iter().map(|p| p.x).min().unwrap(), points.iter().map(|p| p.y).min().unwrap());
+        let max = Point::new(points.iter().map(|p| p.x).max().unwrap(), points.iter().map(|p| p.y).max().unwrap());
+        assert_eq!(d.bounds(), Bounds { min, max }, "{request:?}");
+    }
+}
+
+#[test]
+fn what_leaves_the_travel_is_refused() {
+    let s = settings();
+    // A circle of radius 150 mm centred 150 mm left of a pen at X 100 mm reaches X −200 mm;
+    // from a step further left, one step more.
+    let pen = Point::new(9_999, 0);
+    assert_eq!(build(&ellipse(150.0, 150.0, 0.0, 360.0), pen, &s), Err(DrawError::Travel));
+    assert!(build(&ellipse(150.0, 150.0, 0.0, 360.0), Point::new(10_000, 0), &s).unwrap().is_some());
+    // A function that leaves between any samples one might take.
+    assert_eq!(build(&function("x^2/2", 0.0, 30.0), Point::ORIGIN, &s), Err(DrawError::Travel));
+    assert_eq!(build(&Request::Line { to: Point::new(0, 20_001) }, Point::ORIGIN, &s), Err(DrawError::Travel));
+}
+
+#[test]
+fn what_the_lattice_cannot_draw_is_refused() {
+    let s = settings();
+    // A semi-axis of 0.009 mm is under a step: the reported drives to X −300 mm and a 40 mm
+    // back-and-forth line.
+    assert_eq!(build(&ellipse(150.0, 0.009, 0.0, -30.0), Point::ORIGIN, &s), Err(DrawError::TooFine));
+    assert_eq!(build(&ellipse(20.0, 0.009, 0.0, -30.0), Point::ORIGIN, &s), Err(DrawError::TooFine));
+    // ω = 100 rad/mm at 100 steps/mm is a wave every 6.3 steps.
+    assert_eq!(build(&sine(5.0, 100.0, 10.0), Point::ORIGIN, &s), Err(DrawError::TooFine));
+    // A sine steeper than the jump limit between two columns.
+    assert_eq!(build(&sine(100.0, 6.3, 10.0), Point::ORIGIN, &s), Err(DrawError::TooSteep));
+    // Shorter than a step: nothing to draw.
+    assert_eq!(build(&sine(5.0, 0.1, 0.004), Point::ORIGIN, &s), Ok(None));
+}
+
+#[test]
+fn a_function_that_fails_part_way_is_refused_with_where() {
+    let s = settings();
+    match build(&function("sqrt(1-x)", 0.0, 2.0), Point::ORIGIN, &s) {
+        Err(DrawError::Fails { x_mm, error: CurveError::Domain }) => assert!((x_mm - 1.0).abs() <= 0.011, "{x_mm}"),
+        other => panic!("{other:?}"),
+    }
+    match build(&function("floor(x)*6", 0.0, 10.0), Point::ORIGIN, &s) {
+        Err(DrawError::Fails { x_mm, error: CurveError::Jump }) => assert!((x_mm - 1.0).abs() <= 0.011, "{x_mm}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_guard_stops_a_curve_at_the_edge() {
+    // A curve set up past the builder (as a defect upstream would) stops at the last point
+    // inside the travel.
+    let mut s = settings();
+    s.max_travel_mm = [10.0, 10.0];
+    let shape = Shape::Line { to: Point::new(5_000, 0) };
+    let mut curve = Curve::new(&shape, Point::ORIGIN, &s).unwrap();
+    let mut buf = [Step::new(0, 0); 700];
+    let mut at = Point::ORIGIN;
+    let end = loop {
+        let filled = curve.fill(&mut buf);
+        for step in &buf[..filled.steps] {
+            at = at.stepped(*step);
+        }
+        if let Some(end) = filled.end {
+            break end;
+        }
+    };
+    assert_eq!(end, Err(CurveError::Travel));
+    assert_eq!(at, Point::new(1_000, 0));
+    assert_eq!(curve.next_step(), Ok(None));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Random curves of every kind from random pens: whatever is built stays inside the travel,
+    /// step by step, and ends where it says.
+    #[test]
+    fn nothing_built_leaves_the_travel(
+        kind in 0..3u8,
+        a in 0.001f32..400.0,
+        b in 0.001f32..400.0,
+        start_deg in -360.0f32..360.0,
+        sweep_deg in -360.0f32..360.0,
+        omega in 0.0f32..200.0,
+        x in -20_000i32..=20_000,
+        y in -20_000i32..=20_000,
+    ) {
+        let mut s = settings();
+        s.max_travel_mm = [200.0, 200.0];
+        let request = match kind {
+            0 => ellipse(a, b, start_deg, if sweep_deg == 0.0 { 360.0 } else { sweep_deg }),
+            1 => sine(a.min(300.0), omega, b - 200.0),
+            _ => function("x^3/4000", -a.min(100.0), b.min(100.0)),
+        };
+        let pen = Point::new(x, y);
+        if let Ok(Some(d)) = build(&request, pen, &s) {
+            let points = walk(&d);
+            let [lx, ly] = s.travel_steps();
+            for p in &points {
+                prop_assert!(p.x.abs() <= lx && p.y.abs() <= ly, "{:?} from {:?} reaches {:?}", request, pen, p);
+            }
+            prop_assert_eq!(*points.last().unwrap(), d.end());
+        }
+    }
+}
