@@ -25,7 +25,10 @@
 //!   exact.
 //! - Sine: `y = A·(sin(ω·u + φ) − sin φ)` for `u` from 0 to `length` (negative: towards −X).
 //! - Function: `y = f(x)` for `x` from `x0` to `x1`, moved so that `(x0, f(x0))` is the pen.
-//! - Line: straight to a lattice point (the front end rounds its target, as GRBL does).
+//! - Line: straight to a lattice point: the target in millimetres rounded to the nearest step
+//!   ([`line_target`]), as GRBL rounds its targets.
+//!
+//! A sine or function shorter than one step along X draws nothing.
 
 use crate::expr::Expr;
 use crate::geom::{Axis, Point, Rotation, Step};
@@ -279,6 +282,15 @@ impl defmt::Format for Drawing {
     }
 }
 
+/// The lattice point a line from the pen at `start` to `target_mm` (absolute, machine mm) ends
+/// at; `None` for a target no lattice point is near (not finite, or beyond twice the travel).
+/// Both front ends round their line targets here, so a keypad line and the same G-code line
+/// end on the same step.
+pub fn line_target(target_mm: [f32; 2], settings: &Settings) -> Option<Point> {
+    let near = target_mm.iter().zip(settings.max_travel_mm).all(|(v, limit)| v.abs() <= 2.0 * limit);
+    near.then(|| Point::new(settings.mm_to_steps(Axis::X, target_mm[0]), settings.mm_to_steps(Axis::Y, target_mm[1])))
+}
+
 /// Two drawings are the same when they draw the same shape to the same end (and so from the
 /// same start, with the same settings: the curve is set up from those).
 impl PartialEq for Drawing {
@@ -454,10 +466,11 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
                 return Err(DrawError::BadParameter);
             }
             let ideal = IdealBox::from_extent(start, &s.extent(), settings);
-            let length_steps = settings.mm_to_steps(Axis::X, s.length_mm);
-            if length_steps == 0 {
+            // Shorter than one step: nothing to draw.
+            if s.length_mm.abs() * spm[0] < 1.0 {
                 return Ok(None);
             }
+            let length_steps = settings.mm_to_steps(Axis::X, s.length_mm);
             let amplitude_steps = s.amplitude_mm * spm[1];
             let omega_rad_per_step = s.omega_rad_per_mm / spm[0];
             if omega_rad_per_step.abs() * SINE_MIN_STEPS_PER_WAVE > core::f32::consts::TAU {
@@ -472,10 +485,11 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
             if !(x0_mm.is_finite() && x1_mm.is_finite()) {
                 return Err(DrawError::BadParameter);
             }
-            let dx = settings.mm_to_steps(Axis::X, x1_mm - x0_mm);
-            if dx == 0 {
+            // Shorter than one step: nothing to draw.
+            if (x1_mm - x0_mm).abs() * spm[0] < 1.0 {
                 return Ok(None);
             }
+            let dx = settings.mm_to_steps(Axis::X, x1_mm - x0_mm);
             let x = [start.x as f32, (start.x + dx) as f32];
             let ideal_x = IdealBox { min: [x[0].min(x[1]), start.y as f32], max: [x[0].max(x[1]), start.y as f32] };
             if !ideal_within_travel(&ideal_x, settings) {

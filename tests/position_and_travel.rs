@@ -339,7 +339,7 @@ proptest! {
     }
 }
 
-/// The reported case: four functions over half a step each from (39, 5.6), then 10 mm to the
+/// Four functions over half a step each from (39, 5.6), then 10 mm to the
 /// right, must end at X 49.000 mm.
 #[test]
 fn position_has_one_owner_after_half_step_functions() {

@@ -44,7 +44,7 @@ fn the_end_and_the_box_are_the_curves_own() {
         ellipse(30.0, 15.0, 0.0, 360.0),
         sine(10.0, 0.3, 60.0),
         function("sqrt(x)", 0.0, 10.005),
-        function("acos(x/20)*5", 0.0, 0.005),
+        function("acos(x/20)*5", 0.0, 0.015),
     ] {
         let d = build(&request, start, &s).unwrap().unwrap();
         let points = walk(&d);

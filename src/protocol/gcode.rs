@@ -362,8 +362,7 @@ impl GcodeState {
 
 /// Machine millimetres to the nearest step; `None` for a target no lattice point is near.
 fn to_steps(settings: &Settings, mm: [f32; 2]) -> Option<Point> {
-    let finite = mm.iter().zip(settings.max_travel_mm).all(|(v, limit)| v.abs() <= 2.0 * limit);
-    finite.then(|| Point::new(settings.mm_to_steps(Axis::X, mm[0]), settings.mm_to_steps(Axis::Y, mm[1])))
+    drawing::line_target(mm, settings)
 }
 
 impl GcodeState {

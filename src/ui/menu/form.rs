@@ -7,7 +7,7 @@ use core::ops::RangeInclusive;
 use core::f32::consts::TAU;
 
 use super::{MenuAction, Mode, UiError};
-use crate::drawing::{self, EllipseParams, Request, SineParams};
+use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job};
 use crate::keypad::Key;
@@ -243,12 +243,10 @@ impl Form {
         Ok(match self.mode {
             Mode::Line => {
                 let (dx, dy) = (self.number(0)?, self.number(1)?);
-                Request::Line {
-                    to: Point::new(
-                        start.x.saturating_add(settings.mm_to_steps(Axis::X, dx)),
-                        start.y.saturating_add(settings.mm_to_steps(Axis::Y, dy)),
-                    ),
-                }
+                let pen_mm = [settings.steps_to_mm(Axis::X, start.x), settings.steps_to_mm(Axis::Y, start.y)];
+                let to = drawing::line_target([pen_mm[0] + dx, pen_mm[1] + dy], settings)
+                    .ok_or(UiError::Drawing(DrawError::Travel))?;
+                Request::Line { to }
             }
             Mode::Circle => Request::Ellipse(EllipseParams::circle(self.number(0)?, self.number(1)?, self.sweep(2)?)),
             Mode::Ellipse => Request::Ellipse(EllipseParams {
