@@ -24,7 +24,7 @@ use heapless::String;
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::PLANNER_SEGMENTS;
-use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::report::REPORT_LINE_MAX_BYTES;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;

@@ -3,7 +3,7 @@
 
 use super::{Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 use crate::protocol::GrblError;
-use crate::protocol::line::LINE_MAX_BYTES;
+use crate::protocol::framing::LINE_MAX_BYTES;
 
 /// A line with spaces, tabs, block-delete slashes and comments removed, upper-cased.
 type Compact = heapless::Vec<u8, LINE_MAX_BYTES>;
