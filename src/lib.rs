@@ -22,6 +22,7 @@ pub mod job;
 pub mod keypad;
 pub mod machine;
 pub mod math;
+pub mod method;
 pub mod planner;
 pub mod protocol;
 pub mod pulse;
