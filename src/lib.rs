@@ -4,8 +4,8 @@
 //! host: geometry, interpolators, the expression language, the speed planner, the serial
 //! protocol, keypad decoding, the menu and its screen, settings and machine state. The async
 //! loops in [`tasks`] only wait and move values between the core and the pins. The STM32 board
-//! lives in the firmware binary; the simulated board ([`sim`], host only) lives here so tests
-//! and benchmarks can drive it.
+//! lives in the firmware binary; the simulated board and its command line ([`sim`], host only)
+//! live here so tests and benchmarks can drive it.
 #![no_std]
 
 #[cfg(not(target_os = "none"))]
@@ -23,6 +23,7 @@ pub mod job;
 pub mod keypad;
 pub mod machine;
 pub mod math;
+pub mod method;
 pub mod planner;
 pub mod protocol;
 pub mod pulse;

@@ -8,10 +8,6 @@
 mod stm32f407;
 
 #[cfg(not(target_os = "none"))]
-#[path = "board/host.rs"]
-mod host;
-
-#[cfg(not(target_os = "none"))]
 fn main() -> std::process::ExitCode {
-    host::main()
+    servoplot::sim::cli::main()
 }

@@ -4,7 +4,7 @@
 //! senders show them correctly; the plotter's own settings use numbers GRBL leaves free.
 //! A value outside its range is refused with [`SettingError`] and changes nothing.
 
-use crate::interp::Method;
+use crate::method::Method;
 
 /// Why a setting was not changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

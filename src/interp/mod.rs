@@ -14,6 +14,7 @@ pub mod line;
 pub mod setup;
 pub mod sine;
 
+pub use crate::method::Method;
 pub use arc::{ArcError, ArcInterp};
 pub use ellipse::EllipseInterp;
 pub use explicit::{RowRange, jump_limit_steps};
@@ -25,17 +26,6 @@ pub use sine::SineInterp;
 use crate::expr::Expr;
 use crate::geom::{Point, Rotation, Step};
 use crate::settings::Settings;
-
-/// How an interpolator chooses its steps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Method {
-    /// One axis per step, the original controller's point-by-point comparison; error <= 1 step.
-    Classic,
-    /// Both axes may step together; error <= 0.5 step, fewer and longer steps.
-    #[default]
-    Diagonal,
-}
 
 /// Why a curve ended before its end point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

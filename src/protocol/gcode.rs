@@ -81,7 +81,7 @@ use crate::job::{Feed, Job, JobKind};
 use crate::settings::Settings;
 use crate::status::RunState;
 
-use words::{Stop, compact, parse_block};
+use words::{ProgramStop, compact, parse_block};
 
 /// What one line asks of the machine: an iterator over its [`Command`]s in execution order (a
 /// G4 dwell, then the motion or `$` command, then an M0/M2/M30 stop — GRBL's order). Empty for a
@@ -91,7 +91,7 @@ use words::{Stop, compact, parse_block};
 pub struct Commands {
     dwell_ms: Option<u32>,
     main: Option<Command>,
-    stop: Option<Stop>,
+    stop: Option<ProgramStop>,
 }
 
 impl Commands {
@@ -120,8 +120,8 @@ impl Iterator for Commands {
             return Some(main);
         }
         self.stop.take().map(|stop| match stop {
-            Stop::Pause => Command::Pause,
-            Stop::End => Command::ProgramEnd,
+            ProgramStop::Pause => Command::Pause,
+            ProgramStop::End => Command::ProgramEnd,
         })
     }
 

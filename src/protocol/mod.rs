@@ -3,8 +3,8 @@
 //! Existing G-code senders (UGS, CNCjs, bCNC) and a plain terminal talk to the plotter as if it
 //! were GRBL 1.1. This module owns the three pure parts of that conversation:
 //!
-//! - [`line`](mod@line): bytes in, lines out ([`LineAssembler`]), and the realtime bytes
-//!   that bypass lines ([`realtime`]);
+//! - [`framing`]: bytes in, text lines out ([`LineAssembler`]), and the realtime bytes that
+//!   bypass lines ([`realtime`]);
 //! - [`gcode`]: one line in, machine [`Command`]s out ([`GcodeState::execute`]), with GRBL's
 //!   modal state, planned position and error rules, plus the plotter's own curve commands;
 //! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...).
@@ -60,12 +60,12 @@
 //! millimetres and degrees whatever G20/G21 says, and accept an F word (mm/min) that becomes the
 //! modal feed rate like G1's. See [`gcode`] for their exact syntax and geometry.
 
+pub mod framing;
 pub mod gcode;
-pub mod line;
 pub mod report;
 
+pub use framing::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
 pub use gcode::{Command, Commands, GcodeState, Report};
-pub use line::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
 
 /// Why a line was refused; [`GrblError::code`] is the number sent as `error:N`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -11,7 +11,7 @@ use std::vec::Vec;
 
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 
-use crate::ui::screen::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 
 const GDRAM_ROWS: usize = 32;
 const GDRAM_ROW_BYTES: usize = 32;

@@ -4,8 +4,10 @@
 //! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
 //! pressed by a script, the serial link reads a transcript or standard input, and the LCD is a
 //! model of the ST7920 fed by the real driver. A run ends when every input is used up and the
-//! machine has come to rest.
+//! machine has come to rest. [`cli`] is the simulator's command line: what the firmware binary
+//! runs when built for the host.
 
+pub mod cli;
 pub mod clock;
 pub mod cpu;
 pub mod keys;

@@ -13,7 +13,8 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::SpiDevice;
 
 use crate::machine::Machine;
-use crate::ui::screen::{self, SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+use crate::ui::screen;
 
 /// Shortest time between two frames (10 Hz at most).
 pub const LCD_FRAME_MIN_MS: u64 = 100;

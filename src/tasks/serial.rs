@@ -24,7 +24,7 @@ use heapless::String;
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault};
 use crate::planner::PLANNER_SEGMENTS;
-use crate::protocol::line::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::report::REPORT_LINE_MAX_BYTES;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
@@ -105,13 +105,13 @@ impl<W: Write> Link<'_, W> {
     }
 
     /// Runs `work` unless a reset comes first (or is already on its way).
-    async fn unless_reset<T>(&self, work: impl Future<Output = T>) -> Result<T, Stop> {
+    async fn unless_reset<T>(&self, work: impl Future<Output = T>) -> Result<T, Unfinished> {
         if self.resets_pending.get() > 0 {
-            return Err(Stop::Reset);
+            return Err(Unfinished::Reset);
         }
         match select(work, self.reset.wait()).await {
             Either::First(t) => Ok(t),
-            Either::Second(()) => Err(Stop::Reset),
+            Either::Second(()) => Err(Unfinished::Reset),
         }
     }
 
@@ -187,8 +187,8 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
     }
 }
 
-/// Why a line's commands stopped before all were carried out.
-enum Stop {
+/// Why a line was left unfinished: not all of its commands were carried out.
+enum Unfinished {
     /// The line was refused: answer `error:N`.
     Error(GrblError),
     /// A reset came: the line gets no answer (the banner follows).
@@ -248,15 +248,15 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                             }
                             r
                         }
-                        Err(e) => Err(Stop::Error(e)),
+                        Err(e) => Err(Unfinished::Error(e)),
                     }
                 }
-                Some(other) => Err(Stop::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
+                Some(other) => Err(Unfinished::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
             };
             match result {
                 Ok(()) => link.send(report::ok).await,
-                Err(Stop::Error(e)) => link.send(|a| report::error(a, e)).await,
-                Err(Stop::Reset) => {}
+                Err(Unfinished::Error(e)) => link.send(|a| report::error(a, e)).await,
+                Err(Unfinished::Reset) => {}
             }
         }
     }
@@ -269,7 +269,7 @@ async fn carry_out<W: Write>(
     settings: &Settings,
     command: Command,
     planned_after: u32,
-) -> Result<(), Stop> {
+) -> Result<(), Unfinished> {
     let machine = link.machine;
     match command {
         Command::Job(job) => queue(link, job, planned_after).await?,
@@ -289,7 +289,9 @@ async fn carry_out<W: Write>(
             link.send(|a| report::message(a, "Pgm End")).await;
         }
         Command::SetSetting { id, value } => {
-            machine.update_settings(|s| s.set(id, value)).map_err(|_| Stop::Error(GrblError::InvalidStatement))?;
+            machine
+                .update_settings(|s| s.set(id, value))
+                .map_err(|_| Unfinished::Error(GrblError::InvalidStatement))?;
         }
         Command::RestoreSettings => machine.update_settings(|s| *s = Settings::default()),
         Command::Report(kind) => {
@@ -316,13 +318,13 @@ async fn carry_out<W: Write>(
 /// reset while it waits drops the job silently (the banner follows); an abort while it waits
 /// drops it with `error:9`, since it was planned from a point the pen will not reach.
 /// `planned_after` is the abort count the job was planned after.
-async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Result<(), Stop> {
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Result<(), Unfinished> {
     let feed = job.feed;
     let send = link.machine.jobs.send(job.planned_after(planned_after));
     let mut send = core::pin::pin!(send);
     loop {
         if link.machine.aborts() != planned_after {
-            return Err(Stop::Error(GrblError::Locked));
+            return Err(Unfinished::Error(GrblError::Locked));
         }
         match link.unless_reset(select(send.as_mut(), link.machine.aborted.wait())).await? {
             Either::First(()) => break,
@@ -331,7 +333,7 @@ async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Re
     }
     if link.machine.aborts() != planned_after {
         // Queued just as an abort came: the motion task drops it.
-        return Err(Stop::Error(GrblError::Locked));
+        return Err(Unfinished::Error(GrblError::Locked));
     }
     if let crate::job::Feed::MmPerMin(f) = feed {
         link.feed_mm_per_min.set(f);

@@ -32,6 +32,7 @@ use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::ui::entry::EntryError;
+use crate::ui::layout::{SETTINGS_VIEW_LINES, SETTINGS_VISIBLE_LINES};
 
 mod form;
 #[cfg(test)]
@@ -307,8 +308,7 @@ impl Menu {
                 Ok(MenuAction::None)
             }
             Screen::Settings { first_line } => {
-                let last =
-                    crate::ui::screen::SETTINGS_VIEW_LINES.saturating_sub(crate::ui::screen::SETTINGS_VISIBLE_LINES);
+                let last = SETTINGS_VIEW_LINES.saturating_sub(SETTINGS_VISIBLE_LINES);
                 match key {
                     Key::A => *first_line = first_line.saturating_sub(1),
                     Key::B => *first_line = (*first_line + 1).min(last),

@@ -2,13 +2,16 @@
 //!
 //! [`menu`] turns key events (from [`crate::keypad`]) into jobs, controls and jogs; [`entry`]
 //! holds the number being typed; [`presets`] names the functions the keypad offers; [`screen`]
-//! draws it all on the 122x32 LCD. Everything here is pure: no clock, no pins, no waiting.
+//! draws it all on the 122x32 LCD, whose sizes are in [`layout`]. Everything here is pure: no
+//! clock, no pins, no waiting.
 
 pub mod entry;
+pub mod layout;
 pub mod menu;
 pub mod presets;
 pub mod screen;
 
+pub use layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 pub use menu::{Menu, MenuAction};
 pub use presets::FunctionPreset;
-pub use screen::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX, ScreenView};
+pub use screen::ScreenView;

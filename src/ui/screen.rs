@@ -5,7 +5,8 @@
 //! error (if any) inverted on the bottom line. The view is small and compares cheaply, so the LCD
 //! task redraws only when it changes. [`render`] draws a whole view: every line's full width is
 //! cleared before its text is drawn, so no pixel of an earlier frame survives (no stale digits),
-//! and nothing is drawn outside [`SCREEN_WIDTH_PX`] x [`SCREEN_HEIGHT_PX`].
+//! and nothing is drawn outside [`SCREEN_WIDTH_PX`] x
+//! [`SCREEN_HEIGHT_PX`](crate::ui::layout::SCREEN_HEIGHT_PX).
 //!
 //! Layout:
 //!
@@ -35,26 +36,9 @@ use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::settings::Settings;
 use crate::status::{MotionFault, RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
+use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
 
-/// Visible width of the LCD.
-pub const SCREEN_WIDTH_PX: u32 = 122;
-/// Visible height of the LCD.
-pub const SCREEN_HEIGHT_PX: u32 = 32;
-/// Height of one text line (the 5x8 font).
-pub const SCREEN_LINE_HEIGHT_PX: u32 = 8;
-/// Width of one character (the 5x8 font).
-pub const SCREEN_CHAR_WIDTH_PX: u32 = 5;
-/// Left margin, so inverted lines do not start with a glyph at the glass' edge.
-pub const SCREEN_MARGIN_PX: u32 = 1;
-/// Text lines on the screen.
-pub const SCREEN_LINES: usize = (SCREEN_HEIGHT_PX / SCREEN_LINE_HEIGHT_PX) as usize;
-/// Characters per line.
-pub const SCREEN_COLUMNS: usize = ((SCREEN_WIDTH_PX - SCREEN_MARGIN_PX) / SCREEN_CHAR_WIDTH_PX) as usize;
-/// Lines of the settings view.
-pub const SETTINGS_VIEW_LINES: usize = 7;
-/// Settings lines visible at once (under the title).
-pub const SETTINGS_VISIBLE_LINES: usize = SCREEN_LINES - 1;
 /// Widest position value shown (`-500.000`, or fewer decimals for larger values).
 const POSITION_CHARS: usize = 9;
 
@@ -325,6 +309,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::keypad::{Key, KeyEvent};
+    use crate::ui::layout::SCREEN_HEIGHT_PX;
     use core::convert::Infallible;
     use embedded_graphics::Pixel;
     use embedded_graphics::geometry::OriginDimensions;

@@ -3,7 +3,7 @@
 
 use core::f32::consts::TAU;
 
-use super::words::{Block, NonModal, Stop};
+use super::words::{Block, NonModal, ProgramStop};
 use super::{
     ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM, Command, Commands,
     DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle, to_steps,
@@ -149,7 +149,7 @@ impl GcodeState {
             return Err(GrblError::UnusedWords);
         }
 
-        if block.stop == Some(Stop::End) {
+        if block.stop == Some(ProgramStop::End) {
             // GRBL (after LinuxCNC) resets these groups at program end; units, F, S, T and the
             // G92 offset stay.
             self.motion = MotionMode::Linear;

@@ -3,7 +3,7 @@
 
 use super::{Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 use crate::protocol::GrblError;
-use crate::protocol::line::LINE_MAX_BYTES;
+use crate::protocol::framing::LINE_MAX_BYTES;
 
 /// A line with spaces, tabs, block-delete slashes and comments removed, upper-cased.
 type Compact = heapless::Vec<u8, LINE_MAX_BYTES>;
@@ -121,7 +121,7 @@ pub(super) enum Group {
     ToolLength,
     CoordSystem,
     Control,
-    Stop,
+    ProgramStop,
     Spindle,
     Coolant,
 }
@@ -140,9 +140,10 @@ pub(super) enum NonModal {
     ClearOffset,
 }
 
-/// M0 or M2/M30 (M1, an optional stop without a switch, is no stop).
+/// A program stop: M0 pauses, M2/M30 end the program (M1, an optional stop without a switch,
+/// is no stop).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Stop {
+pub(super) enum ProgramStop {
     Pause,
     End,
 }
@@ -158,7 +159,7 @@ pub(super) struct Block {
     pub(super) units: Option<Units>,
     pub(super) distance: Option<Distance>,
     pub(super) spindle: Option<Spindle>,
-    pub(super) stop: Option<Stop>,
+    pub(super) stop: Option<ProgramStop>,
     pub(super) words: Words,
 }
 
@@ -240,11 +241,11 @@ impl Block {
         let group = match int {
             0 | 1 | 2 | 30 => {
                 self.stop = match int {
-                    0 => Some(Stop::Pause),
+                    0 => Some(ProgramStop::Pause),
                     1 => None,
-                    _ => Some(Stop::End),
+                    _ => Some(ProgramStop::End),
                 };
-                Group::Stop
+                Group::ProgramStop
             }
             3..=5 => {
                 self.spindle = Some([Spindle::Cw, Spindle::Ccw, Spindle::Off][int as usize - 3]);

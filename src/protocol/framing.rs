@@ -1,4 +1,5 @@
-//! Bytes from the host into lines, and the realtime bytes that never belong to a line.
+//! Serial framing: the host's bytes into text lines (one G-code block or `$` command each), and
+//! the realtime bytes that never belong to a line.
 //!
 //! GRBL senders stream lines ended by LF, CR or CRLF, and at any moment (even in the middle of a
 //! line) send single realtime bytes: `?` status, `!` hold, `~` resume, Ctrl-X reset and GRBL's

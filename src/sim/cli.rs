@@ -3,8 +3,11 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::string::{String, ToString};
+use std::vec::Vec;
+use std::{eprintln, format};
 
-use servoplot::sim::{self, KeysStart, SimConfig, keys::KeyScript, picture, serial::SimSerial};
+use crate::sim::{self, KeysStart, SimConfig, keys::KeyScript, picture, serial::SimSerial};
 
 /// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
 const DEMO_GCODE: &str = include_str!("../../demo/demo.gcode");
@@ -93,6 +96,7 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
+/// Runs the simulator with the process' command line; the firmware binary's `main` on the host.
 pub fn main() -> ExitCode {
     init_log();
     let args = match parse_args() {

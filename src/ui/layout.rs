@@ -1,0 +1,24 @@
+//! The LCD's geometry: its visible size, the text grid the 5x8 font makes of it, and how the
+//! settings view scrolls in that grid.
+//!
+//! The menu keeps the settings view's scroll position and the screen draws it; both take the
+//! sizes from here, so neither has to know the other's code.
+
+/// Visible width of the LCD.
+pub const SCREEN_WIDTH_PX: u32 = 122;
+/// Visible height of the LCD.
+pub const SCREEN_HEIGHT_PX: u32 = 32;
+/// Height of one text line (the 5x8 font).
+pub const SCREEN_LINE_HEIGHT_PX: u32 = 8;
+/// Width of one character (the 5x8 font).
+pub const SCREEN_CHAR_WIDTH_PX: u32 = 5;
+/// Left margin, so inverted lines do not start with a glyph at the glass' edge.
+pub const SCREEN_MARGIN_PX: u32 = 1;
+/// Text lines on the screen.
+pub const SCREEN_LINES: usize = (SCREEN_HEIGHT_PX / SCREEN_LINE_HEIGHT_PX) as usize;
+/// Characters per line.
+pub const SCREEN_COLUMNS: usize = ((SCREEN_WIDTH_PX - SCREEN_MARGIN_PX) / SCREEN_CHAR_WIDTH_PX) as usize;
+/// Lines of the settings view.
+pub const SETTINGS_VIEW_LINES: usize = 7;
+/// Settings lines visible at once (under the title).
+pub const SETTINGS_VISIBLE_LINES: usize = SCREEN_LINES - 1;
