@@ -128,13 +128,6 @@ fn foot_within_tolerance(a: i32, b: i32, p: (i64, i64)) -> Option<(f32, f32)> {
     if math::hypot(d.0, d.1) <= ARC_END_TOLERANCE_STEPS as f32 { Some(d) } else { None }
 }
 
-/// Euclidean distance from lattice point `p` (relative to the centre) to the ellipse with
-/// semi-axes `a` along X and `b` along Y (both > 0): the length of [`foot`].
-pub fn distance_to_ellipse(a: i32, b: i32, p: (i64, i64)) -> f32 {
-    let d = foot(a, b, p);
-    math::hypot(d.0, d.1)
-}
-
 /// From lattice point `p` (relative to the centre) to the point of the ellipse with semi-axes
 /// `a` along X and `b` along Y (both > 0) nearest to it: `nearest − p`. The nearest point lies
 /// in the same closed quadrant as `p` (a zero coordinate counts as positive where the nearest
