@@ -76,16 +76,6 @@ impl Key {
         if row < KEYPAD_ROWS && col < KEYPAD_COLS { Some(KEY_MAP[row][col]) } else { None }
     }
 
-    /// Where the key sits in the matrix; `None` for a digit above 9.
-    pub fn row_col(self) -> Option<(usize, usize)> {
-        (0..KEYPAD_ROWS).flat_map(|r| (0..KEYPAD_COLS).map(move |c| (r, c))).find(|&(r, c)| KEY_MAP[r][c] == self)
-    }
-
-    /// The key's bit in a raw scan.
-    pub fn scan_bit(self) -> Option<u16> {
-        self.row_col().map(|(r, c)| 1 << (r * KEYPAD_COLS + c))
-    }
-
     /// Navigation keys auto-repeat while held: `A` (up, or sign) and `B` (down, or backspace).
     pub const fn is_navigation(self) -> bool {
         matches!(self, Key::A | Key::B)
@@ -242,8 +232,15 @@ mod tests {
     use super::*;
     use std::vec::Vec;
 
+    /// Where `key` sits in the matrix; `None` for a digit above 9.
+    fn row_col(key: Key) -> Option<(usize, usize)> {
+        (0..KEYPAD_ROWS).flat_map(|r| (0..KEYPAD_COLS).map(move |c| (r, c))).find(|&(r, c)| KEY_MAP[r][c] == key)
+    }
+
+    /// `key`'s bit in a raw scan.
     fn bit(key: Key) -> u16 {
-        key.scan_bit().unwrap()
+        let (r, c) = row_col(key).unwrap();
+        1 << (r * KEYPAD_COLS + c)
     }
 
     /// Scans `raw` every scan period from `*now` for `duration_ms`, collecting (time, event).
@@ -268,13 +265,12 @@ mod tests {
             for (c, ch) in row.chars().enumerate() {
                 let key = Key::from_row_col(r, c).unwrap();
                 assert_eq!(key.legend(), ch);
-                assert_eq!(key.row_col(), Some((r, c)));
-                assert_eq!(key.scan_bit(), Some(1 << (r * 4 + c)));
+                assert_eq!(row_col(key), Some((r, c)));
             }
         }
         assert_eq!(Key::from_row_col(4, 0), None);
         assert_eq!(Key::from_row_col(0, 4), None);
-        assert_eq!(Key::Digit(10).scan_bit(), None);
+        assert_eq!(row_col(Key::Digit(10)), None);
     }
 
     #[test]
@@ -455,7 +451,7 @@ mod tests {
                         }
                         KeyEvent::Release(k) => (k, true),
                     };
-                    let (r, c) = k.row_col().unwrap();
+                    let (r, c) = row_col(k).unwrap();
                     proptest::prop_assert_eq!(down[r * 4 + c], expect_down, "{:?}", e);
                     down[r * 4 + c] = !matches!(e, KeyEvent::Release(_));
                 }

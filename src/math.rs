@@ -170,15 +170,6 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     if quadrant & 2 == 0 { (s, c) } else { (-s, -c) }
 }
 
-/// tan x (radians) as sin x / cos x. Within 3 ulp for |x| ≤ π/4; for |x| ≤
-/// [`TRIG_ACCURATE_MAX_RAD`] within 3 ulp plus 1e-8·(1 + tan²x), the reduction's error times
-/// the derivative, which grows toward the poles. At the f32 nearest each pole there it is large
-/// (|tan| > 1e3) but finite and within 1e-3 of itself.
-pub fn tan(x: f32) -> f32 {
-    let (s, c) = sin_cos(x);
-    s / c
-}
-
 // ----- inverse functions ----------------------------------------------------------------------
 
 /// asin x (radians, in [-π/2, π/2]) as atan2(x, √((1-x)(1+x))), with the FPU's square root:

@@ -119,38 +119,6 @@ const GATE_STEP_SHIFT: u32 = 31;
 /// A point in 1/[`GATE_SCALE`] step, relative to the centre.
 pub(crate) type Fine = (i64, i64);
 
-/// `p` (in steps) in 1/[`GATE_SCALE`] step, rounded.
-pub(crate) fn fine(p: (f32, f32)) -> Fine {
-    let scale = GATE_SCALE as f32;
-    (math::round(p.0 * scale) as i64, math::round(p.1 * scale) as i64)
-}
-
-/// How a tracer finds its end.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Plan {
-    /// To the end point given as a lattice point: the curve part stops at the [`Gate`] through
-    /// `near`, the point of the curve nearest to the end (machine frame, relative to the centre,
-    /// in 1/[`GATE_SCALE`] step). An end on the start's own ray (the start itself included)
-    /// takes one full turn.
-    ToEnd { near: Fine },
-    /// Along the ideal arc from its point `from` to its point `to` (machine frame, relative to
-    /// the centre, in steps), `long` when it sweeps half a turn or more; the lattice start and
-    /// end are these points rounded, and may lie on either side of them.
-    Between { from: (f32, f32), to: (f32, f32), long: bool },
-    /// No steps: the end is the start.
-    Empty,
-}
-
-impl Plan {
-    /// The plan of an ideal arc from `from` to `to` sweeping `sweep` radians (less than a
-    /// turn), whose end rounds onto the start when `same_point`: nothing to draw for a short
-    /// sweep, which is shorter than the rounding.
-    pub(crate) fn between(from: (f32, f32), to: (f32, f32), sweep: f32, same_point: bool) -> Plan {
-        let long = sweep.abs() >= core::f32::consts::PI;
-        if same_point && !long { Plan::Empty } else { Plan::Between { from, to, long } }
-    }
-}
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
     /// Following the curve.
@@ -169,20 +137,6 @@ fn quadrant(x: i32, y: i32) -> u8 {
     } else if x <= 0 && y > 0 {
         1
     } else if x < 0 && y <= 0 {
-        2
-    } else {
-        3
-    }
-}
-
-/// [`quadrant`] of a fractional point.
-fn quadrant_f(p: (f32, f32)) -> u8 {
-    let (x, y) = p;
-    if x > 0.0 && y >= 0.0 {
-        0
-    } else if x <= 0.0 && y > 0.0 {
-        1
-    } else if x < 0.0 && y <= 0.0 {
         2
     } else {
         3
@@ -352,13 +306,15 @@ pub(crate) struct Tracer {
 impl Tracer {
     /// `start` and `end` relative to the centre (the caller checks them: within
     /// [`ARC_END_TOLERANCE_STEPS`](crate::interp::arc::ARC_END_TOLERANCE_STEPS) of the curve),
-    /// `weights` = `(wx, wy)`, `c` modulo 2⁶⁴, `half_axes` = ceilings of the semi-axes along X
-    /// and Y.
+    /// `near` the point of the curve nearest to the end (machine frame, relative to the centre,
+    /// in 1/[`GATE_SCALE`] step), where the curve part stops at the [`Gate`]; an end on the
+    /// start's own ray (the start itself included) takes one full turn. `weights` = `(wx, wy)`,
+    /// `c` modulo 2⁶⁴, `half_axes` = ceilings of the semi-axes along X and Y.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn new(
         start: (i32, i32),
         end: (i32, i32),
-        plan: Plan,
+        near: Fine,
         weights: (i64, i64),
         c: i64,
         half_axes: (i32, i32),
@@ -372,69 +328,39 @@ impl Tracer {
         let big = wx.max(wy) as f32;
         let tw = (wx as f32 / big, wy as f32 / big);
         let f = discriminant_at((x, y), weights, c);
-        let frame = |p: (f32, f32)| (p.0, if mirror { -p.1 } else { p.1 });
         // A start on an axis counts as having just come in along it, so that it does not climb
         // to a tip: whether the tip lies ahead or behind is unknown, and it is taken to be
-        // behind (at the start's own angle). Unless the ideal start is known to lie before
-        // the axis.
-        let on_axis_in = if x == 0 {
+        // behind (at the start's own angle).
+        let last = if x == 0 {
             (0, -y.signum())
         } else if y == 0 {
             (-x.signum(), 0)
         } else {
             (0, 0)
         };
-        let before_axis = match plan {
-            Plan::Between { from, .. } => quadrant(x, y) == (quadrant_f(frame(from)) + 1) % 4,
-            _ => false,
-        };
-        let last = if before_axis { (0, 0) } else { on_axis_in };
         let q = progress_quadrant((x, y), f, last, weights);
-        let (needed, crossed, gate, phase) = match plan {
-            Plan::ToEnd { near } => {
-                // An end inside a tip, on its axis, is met on the way up to the tip: it counts in
-                // the quadrant before.
-                let fe = discriminant_at((ex, ey), weights, c);
-                let eq = if (ex, ey) == (x, y) { q } else { progress_quadrant((ex, ey), fe, (0, 0), weights) };
-                let mut needed = (eq + 4 - q) % 4;
-                let (s, e) = ((x as i64, y as i64), (ex as i64, ey as i64));
-                let ahead = cross(s, e);
-                if ahead == 0 && s.0 * e.0 + s.1 * e.1 > 0 {
-                    // On the start's own ray: one full turn (less one quadrant if the end is met
-                    // on the way up a tip the start has left behind).
-                    needed = if needed == 3 { 3 } else { needed + 4 };
-                } else if needed == 0 && ahead < 0 {
-                    // Same quadrant, behind the start.
-                    needed = 4;
-                }
-                // Back to the start itself; else to the curve point nearest the end.
-                let target = if (x, y) == (ex, ey) {
-                    (x as i64 * GATE_SCALE, y as i64 * GATE_SCALE)
-                } else {
-                    (near.0, if mirror { -near.1 } else { near.1 })
-                };
-                (needed, 0, Gate::new(target, eq, tw), Phase::Curve)
-            }
-            Plan::Between { from, to, long } => {
-                let (from, to) = (frame(from), frame(to));
-                let (qf, qt) = (quadrant_f(from), quadrant_f(to));
-                let mut needed = (qt + 4 - qf) % 4;
-                if needed == 0 && long {
-                    needed = 4;
-                }
-                // The lattice start may have been rounded across an axis.
-                let (needed, crossed) = match (q + 4 - qf) % 4 {
-                    1 => (needed, 1),
-                    3 => (needed + 1, 0),
-                    _ => (needed, 0),
-                };
-                (needed, crossed, Gate::new(fine(to), qt, tw), Phase::Curve)
-            }
-            Plan::Empty => {
-                let gate = Gate::new((ex as i64 * GATE_SCALE, ey as i64 * GATE_SCALE), quadrant(ex, ey), tw);
-                (0, 0, gate, if (x, y) == (ex, ey) { Phase::Done } else { Phase::Tail })
-            }
+        // An end inside a tip, on its axis, is met on the way up to the tip: it counts in the
+        // quadrant before.
+        let fe = discriminant_at((ex, ey), weights, c);
+        let eq = if (ex, ey) == (x, y) { q } else { progress_quadrant((ex, ey), fe, (0, 0), weights) };
+        let mut needed = (eq + 4 - q) % 4;
+        let (s, e) = ((x as i64, y as i64), (ex as i64, ey as i64));
+        let ahead = cross(s, e);
+        if ahead == 0 && s.0 * e.0 + s.1 * e.1 > 0 {
+            // On the start's own ray: one full turn (less one quadrant if the end is met on the
+            // way up a tip the start has left behind).
+            needed = if needed == 3 { 3 } else { needed + 4 };
+        } else if needed == 0 && ahead < 0 {
+            // Same quadrant, behind the start.
+            needed = 4;
+        }
+        // Back to the start itself; else to the curve point nearest the end.
+        let target = if (x, y) == (ex, ey) {
+            (x as i64 * GATE_SCALE, y as i64 * GATE_SCALE)
+        } else {
+            (near.0, if mirror { -near.1 } else { near.1 })
         };
+        let gate = Gate::new(target, eq, tw);
         let quarter = half_axes.0 as u32 + half_axes.1 as u32 + QUARTER_SLACK_STEPS;
         Tracer {
             x,
@@ -448,9 +374,9 @@ impl Tracer {
             f,
             mirror,
             method,
-            phase,
+            phase: Phase::Curve,
             quadrant: q,
-            crossed,
+            crossed: 0,
             needed,
             budget: 4 * (needed as u32 + 1) * quarter,
             last,

@@ -22,8 +22,8 @@
 //! relative precision (about 10⁻⁶ step) for any size of ellipse.
 
 use crate::geom::{Point, Rotation, Step};
-use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset, point_at, round};
-use crate::interp::conic::{GATE_SCALE, Plan, Tracer};
+use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset};
+use crate::interp::conic::{GATE_SCALE, Tracer};
 use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
 use crate::math;
 
@@ -51,9 +51,6 @@ const EXACT_RESIDUAL_MAX: f32 = 2_305_843_009_213_693_952.0; // 2⁶¹
 #[derive(Clone, Debug)]
 pub struct EllipseInterp {
     tracer: Tracer,
-    center: Point,
-    end: Point,
-    rotation: Rotation,
 }
 
 impl EllipseInterp {
@@ -92,96 +89,11 @@ impl EllipseInterp {
         let scale = GATE_SCALE as f32;
         let near =
             (e.0 * GATE_SCALE + math::round(d.0 * scale) as i64, e.1 * GATE_SCALE + math::round(d.1 * scale) as i64);
-        Ok(Self::build(narrow(s), narrow(e), a, b, center, end, rotation, method, Plan::ToEnd { near }))
-    }
-
-    /// An elliptic arc that starts at the pen point `start`, which lies at parametric angle
-    /// `start_angle_rad` (the point `center + (a·cos t, b·sin t)`); the centre is rounded to the
-    /// lattice, so `start` is within 0.71 step of the ellipse.
-    ///
-    /// A positive `sweep_rad` turns counter-clockwise, a negative one clockwise; a sweep of at
-    /// least 2π either way draws the full ellipse (one turn). The end is the lattice point
-    /// nearest to the ideal end at parametric angle `start_angle + sweep` ([`end`](Self::end)
-    /// tells it). The number of quadrants swept comes from the angles, not from the rounded
-    /// points, so rounding never turns a short arc into a full turn or back: an arc shorter
-    /// than half a turn whose end rounds onto the start takes no steps.
-    pub fn from_angles(
-        start: Point,
-        a: i32,
-        b: i32,
-        start_angle_rad: f32,
-        sweep_rad: f32,
-        method: Method,
-    ) -> Result<Self, ArcError> {
-        if !start_angle_rad.is_finite() || !sweep_rad.is_finite() {
-            return Err(ArcError::NotFinite);
-        }
-        if a <= 0 || b <= 0 {
-            return Err(ArcError::ZeroRadius);
-        }
-        if a > MAX_ELLIPSE_AXIS_STEPS || b > MAX_ELLIPSE_AXIS_STEPS {
-            return Err(ArcError::TooLarge);
-        }
-        let (af, bf) = (a as f32, b as f32);
-        let (sin, cos) = math::sin_cos(start_angle_rad);
-        let from = (af * cos, bf * sin);
-        let s = (round(from.0), round(from.1));
-        if s == (0, 0) {
-            return Err(ArcError::ZeroRadius);
-        }
-        let center = point_at(start, (-s.0, -s.1))?;
-        let rotation = if sweep_rad < 0.0 { Rotation::Clockwise } else { Rotation::CounterClockwise };
-        let (e, plan) = if sweep_rad.abs() >= core::f32::consts::TAU {
-            (s, Plan::ToEnd { near: (s.0 as i64 * GATE_SCALE, s.1 as i64 * GATE_SCALE) })
-        } else {
-            // The ideal arc, between the requested parametric angles; the lattice start and
-            // end are its ends rounded.
-            let (sin, cos) = math::sin_cos(start_angle_rad + sweep_rad);
-            let to = (af * cos, bf * sin);
-            let e = (round(to.0), round(to.1));
-            (e, Plan::between(from, to, sweep_rad, e == s))
-        };
-        if e == (0, 0) {
-            // Cannot happen with semi-axes of a step or more (one of |a·cos|, |b·sin| is at
-            // least 0.71); refused rather than traced should it ever.
-            return Err(ArcError::EndOffCurve);
-        }
-        let end = point_at(center, e)?;
-        Ok(Self::build(s, e, a, b, center, end, rotation, method, plan))
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn build(
-        s: (i32, i32),
-        e: (i32, i32),
-        a: i32,
-        b: i32,
-        center: Point,
-        end: Point,
-        rotation: Rotation,
-        method: Method,
-        plan: Plan,
-    ) -> Self {
         let (a2, b2) = (a as i64 * a as i64, b as i64 * b as i64);
         // a²b² modulo 2⁶⁴; the tracer only ever needs F near the curve, which fits.
         let c = a2.wrapping_mul(b2);
-        let tracer = Tracer::new(s, e, plan, (b2, a2), c, (a, b), rotation, method);
-        EllipseInterp { tracer, center, end, rotation }
-    }
-
-    /// The centre, in absolute steps.
-    pub fn center(&self) -> Point {
-        self.center
-    }
-
-    /// The point where the trace ends, in absolute steps.
-    pub fn end(&self) -> Point {
-        self.end
-    }
-
-    /// The direction of travel.
-    pub fn rotation(&self) -> Rotation {
-        self.rotation
+        let tracer = Tracer::new(narrow(s), narrow(e), near, (b2, a2), c, (a, b), rotation, method);
+        Ok(EllipseInterp { tracer })
     }
 
     /// The tracer, for tests that step it by the rules alone.
@@ -214,13 +126,6 @@ fn foot_within_tolerance(a: i32, b: i32, p: (i64, i64)) -> Option<(f32, f32)> {
     }
     let d = foot(a, b, p);
     if math::hypot(d.0, d.1) <= ARC_END_TOLERANCE_STEPS as f32 { Some(d) } else { None }
-}
-
-/// Euclidean distance from lattice point `p` (relative to the centre) to the ellipse with
-/// semi-axes `a` along X and `b` along Y (both > 0): the length of [`foot`].
-pub fn distance_to_ellipse(a: i32, b: i32, p: (i64, i64)) -> f32 {
-    let d = foot(a, b, p);
-    math::hypot(d.0, d.1)
 }
 
 /// From lattice point `p` (relative to the centre) to the point of the ellipse with semi-axes

@@ -18,6 +18,15 @@ mod properties;
 
 const DEFAULT_FEED: Feed = Feed::MmPerMin(3_000.0);
 
+/// Steps a line of `(dx, dy)` takes with `method`: one axis per step, or both at once.
+fn line_steps(dx: i32, dy: i32, method: Method) -> u64 {
+    let (x, y) = (dx.unsigned_abs() as u64, dy.unsigned_abs() as u64);
+    match method {
+        Method::Classic => x + y,
+        Method::Diagonal => x.max(y),
+    }
+}
+
 fn limits_with(change: impl FnOnce(&mut Settings)) -> Limits {
     let mut s = Settings::default();
     change(&mut s);
@@ -45,9 +54,8 @@ impl Chords {
         let chords = points
             .windows(2)
             .map(|p| {
-                let line = LineInterp::new(p[1].x - p[0].x, p[1].y - p[0].y, method);
-                let n = line.total_steps();
-                (line, n)
+                let (dx, dy) = (p[1].x - p[0].x, p[1].y - p[0].y);
+                (LineInterp::new(dx, dy, method), line_steps(dx, dy, method))
             })
             .collect();
         Chords { chords, index: 0, fail_after_steps: None, taken: 0, ended: false, centre: None, at: (0, 0) }

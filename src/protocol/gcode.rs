@@ -298,11 +298,6 @@ impl GcodeState {
         self.position
     }
 
-    /// The planned position in machine millimetres.
-    pub fn planned_position_mm(&self) -> [f32; 2] {
-        self.position_mm
-    }
-
     /// The G92 work offset (machine = work + offset), for `WCO:` and `$#`.
     pub fn work_offset_mm(&self) -> [f32; 2] {
         self.offset_mm

@@ -85,11 +85,6 @@ pub fn message(out: &mut impl Write, text: &str) -> fmt::Result {
     write!(out, "[MSG:{text}]\r\n")
 }
 
-/// `ALARM:N` with GRBL's alarm numbers (1 hard limit, 2 soft limit, 3 reset while moving).
-pub fn alarm(out: &mut impl Write, code: u8) -> fmt::Result {
-    write!(out, "ALARM:{code}\r\n")
-}
-
 /// The status report for `?`: `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `feed_mm_per_min` is the
 /// speed now (0 when stopped); `work_offset_mm`, when given, adds GRBL's `|WCO:x,y,0.000` field
 /// (GRBL sends it every 10 to 30 reports and after the offset changes). Once the pulses have had
@@ -284,7 +279,6 @@ mod tests {
         assert_eq!(text(|o| error(o, GrblError::ModalGroupViolation)), "error:21\r\n");
         assert_eq!(text(welcome), "\r\nGrbl 1.1h ['$' for help]\r\n");
         assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
-        assert_eq!(text(|o| alarm(o, 1)), "ALARM:1\r\n");
         assert_eq!(text(|o| build_info(o, 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
         assert!(text(help).starts_with("[HLP:$$ $# $G $I"));
     }

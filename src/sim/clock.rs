@@ -46,11 +46,6 @@ pub fn now_ticks() -> u64 {
     NOW_TICKS.with(|n| n.get())
 }
 
-/// Moves time forward by `ticks` (a task that busy-waits).
-pub fn advance(ticks: u64) {
-    NOW_TICKS.with(|n| n.set(n.get() + ticks));
-}
-
 /// Starts this thread's clock again at zero with no timer pending.
 pub fn reset() {
     NOW_TICKS.with(|n| n.set(0));

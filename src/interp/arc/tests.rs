@@ -4,7 +4,7 @@ use crate::interp::conic::cross;
 use crate::interp::conic::test_support::*;
 use Method::{Classic, Diagonal};
 use Rotation::{Clockwise as Cw, CounterClockwise as Ccw};
-use core::f64::consts::{PI, SQRT_2, TAU};
+use core::f64::consts::{SQRT_2, TAU};
 use proptest::prelude::*;
 use std::vec::Vec;
 
@@ -14,8 +14,8 @@ impl ArcInterp {
     }
 }
 
-fn trace(arc: &mut ArcInterp, start: Point, method: Method) -> Walk {
-    let r = libm::sqrt(r2(start, arc.center) as f64) as usize;
+fn trace(arc: &mut ArcInterp, start: Point, center: Point, method: Method) -> Walk {
+    let r = libm::sqrt(r2(start, center) as f64) as usize;
     walk(arc, start, method == Classic, ArcInterp::tail_steps, 16 * r + 64)
 }
 
@@ -108,12 +108,12 @@ fn classic_first_quadrant_counter_clockwise_follows_the_textbook() {
 #[test]
 fn first_quadrant_arc_of_radius_five_step_by_step() {
     let mut arc = ArcInterp::new(Point::new(5, 0), Point::ORIGIN, Point::new(0, 5), Ccw, Classic).unwrap();
-    let w = trace(&mut arc, Point::new(5, 0), Classic);
+    let w = trace(&mut arc, Point::new(5, 0), Point::ORIGIN, Classic);
     use Step as S;
     assert_eq!(w.steps, [S::XN, S::YP, S::YP, S::YP, S::XN, S::YP, S::XN, S::YP, S::XN, S::XN]);
     // Diagonal: the nearest lattice point of each row (below 45°) or column (above).
     let mut arc = ArcInterp::new(Point::new(5, 0), Point::ORIGIN, Point::new(0, 5), Ccw, Diagonal).unwrap();
-    let w = trace(&mut arc, Point::new(5, 0), Diagonal);
+    let w = trace(&mut arc, Point::new(5, 0), Point::ORIGIN, Diagonal);
     let expected = [(5, 0), (5, 1), (5, 2), (4, 3), (3, 4), (2, 5), (1, 5), (0, 5)].map(|(x, y)| Point::new(x, y));
     assert_eq!(w.points, expected);
 }
@@ -165,7 +165,7 @@ fn classic_matches_the_tables_in_every_quadrant_and_direction() {
                     let start = Point::new(s.0 as i32, s.1 as i32);
                     let end = Point::new(e.0 as i32, e.1 as i32);
                     let mut arc = ArcInterp::new(start, Point::ORIGIN, end, rotation, Classic).unwrap();
-                    let w = trace(&mut arc, start, Classic);
+                    let w = trace(&mut arc, start, Point::ORIGIN, Classic);
                     let expected = table_walk(*s, e, rotation, k == 4, 10 * r as usize);
                     assert_eq!(w.steps, expected, "r {r} from {s:?} {k} quarters {rotation:?}");
                     assert_eq!(w.len() as i64, 2 * r * k as i64, "classic takes 2R per quarter");
@@ -179,7 +179,7 @@ fn classic_matches_the_tables_in_every_quadrant_and_direction() {
         for rotation in [Ccw, Cw] {
             let start = Point::new(x as i32, y as i32);
             let mut arc = ArcInterp::new(start, Point::ORIGIN, start, rotation, Classic).unwrap();
-            let w = trace(&mut arc, start, Classic);
+            let w = trace(&mut arc, start, Point::ORIGIN, Classic);
             assert_eq!(w.steps, table_walk((x, y), (x, y), rotation, true, 200), "from ({x}, {y}) {rotation:?}");
         }
     }
@@ -193,12 +193,12 @@ fn full_circles_take_8r_classic_and_about_4_root_2_r_diagonal_steps() {
                 let c = Point::new(-17, 33);
                 let start = Point::new(c.x + x, c.y + y);
                 let mut arc = ArcInterp::new(start, c, start, rotation, Classic).unwrap();
-                let w = trace(&mut arc, start, Classic);
+                let w = trace(&mut arc, start, c, Classic);
                 assert_eq!(w.len(), 8 * r as usize, "classic r {r}");
                 check_arc(&w, start, c, start, rotation, Classic);
 
                 let mut arc = ArcInterp::new(start, c, start, rotation, Diagonal).unwrap();
-                let w = trace(&mut arc, start, Diagonal);
+                let w = trace(&mut arc, start, c, Diagonal);
                 let analytic = 4.0 * SQRT_2 * r as f64;
                 assert!((w.len() as f64 - analytic).abs() <= 4.0, "diagonal r {r}: {} vs {analytic}", w.len());
                 assert_eq!(w.last(), start);
@@ -223,7 +223,7 @@ fn arcs_across_quadrants_end_on_their_end_points() {
         for method in [Classic, Diagonal] {
             let (start, end) = (Point::new(sx, sy), Point::new(ex, ey));
             let mut arc = ArcInterp::new(start, Point::ORIGIN, end, rotation, method).unwrap();
-            let w = trace(&mut arc, start, method);
+            let w = trace(&mut arc, start, Point::ORIGIN, method);
             check_arc(&w, start, Point::ORIGIN, end, rotation, method);
             assert_eq!(w.tail_len(), 0, "end on the circle is on the path");
         }
@@ -270,11 +270,11 @@ fn tiny_radii_and_every_tolerated_end_terminate_exactly() {
 fn a_radius_of_one_goes_around_the_centre_not_through_it() {
     let s = Point::new(1, 0);
     let mut arc = ArcInterp::new(s, Point::ORIGIN, s, Ccw, Classic).unwrap();
-    let w = trace(&mut arc, s, Classic);
+    let w = trace(&mut arc, s, Point::ORIGIN, Classic);
     assert_eq!(w.len(), 8);
     assert!(!w.points.contains(&Point::ORIGIN));
     let mut arc = ArcInterp::new(s, Point::ORIGIN, Point::new(0, 1), Ccw, Classic).unwrap();
-    assert_eq!(trace(&mut arc, s, Classic).len(), 2);
+    assert_eq!(trace(&mut arc, s, Point::ORIGIN, Classic).len(), 2);
 }
 
 #[test]
@@ -282,10 +282,7 @@ fn bad_arcs_are_refused() {
     let p = Point::new(10, 0);
     assert_eq!(ArcInterp::new(p, p, p, Ccw, Classic).err(), Some(ArcError::ZeroRadius));
     assert_eq!(ArcInterp::new(p, Point::ORIGIN, Point::new(0, 13), Ccw, Classic).err(), Some(ArcError::EndOffCurve));
-    assert_eq!(
-        ArcInterp::new(p, Point::ORIGIN, Point::new(0, 12), Ccw, Classic).map(|a| a.end()),
-        Ok(Point::new(0, 12))
-    );
+    assert!(ArcInterp::new(p, Point::ORIGIN, Point::new(0, 12), Ccw, Classic).is_ok());
     assert_eq!(ArcInterp::new(p, Point::ORIGIN, Point::ORIGIN, Ccw, Classic).err(), Some(ArcError::EndOffCurve));
     let far = Point::new(MAX_RADIUS_STEPS + 1, 0);
     assert_eq!(ArcInterp::new(far, Point::ORIGIN, far, Ccw, Classic).err(), Some(ArcError::TooLarge));
@@ -294,87 +291,6 @@ fn bad_arcs_are_refused() {
         ArcInterp::new(corner, Point::new(i32::MAX, i32::MIN), corner, Cw, Diagonal).err(),
         Some(ArcError::TooLarge)
     );
-    assert_eq!(ArcInterp::from_angles(p, 0, 0.0, 1.0, Classic).err(), Some(ArcError::ZeroRadius));
-    assert_eq!(ArcInterp::from_angles(p, -5, 0.0, 1.0, Classic).err(), Some(ArcError::ZeroRadius));
-    assert_eq!(ArcInterp::from_angles(p, 5, f32::NAN, 1.0, Classic).err(), Some(ArcError::NotFinite));
-    assert_eq!(ArcInterp::from_angles(p, 5, 0.0, f32::INFINITY, Classic).err(), Some(ArcError::NotFinite));
-    assert_eq!(ArcInterp::from_angles(p, MAX_RADIUS_STEPS + 1, 0.0, 1.0, Classic).err(), Some(ArcError::TooLarge));
-    let edge = Point::new(i32::MAX - 5, 0);
-    assert_eq!(ArcInterp::from_angles(edge, 100, PI as f32, 1.0, Classic).err(), Some(ArcError::TooLarge));
-}
-
-#[test]
-fn from_angles_draws_what_the_menu_asks_for() {
-    let pen = Point::new(1000, -2000);
-    // Quarter turn counter-clockwise from angle 0: centre 50 to the left, end above it.
-    let mut arc = ArcInterp::from_angles(pen, 50, 0.0, core::f32::consts::FRAC_PI_2, Classic).unwrap();
-    assert_eq!(arc.center(), Point::new(950, -2000));
-    assert_eq!(arc.end(), Point::new(950, -1950));
-    assert_eq!(arc.rotation(), Ccw);
-    assert_eq!(trace(&mut arc, pen, Classic).len(), 100);
-    // Negative sweep turns clockwise: from the top of the circle to its right end.
-    let mut arc =
-        ArcInterp::from_angles(pen, 50, core::f32::consts::FRAC_PI_2, -core::f32::consts::FRAC_PI_2, Diagonal).unwrap();
-    assert_eq!((arc.center(), arc.end(), arc.rotation()), (Point::new(1000, -2050), Point::new(1050, -2050), Cw));
-    let w = trace(&mut arc, pen, Diagonal);
-    check_arc(&w, pen, arc.center(), arc.end(), Cw, Diagonal);
-    // A full turn, and more than one, returns to the pen after 8R classic steps.
-    for sweep in [TAU as f32, -TAU as f32, 10.0] {
-        let mut arc = ArcInterp::from_angles(pen, 50, 0.0, sweep, Classic).unwrap();
-        assert_eq!(arc.end(), pen);
-        assert_eq!(trace(&mut arc, pen, Classic).len(), 400);
-    }
-    // Nearly a full turn, whose end rounds to the pen: still (almost) a full turn.
-    let mut arc = ArcInterp::from_angles(pen, 50, 0.3, TAU as f32 - 0.001, Diagonal).unwrap();
-    assert!(trace(&mut arc, pen, Diagonal).len() > 250);
-    // Nearly a full turn whose end rounds to just below the pen.
-    let mut arc = ArcInterp::from_angles(pen, 50, 0.0, TAU as f32 - 0.015, Classic).unwrap();
-    assert_eq!(arc.end(), Point::new(1000, -2001));
-    assert_eq!(trace(&mut arc, pen, Classic).len(), 399);
-    // Shorter than a step: nothing to do.
-    let mut arc = ArcInterp::from_angles(pen, 50, 0.0, 0.001, Classic).unwrap();
-    assert_eq!(arc.next_step(), Ok(None));
-    let mut arc = ArcInterp::from_angles(pen, 50, 0.0, 0.0, Diagonal).unwrap();
-    assert_eq!(arc.next_step(), Ok(None));
-}
-
-#[test]
-fn rounding_never_turns_a_short_arc_into_a_long_one_or_back() {
-    // Sweeps of a few steps, and a few steps short of a full turn, from many start angles:
-    // the rounded ends may fall on either side of the rounded start, the trace still
-    // sweeps what was asked.
-    let pen = Point::new(40, -40);
-    for radius in [3, 10, 50] {
-        let full = 8 * radius as usize;
-        for k in 0..200 {
-            let a0 = k as f32 * 0.0317;
-            for steps in [0.3f32, 0.8, 1.5, 3.0] {
-                let sweep = steps / radius as f32;
-                for (s, method) in [
-                    (sweep, Classic),
-                    (-sweep, Diagonal),
-                    (TAU as f32 - sweep, Classic),
-                    (sweep - TAU as f32, Diagonal),
-                ] {
-                    let mut arc = ArcInterp::from_angles(pen, radius, a0, s, method).unwrap();
-                    let end = arc.end();
-                    let w = trace(&mut arc, pen, method);
-                    assert_eq!(w.last(), end);
-                    if s.abs() < PI as f32 {
-                        let most = libm::ceil(steps as f64 * SQRT_2) as usize + 4;
-                        assert!(w.len() <= most, "r {radius} from {a0} sweep {s}: {} steps", w.len());
-                    } else {
-                        let turn = if method == Classic { full as f64 } else { full as f64 / SQRT_2 };
-                        assert!(
-                            (w.len() as f64 - turn).abs() <= 10.0,
-                            "r {radius} from {a0} sweep {s}: {} steps",
-                            w.len()
-                        );
-                    }
-                }
-            }
-        }
-    }
 }
 
 #[test]
@@ -422,19 +338,20 @@ fn the_largest_circles_do_not_overflow() {
     for (start, center, end, rotation) in cases {
         for method in [Classic, Diagonal] {
             let mut arc = ArcInterp::new(start, center, end, rotation, method).unwrap();
-            let w = trace(&mut arc, start, method);
+            let w = trace(&mut arc, start, center, method);
             check_arc(&w, start, center, end, rotation, method);
         }
     }
     // The full circle of radius 100_000 from an axis: exactly 8R classic steps, 4·√2·R ± 4
     // diagonal ones; the quarter at the limit exactly 2R classic steps.
     let s = Point::new(100_000, 0);
-    let n = |method| trace(&mut ArcInterp::new(s, Point::ORIGIN, s, Ccw, method).unwrap(), s, method).len();
+    let n =
+        |method| trace(&mut ArcInterp::new(s, Point::ORIGIN, s, Ccw, method).unwrap(), s, Point::ORIGIN, method).len();
     assert_eq!(n(Classic), 800_000);
     assert!((n(Diagonal) as f64 - 400_000.0 * SQRT_2).abs() <= 4.0);
     let (s, e) = (Point::new(0, -MAX_RADIUS_STEPS), Point::new(MAX_RADIUS_STEPS, 0));
     let mut arc = ArcInterp::new(s, Point::ORIGIN, e, Ccw, Classic).unwrap();
-    assert_eq!(trace(&mut arc, s, Classic).len(), 2 * MAX_RADIUS_STEPS as usize);
+    assert_eq!(trace(&mut arc, s, Point::ORIGIN, Classic).len(), 2 * MAX_RADIUS_STEPS as usize);
 }
 
 proptest! {
@@ -453,7 +370,7 @@ proptest! {
         let r = libm::sqrt((sx * sx + sy * sy) as f64);
         let end = Point::new(cx + libm::round(r * libm::cos(end_angle)) as i32, cy + libm::round(r * libm::sin(end_angle)) as i32);
         let mut arc = ArcInterp::new(start, c, end, rotation, method).unwrap();
-        let w = trace(&mut arc, start, method);
+        let w = trace(&mut arc, start, c, method);
         check_arc(&w, start, c, end, rotation, method);
     }
 
@@ -466,70 +383,30 @@ proptest! {
         let (method, rotation) = (if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
         let start = Point::new(sx, sy);
         let mut full = ArcInterp::new(start, Point::ORIGIN, start, rotation, method).unwrap();
-        let circle = trace(&mut full, start, method);
+        let circle = trace(&mut full, start, Point::ORIGIN, method);
         prop_assert_eq!(circle.last(), start);
         prop_assert_eq!(circle.tail_len(), 0);
         let k = 1 + ((circle.len() - 2) as f64 * pick) as usize;
         let end = circle.points[k];
         prop_assume!(cross(offset(start, Point::ORIGIN), offset(end, Point::ORIGIN)) != 0);
         let mut arc = ArcInterp::new(start, Point::ORIGIN, end, rotation, method).unwrap();
-        let w = trace(&mut arc, start, method);
+        let w = trace(&mut arc, start, Point::ORIGIN, method);
         prop_assert_eq!(&w.points[..], &circle.points[..=k]);
-    }
-
-    /// Arcs given by angles, as the keypad and serial commands give them.
-    #[test]
-    fn arcs_from_angles_sweep_what_was_asked(
-        px in -100_000i32..100_000, py in -100_000i32..100_000, radius in 1i32..400,
-        start_angle in -7.0f32..7.0, sweep in -7.0f32..7.0, classic: bool,
-    ) {
-        let method = if classic { Classic } else { Diagonal };
-        let pen = Point::new(px, py);
-        let mut arc = ArcInterp::from_angles(pen, radius, start_angle, sweep, method).unwrap();
-        let (c, end, rotation) = (arc.center(), arc.end(), arc.rotation());
-        prop_assert!((libm::sqrt(r2(pen, c) as f64) - radius as f64).abs() <= 0.71);
-        prop_assert!(off_circle(end, c, pen) <= 0.71);
-        let w = trace(&mut arc, pen, method);
-        prop_assert_eq!(w.last(), end);
-        if w.len() == 0 {
-            prop_assert_eq!(end, pen);
-            prop_assert!((sweep.abs() as f64) * radius as f64 <= 1.0);
-        } else if sweep.abs() as f64 >= TAU {
-            prop_assert_eq!(end, pen);
-            check_arc(&w, pen, c, end, rotation, method);
-        } else {
-            // The drawn sweep: the arc's step count against the L1 / L∞ length of the
-            // requested ideal arc.
-            let r = libm::sqrt(r2(pen, c) as f64);
-            let a0 = angle(pen, c);
-            let (s, t) = (sweep as f64, sweep.abs() as f64);
-            let sign = s.signum();
-            let (l1, linf) = ideal_lengths(|u| (r * libm::cos(a0 + sign * u), r * libm::sin(a0 + sign * u)), 0.0, t, 4096);
-            let analytic = if classic { l1 } else { linf };
-            // The rounded end adds up to a step on each axis.
-            let slack = count_slack(axes_crossed(a0, t, sign)) + 2.0;
-            prop_assert!((w.len() as f64 - analytic).abs() <= slack, "{} steps for {} ± {}", w.len(), analytic, slack);
-        }
     }
 
     /// Garbage in never panics and never hangs.
     #[test]
     fn any_input_is_refused_or_drawn(
         s in any::<(i32, i32)>(), c in any::<(i32, i32)>(), e in any::<(i32, i32)>(),
-        radius in any::<i32>(), a0 in any::<f32>(), sweep in any::<f32>(), ccw: bool, classic: bool,
+        ccw: bool, classic: bool,
     ) {
         let (method, rotation) = (if classic { Classic } else { Diagonal }, if ccw { Ccw } else { Cw });
         let (s, c, e) = (Point::new(s.0, s.1), Point::new(c.0, c.1), Point::new(e.0, e.1));
         if let Ok(mut arc) = ArcInterp::new(s, c, e, rotation, method) {
             // Within tolerance only by chance; tiny circles are walked.
             if r2(s, c) < 10_000 {
-                trace(&mut arc, s, method);
+                trace(&mut arc, s, c, method);
             }
         }
-        if let Ok(mut arc) = ArcInterp::from_angles(s, radius.rem_euclid(2000) + 1, a0, sweep, method) {
-            let end = arc.end();
-            prop_assert_eq!(trace(&mut arc, s, method).last(), end);
-        }
-        let _ = ArcInterp::from_angles(s, radius, a0, sweep, method);
     }
 }

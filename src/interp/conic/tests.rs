@@ -180,21 +180,4 @@ proptest! {
             check_same(el, ellipse, &sizes, 100_000);
         }
     }
-
-    /// Curves given by angles (plans between ideal points, rounded ends, empty arcs).
-    #[test]
-    fn curves_from_angles_are_the_same_in_batches(
-        a in 1i32..300, b in 1i32..300, t0 in -7.0f32..7.0, sweep in -7.0f32..7.0,
-        sizes in proptest::collection::vec(prop_oneof![0usize..40, Just(ONE_BY_NEXT_STEP)], 1..6), classic: bool,
-    ) {
-        let method = if classic { Classic } else { Diagonal };
-        prop_assume!(sizes.iter().any(|&n| n > 0));
-        let pen = Point::new(1234, -4321);
-        if let Ok(arc) = ArcInterp::from_angles(pen, a, t0, sweep, method) {
-            check_same(arc, self::arc, &sizes, 100_000);
-        }
-        if let Ok(el) = EllipseInterp::from_angles(pen, a, b, t0, sweep, method) {
-            check_same(el, ellipse, &sizes, 100_000);
-        }
-    }
 }

@@ -172,7 +172,7 @@ fn motion_mode_and_feed_are_modal() {
     assert_eq!(g.motion_mode(), MotionMode::Linear);
     // A move that ends on its own step hands out nothing but is still planned.
     assert_eq!(run(&mut g, "X3.004"), Ok(Vec::new()));
-    assert_eq!(g.planned_position_mm(), [3.004, 0.0]);
+    assert_eq!(g.position_mm, [3.004, 0.0]);
 }
 
 #[test]
@@ -435,7 +435,7 @@ fn changing_steps_per_mm_keeps_the_pen_on_its_step() {
     assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::SetSetting { id: 100, value: 80.0 }]);
     s.set(100, 80.0).unwrap();
     assert_eq!(g.planned_position(), Point::new(1000, 0));
-    assert_eq!(g.planned_position_mm(), [12.5, 0.0]);
+    assert_eq!(g.position_mm, [12.5, 0.0]);
     let cmds = g.execute("G91 G0 X1", &s, RunState::Idle).unwrap();
     let from = Point::new(1000, 0);
     let drawing = crate::drawing::build(&Request::Line { to: Point::new(1080, 0) }, from, &s).unwrap().unwrap();
@@ -454,7 +454,7 @@ fn restoring_defaults() {
     let cmds = g.execute("$RST=$", &s, RunState::Idle).unwrap();
     assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::RestoreSettings]);
     // Still on step 500, now 5 mm at the default 100 steps/mm.
-    assert_eq!(g.planned_position_mm(), [5.0, 0.0]);
+    assert_eq!(g.position_mm, [5.0, 0.0]);
 }
 
 #[test]
