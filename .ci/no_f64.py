@@ -8,8 +8,9 @@ the image is free of f64 arithmetic exactly when none of those routines is linke
 lists every one that is.
 """
 import re
-import struct
 import sys
+
+from elf import functions
 
 # The soft-float f64 routines of the ARM EABI and of compiler-builtins.
 F64_ROUTINE = re.compile(
@@ -19,27 +20,8 @@ F64_ROUTINE = re.compile(
 )
 
 
-def function_symbols(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    if data[:4] != b"\x7fELF" or data[4] != 1:
-        sys.exit(f"{path}: not a 32-bit ELF file")
-    shoff, = struct.unpack_from("<I", data, 0x20)
-    shentsize, shnum = struct.unpack_from("<HH", data, 0x2E)
-    headers = [struct.unpack_from("<IIIIIIIIII", data, shoff + i * shentsize) for i in range(shnum)]
-    for _, typ, _, _, off, size, link, _, _, entsize in headers:
-        if typ != 2:  # SHT_SYMTAB
-            continue
-        strtab = headers[link][4]
-        for i in range(size // entsize):
-            name, _, _, info, _, _ = struct.unpack_from("<IIIBBH", data, off + i * entsize)
-            if info & 0xF == 2:  # STT_FUNC
-                end = data.index(b"\0", strtab + name)
-                yield data[strtab + name:end].decode(errors="replace")
-
-
 def main():
-    found = sorted({s for s in function_symbols(sys.argv[1]) if F64_ROUTINE.match(s)})
+    found = sorted({name for _, _, name in functions(sys.argv[1]) if F64_ROUTINE.match(name)})
     if found:
         print(f"f64 arithmetic in {sys.argv[1]}: {len(found)} soft-float routines linked:")
         for s in found:

@@ -1,25 +1,12 @@
 #!/usr/bin/env python3
 """Prints the flash and static RAM a firmware ELF image uses, from its section headers; with
 --max-flash-kib N, fails when the flash used is above N KiB."""
-import struct
 import sys
+
+from elf import sections
 
 FLASH = (0x08000000, 1024 * 1024)
 RAM = (0x20000000, 128 * 1024)
-
-
-def sections(path):
-    with open(path, "rb") as f:
-        data = f.read()
-    if data[:4] != b"\x7fELF" or data[4] != 1:
-        sys.exit(f"{path}: not a 32-bit ELF file")
-    shoff, = struct.unpack_from("<I", data, 0x20)
-    shentsize, shnum, shstrndx = struct.unpack_from("<HHH", data, 0x2E)
-    headers = [struct.unpack_from("<IIIIIIIIII", data, shoff + i * shentsize) for i in range(shnum)]
-    strtab = headers[shstrndx]
-    for name, typ, flags, addr, off, size, *_ in headers:
-        end = data.index(b"\0", strtab[4] + name)
-        yield data[strtab[4] + name:end].decode(), typ, flags, addr, size
 
 
 def main():

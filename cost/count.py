@@ -13,11 +13,13 @@ and turns the instruction counts between the harness's marks into per-step figur
 """
 import argparse
 import os
-import struct
 import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+# The ELF reader the firmware checks use.
+sys.path.insert(0, os.path.join(HERE, "..", ".ci"))
+from elf import functions  # noqa: E402
 TARGET = "thumbv7em-none-eabihf"
 ELF = os.path.join(HERE, "..", "target", TARGET, "release", "servoplot-cost")
 PLUGIN_SRC = os.path.join(HERE, "plugin", "insn_count.c")
@@ -62,26 +64,6 @@ def build():
     subprocess.run(["cargo", "build", "--release", "--locked", "--quiet"], cwd=HERE, check=True)
 
 
-def symbols(path):
-    """(address, size, name) of every function in an ELF32 file, Thumb bit cleared."""
-    with open(path, "rb") as f:
-        data = f.read()
-    shoff, = struct.unpack_from("<I", data, 0x20)
-    shentsize, shnum = struct.unpack_from("<HH", data, 0x2E)
-    headers = [struct.unpack_from("<IIIIIIIIII", data, shoff + i * shentsize) for i in range(shnum)]
-    out = []
-    for _, typ, _, _, off, size, link, _, _, entsize in headers:
-        if typ != 2:  # SHT_SYMTAB
-            continue
-        strtab = headers[link][4]
-        for i in range(size // entsize):
-            name, value, sym_size, info, _, _ = struct.unpack_from("<IIIBBH", data, off + i * entsize)
-            if info & 0xF == 2:  # STT_FUNC
-                end = data.index(b"\0", strtab + name)
-                out.append((value & ~1, sym_size, data[strtab + name:end].decode(errors="replace")))
-    return out
-
-
 def demangle(name):
     """Readable form of a legacy-mangled Rust name (`_ZN...E`); other names as they are."""
     if not name.startswith("_ZN"):
@@ -104,7 +86,7 @@ def demangle(name):
 
 
 def run(only, profile):
-    syms = symbols(ELF)
+    syms = functions(ELF)
     mark = next(addr for addr, _, name in syms if name == "cost_mark")
     log = os.path.join(os.path.dirname(PLUGIN), "counts.txt")
     plugin = f"{PLUGIN},mark={mark:#x}" + (",profile=on" if profile else "")

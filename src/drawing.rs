@@ -308,33 +308,24 @@ pub fn build(request: &Request, start: Point, settings: &Settings) -> Result<Opt
     {
         return Err(DrawError::Travel);
     }
-    let x0_mm = match request {
-        Request::Function { x0_mm, .. } => *x0_mm,
-        _ => 0.0,
-    };
-    checked(shape, ideal, x0_mm, start, settings).map(Some)
+    checked(shape, ideal, start, settings).map(Some)
 }
 
 /// A drawing of a shape already in steps (a benchmark's, say), checked as [`build`] checks a
 /// request's, but for the ideal box, which a shape does not give.
 pub fn from_shape(shape: Shape, start: Point, settings: &Settings) -> Result<Drawing, DrawError> {
+    checked(shape, None, start, settings)
+}
+
+/// Sets the curve up, traces it, and checks its lattice path against the ideal box (where
+/// known) and the travel.
+fn checked(shape: Shape, ideal: Option<IdealBox>, start: Point, settings: &Settings) -> Result<Drawing, DrawError> {
+    let curve = Curve::new(&shape, start, settings)?;
+    // Where a function's x starts, for the x of its errors.
     let x0_mm = match &shape {
         Shape::Function { x0_mm, .. } => *x0_mm,
         _ => 0.0,
     };
-    checked(shape, None, x0_mm, start, settings)
-}
-
-/// Sets the curve up, traces it, and checks its lattice path against the ideal box (where
-/// known) and the travel. `x0_mm` is where a function's x starts, for its errors.
-fn checked(
-    shape: Shape,
-    ideal: Option<IdealBox>,
-    x0_mm: f32,
-    start: Point,
-    settings: &Settings,
-) -> Result<Drawing, DrawError> {
-    let curve = Curve::new(&shape, start, settings)?;
     let (end, bounds, steps) = trace(&curve, start).map_err(|(at, error)| match error {
         // The ideal curve is inside the travel, its lattice path is not: it strays from the
         // curve.

@@ -481,13 +481,7 @@ fn drawings() -> Vec<SameDrawing> {
             .iter()
             .enumerate()
     {
-        let mut g = format!("$O R{r}");
-        if !s.is_empty() {
-            g += &format!(" S{s}");
-        }
-        if !w.is_empty() {
-            g += &format!(" W{w}");
-        }
+        let g = with_angles(format!("$O R{r}"), s, w);
         all.push(from_start(
             starts[k % starts.len()],
             format!("circle R {r} S {s:?} W {w:?}"),
@@ -506,13 +500,7 @@ fn drawings() -> Vec<SameDrawing> {
     .iter()
     .enumerate()
     {
-        let mut g = format!("$E A{a} B{b}");
-        if !s.is_empty() {
-            g += &format!(" S{s}");
-        }
-        if !w.is_empty() {
-            g += &format!(" W{w}");
-        }
+        let g = with_angles(format!("$E A{a} B{b}"), s, w);
         all.push(from_start(
             starts[k % starts.len()],
             format!("ellipse A {a} B {b} S {s:?} W {w:?}"),
@@ -573,6 +561,18 @@ fn drawings() -> Vec<SameDrawing> {
 
 /// Every curve the keypad offers, typed on the keypad and sent as G-code from the same point:
 /// the same steps in the same order (timing aside).
+/// A `$O`/`$E` command with its S and W words, where typed (an empty field is the default).
+fn with_angles(command: String, start: &str, sweep: &str) -> String {
+    let mut g = command;
+    if !start.is_empty() {
+        g += &format!(" S{start}");
+    }
+    if !sweep.is_empty() {
+        g += &format!(" W{sweep}");
+    }
+    g
+}
+
 #[test]
 fn keypad_and_gcode_draw_the_same_steps() {
     let mut failures = Vec::new();

@@ -355,11 +355,6 @@ impl GcodeState {
     }
 }
 
-/// Machine millimetres to the nearest step; `None` for a target no lattice point is near.
-fn to_steps(settings: &Settings, mm: [f32; 2]) -> Option<Point> {
-    drawing::line_target(mm, settings)
-}
-
 impl GcodeState {
     /// Builds `request` from the planned position and plans the pen at its end: `target_mm`
     /// (the G-code target, kept in millimetres so relative moves never drift by rounding) when
@@ -381,7 +376,7 @@ impl GcodeState {
         };
         let end = drawing.end();
         self.position_mm = match target_mm {
-            Some(target) if to_steps(settings, target) == Some(end) => target,
+            Some(target) if drawing::line_target(target, settings) == Some(end) => target,
             _ => [settings.steps_to_mm(Axis::X, end.x), settings.steps_to_mm(Axis::Y, end.y)],
         };
         self.position = end;

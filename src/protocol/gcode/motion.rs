@@ -6,9 +6,9 @@ use core::f32::consts::TAU;
 use super::words::{Block, NonModal, ProgramStop};
 use super::{
     ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM, Command, Commands,
-    DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle, to_steps,
+    DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
 };
-use crate::drawing::{EllipseParams, Request};
+use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
@@ -168,7 +168,7 @@ impl GcodeState {
 
     /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
     fn line(&mut self, target_mm: [f32; 2], feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
-        let to = to_steps(settings, target_mm).ok_or(GrblError::TravelExceeded)?;
+        let to = drawing::line_target(target_mm, settings).ok_or(GrblError::TravelExceeded)?;
         self.draw(Request::Line { to }, feed, JobKind::Draw, Some(target_mm), settings)
     }
 

@@ -2,8 +2,8 @@
 //! commands are handed on to [`super::curves`].
 
 use super::words::{Group, NonModal, compact, parse_block, parse_number};
-use super::{Command, Commands, Distance, GcodeState, Report, to_steps};
-use crate::drawing::Request;
+use super::{Command, Commands, Distance, GcodeState, Report};
+use crate::drawing::{self, Request};
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
 use crate::settings::{SettingError, Settings};
@@ -146,7 +146,7 @@ impl GcodeState {
                 };
             }
         }
-        let to = to_steps(settings, target).ok_or(GrblError::TravelExceeded)?;
+        let to = drawing::line_target(target, settings).ok_or(GrblError::TravelExceeded)?;
         let jog = self.draw(Request::Line { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
         Ok(jog.map(Commands::one).unwrap_or_default())
     }
