@@ -101,10 +101,13 @@ pub fn main() -> ExitCode {
     init_log();
     let args = match parse_args() {
         Ok(a) => a,
+        // `--help` asked for the usage: it goes to standard output and is no error.
+        Err(e) if e.is_empty() => {
+            std::println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
         Err(e) => {
-            if !e.is_empty() {
-                eprintln!("error: {e}");
-            }
+            eprintln!("error: {e}");
             eprintln!("{USAGE}");
             return ExitCode::from(2);
         }
