@@ -36,10 +36,6 @@ pub struct Job {
     pub drawing: Drawing,
     pub feed: Feed,
     pub kind: JobKind,
-    /// Aborts the machine had counted when the job was planned (`Machine::aborts`): a job
-    /// planned before an abort was planned from a point the pen never reached, and the motion
-    /// task drops it.
-    pub aborts_before: u32,
 }
 
 /// Run-time commands that act on the motion in progress. Requests that arrive before the motion
@@ -69,19 +65,13 @@ impl Control {
 impl Job {
     /// A drawing job.
     pub const fn draw(drawing: Drawing, feed: Feed) -> Job {
-        Job { drawing, feed, kind: JobKind::Draw, aborts_before: 0 }
+        Job { drawing, feed, kind: JobKind::Draw }
     }
 
     /// A jog: a straight move from `from` to `to`; `None` when it goes nowhere.
     pub fn jog_to(from: Point, to: Point, feed: Feed, settings: &Settings) -> Result<Option<Job>, DrawError> {
         let drawing = drawing::build(&Request::Line { to }, from, settings)?;
-        Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog, aborts_before: 0 }))
-    }
-
-    /// The same job, planned after `aborts` aborts.
-    pub const fn planned_after(mut self, aborts: u32) -> Job {
-        self.aborts_before = aborts;
-        self
+        Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog }))
     }
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a

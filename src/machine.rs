@@ -5,12 +5,18 @@
 //! slot (inputs → motion), the counters of the step queue (the queue itself, motion → pulses,
 //! is a lock-free single-producer single-consumer ring owned by its two ends), the position
 //! counters (written only by the pulse engine) and a change signal that wakes the LCD.
+//!
+//! The machine also owns the rule that keeps the inputs' planned positions true: a job is
+//! planned from where the jobs before it end, and an abort drops those. Every job is handed
+//! over with the [`PlanEpoch`] it was planned in; an abort starts a new epoch, and a job from
+//! an earlier one is refused ([`Stale`]) or, if it was queued already, dropped.
 //! Everything here is shared across priorities: every lock is a critical section that only
 //! copies a value in or out, and every counter has a single writer.
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
 
+use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
@@ -34,25 +40,46 @@ pub const STEP_QUEUE_MAX_US: u32 = 20_000;
 /// The same in pulse timer ticks.
 pub const STEP_QUEUE_MAX_TICKS: u32 = STEP_QUEUE_MAX_US * (TICK_HZ / 1_000_000);
 
+/// The aborts counted when a position was planned: positions planned in an earlier epoch lead
+/// from points the pen never reached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct PlanEpoch(u32);
+
+/// A job planned in an earlier [`PlanEpoch`]: an abort came, and it is not queued.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct Stale;
+
+/// Why [`Machine::try_submit`] did not queue a job.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Refused {
+    /// The job queue is full.
+    Full,
+    /// See [`Stale`].
+    Stale,
+}
+
 /// Everything the tasks share.
 pub struct Machine {
-    pub jobs: Channel<CriticalSectionRawMutex, Job, JOB_QUEUE_LEN>,
+    /// Jobs handed over, each with the epoch it was planned in.
+    jobs: Channel<CriticalSectionRawMutex, (PlanEpoch, Job), JOB_QUEUE_LEN>,
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
     /// Wakes the motion task when a control is requested.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
     /// Wakes the LCD task after anything it shows may have changed.
-    pub changed: Signal<CriticalSectionRawMutex, ()>,
+    changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
-    pub faults: Signal<CriticalSectionRawMutex, MotionFault>,
-    /// Counts aborts (a control, a curve stopped part way): jobs planned before one were
-    /// planned from a point the pen may never reach.
+    faults: Signal<CriticalSectionRawMutex, MotionFault>,
+    /// Counts aborts (a control, a curve stopped part way): the current [`PlanEpoch`].
     aborts: AtomicU32,
     /// Wakes whoever waits to hand over a job when an abort happens.
-    pub aborted: Signal<CriticalSectionRawMutex, ()>,
+    aborted: Signal<CriticalSectionRawMutex, ()>,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
-    pub pulses_done: Signal<CriticalSectionRawMutex, ()>,
+    pulses_done: Signal<CriticalSectionRawMutex, ()>,
     menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
     /// Pulses emitted (written only by the pulse engine).
     position: [AtomicI32; 2],
@@ -182,6 +209,21 @@ impl Machine {
         self.changed.signal(());
     }
 
+    /// Waits until the pulse engine next reports that it stopped.
+    pub async fn until_pulses_stopped(&self) {
+        self.pulses_done.wait().await
+    }
+
+    /// Waits until anything a display shows may have changed.
+    pub async fn changed(&self) {
+        self.changed.wait().await
+    }
+
+    /// Waits for the next fault (a curve stopped part way), for the host link.
+    pub async fn next_fault(&self) -> MotionFault {
+        self.faults.wait().await
+    }
+
     /// True when no step is queued or being emitted.
     pub fn pulses_idle(&self) -> bool {
         self.queued_steps.load(Ordering::Acquire) == self.emitted_steps.load(Ordering::Acquire)
@@ -215,7 +257,7 @@ impl Machine {
         Status {
             state: self.run_state(),
             position: self.position(),
-            queued_jobs: self.jobs.len() as u8,
+            queued_jobs: self.queued_jobs() as u8,
             fault: self.fault(),
             underruns: self.underruns(),
         }
@@ -257,15 +299,66 @@ impl Machine {
         self.changed.signal(());
     }
 
-    /// Counts an abort: what was planned is dropped. Only the motion task calls this.
-    pub fn note_abort(&self) {
-        self.aborts.fetch_add(1, Ordering::AcqRel);
-        self.aborted.signal(());
+    /// The epoch positions are planned in now: until the next abort, a job planned from the
+    /// end of the jobs before it starts where the pen will be.
+    pub fn plan_epoch(&self) -> PlanEpoch {
+        PlanEpoch(self.aborts.load(Ordering::Acquire))
     }
 
-    /// Aborts so far: when this changes, positions planned before it are stale.
-    pub fn aborts(&self) -> u32 {
-        self.aborts.load(Ordering::Acquire)
+    /// Hands `job`, planned in `epoch`, to the motion task, waiting for room. An abort before
+    /// or while it waits refuses it: it was planned from a point the pen will not reach.
+    pub async fn submit(&self, job: Job, epoch: PlanEpoch) -> Result<(), Stale> {
+        let mut send = core::pin::pin!(self.jobs.send((epoch, job)));
+        loop {
+            if self.plan_epoch() != epoch {
+                return Err(Stale);
+            }
+            match select(send.as_mut(), self.aborted.wait()).await {
+                Either::First(()) => break,
+                Either::Second(()) => continue,
+            }
+        }
+        // Queued just as an abort came, the motion task drops it.
+        if self.plan_epoch() != epoch { Err(Stale) } else { Ok(()) }
+    }
+
+    /// Hands `job`, planned in `epoch`, to the motion task if there is room now.
+    pub fn try_submit(&self, job: Job, epoch: PlanEpoch) -> Result<(), Refused> {
+        if self.plan_epoch() != epoch {
+            return Err(Refused::Stale);
+        }
+        self.jobs.try_send((epoch, job)).map_err(|_| Refused::Full)
+    }
+
+    /// Jobs handed over and not yet taken by the motion task.
+    pub fn queued_jobs(&self) -> usize {
+        self.jobs.len()
+    }
+
+    /// Waits until a job is queued (it may already be). For the motion task.
+    pub async fn job_ready(&self) {
+        self.jobs.ready_to_receive().await
+    }
+
+    /// The next job queued in the current epoch, dropping those planned before an abort (their
+    /// senders were refused, or the abort's message covers them). Only the motion task calls
+    /// this.
+    pub fn next_job(&self) -> Option<Job> {
+        loop {
+            let (epoch, job) = self.jobs.try_receive().ok()?;
+            if epoch == self.plan_epoch() {
+                return Some(job);
+            }
+            warn!("job planned before an abort dropped");
+        }
+    }
+
+    /// An abort: drops every queued job and starts a new epoch, so that jobs planned before it
+    /// are refused. Only the motion task calls this, once its planner has dropped its plan.
+    pub fn abort_plan(&self) {
+        while self.jobs.try_receive().is_ok() {}
+        self.aborts.fetch_add(1, Ordering::AcqRel);
+        self.aborted.signal(());
     }
 
     /// Whether the planner holds anything. Only the motion task calls this.

@@ -61,7 +61,7 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
     let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}, servoplot::tasks::motion::RealTime));
-    if machine.jobs.try_send(job).is_err() {
+    if machine.try_submit(job, machine.plan_epoch()).is_err() {
         panic!("job queue");
     }
     let waker = noop_waker();

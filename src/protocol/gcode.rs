@@ -380,7 +380,7 @@ impl GcodeState {
             _ => [settings.steps_to_mm(Axis::X, end.x), settings.steps_to_mm(Axis::Y, end.y)],
         };
         self.position = end;
-        Ok(Some(Command::Job(Job { drawing, feed, kind, aborts_before: 0 })))
+        Ok(Some(Command::Job(Job { drawing, feed, kind })))
     }
 }
 

@@ -66,7 +66,8 @@ fn act(machine: &Machine, action: MenuAction) {
 }
 
 fn queue(machine: &Machine, job: Job) {
-    if machine.jobs.try_send(job.planned_after(machine.aborts())).is_err() {
+    // Planned from the pen as it stands now: the current epoch.
+    if machine.try_submit(job, machine.plan_epoch()).is_err() {
         // The menu starts jobs only while the machine is idle, so this is a full queue from the
         // host link: the keypad job is refused, visibly, rather than waiting unseen.
         refuse(machine, UiError::Busy);

@@ -91,6 +91,6 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
             shown = Some(view);
             Timer::after(Duration::from_millis(LCD_FRAME_MIN_MS)).await;
         }
-        select(machine.changed.wait(), Timer::after(Duration::from_millis(LCD_POLL_MS))).await;
+        select(machine.changed(), Timer::after(Duration::from_millis(LCD_POLL_MS))).await;
     }
 }

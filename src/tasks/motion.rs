@@ -85,13 +85,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             apply(machine, &mut planner, control);
         }
         while !planner.is_full() {
-            let Ok(job) = machine.jobs.try_receive() else { break };
-            if job.aborts_before != machine.aborts() {
-                // Planned before an abort, from where the dropped plan would have ended; its
-                // sender was told (`error:9`) or the abort's message covers it.
-                warn!("job planned before an abort dropped");
-                continue;
-            }
+            let Some(job) = machine.next_job() else { break };
             let settings = machine.settings();
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
@@ -135,7 +129,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                     PlannerState::Idle => {
                         // Everything planned is queued: rest once it has been emitted.
                         while !machine.pulses_idle() {
-                            machine.pulses_done.wait().await;
+                            machine.until_pulses_stopped().await;
                         }
                         if machine.run_state() != RunState::Idle {
                             info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
@@ -216,7 +210,7 @@ async fn wait_for_work(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGME
     if planner.is_full() {
         machine.control_requested().await;
     } else {
-        match select(machine.jobs.ready_to_receive(), machine.control_requested()).await {
+        match select(machine.job_ready(), machine.control_requested()).await {
             Either::First(()) | Either::Second(()) => {}
         }
     }
@@ -235,6 +229,5 @@ fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, cont
 /// positions planned so far are stale.
 fn abort(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>) {
     planner.abort();
-    while machine.jobs.try_receive().is_ok() {}
-    machine.note_abort();
+    machine.abort_plan();
 }

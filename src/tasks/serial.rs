@@ -22,7 +22,7 @@ use embedded_io_async::{Read, Write};
 use heapless::String;
 
 use crate::job::{Control, Job};
-use crate::machine::{Machine, MotionFault};
+use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::report::REPORT_LINE_MAX_BYTES;
@@ -201,8 +201,9 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
     let mut assembler = LineAssembler::new();
     let mut gcode = GcodeState::new();
     let mut buf = [0u8; SERIAL_CHUNK_BYTES];
-    // Aborts seen: after one, the parser's planned position is stale until the machine stops.
-    let mut aborts_seen = machine.aborts();
+    // The epoch the parser plans in: after an abort, its planned position is stale until the
+    // machine stops.
+    let mut epoch = machine.plan_epoch();
     loop {
         let n = link.bytes.read(&mut buf).await;
         for &byte in &buf[..n] {
@@ -212,7 +213,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 link.machine_stopped().await;
                 link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
-                aborts_seen = machine.aborts();
+                epoch = machine.plan_epoch();
                 link.send(report::welcome).await;
                 continue;
             }
@@ -222,13 +223,13 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
             let result = match assembler.push(byte) {
                 None => continue,
                 Some(LineEvent::Line(line)) => {
-                    if machine.aborts() != aborts_seen {
+                    if machine.plan_epoch() != epoch {
                         // An abort (keypad, jog cancel, a curve stopped part way) dropped what
                         // was planned: plan on from where the pen stops.
                         if link.unless_reset(link.machine_stopped()).await.is_err() {
                             continue;
                         }
-                        aborts_seen = machine.aborts();
+                        epoch = machine.plan_epoch();
                         gcode.sync_position(machine.position(), &machine.settings());
                     }
                     let settings = machine.settings();
@@ -241,7 +242,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         Ok(commands) => {
                             let mut r = Ok(());
                             for command in commands {
-                                r = carry_out(link, &gcode, &settings, command, aborts_seen).await;
+                                r = carry_out(link, &gcode, &settings, command, epoch).await;
                                 if r.is_err() {
                                     break;
                                 }
@@ -268,11 +269,11 @@ async fn carry_out<W: Write>(
     gcode: &GcodeState,
     settings: &Settings,
     command: Command,
-    planned_after: u32,
+    epoch: PlanEpoch,
 ) -> Result<(), Unfinished> {
     let machine = link.machine;
     match command {
-        Command::Job(job) => queue(link, job, planned_after).await?,
+        Command::Job(job) => queue(link, job, epoch).await?,
         Command::Dwell { ms } => {
             link.unless_reset(async {
                 link.machine_at_rest().await;
@@ -314,27 +315,13 @@ async fn carry_out<W: Write>(
     Ok(())
 }
 
-/// Hands a job to the motion task, waiting for room: the `ok` goes out once it is queued. A
-/// reset while it waits drops the job silently (the banner follows); an abort while it waits
-/// drops it with `error:9`, since it was planned from a point the pen will not reach.
-/// `planned_after` is the abort count the job was planned after.
-async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Result<(), Unfinished> {
+/// Hands a job, planned in `epoch`, to the motion task, waiting for room: the `ok` goes out
+/// once it is queued. A reset while it waits drops the job silently (the banner follows); an
+/// abort before it is queued drops it with `error:9`, since it was planned from a point the pen
+/// will not reach.
+async fn queue<W: Write>(link: &Link<'_, W>, job: Job, epoch: PlanEpoch) -> Result<(), Unfinished> {
     let feed = job.feed;
-    let send = link.machine.jobs.send(job.planned_after(planned_after));
-    let mut send = core::pin::pin!(send);
-    loop {
-        if link.machine.aborts() != planned_after {
-            return Err(Unfinished::Error(GrblError::Locked));
-        }
-        match link.unless_reset(select(send.as_mut(), link.machine.aborted.wait())).await? {
-            Either::First(()) => break,
-            Either::Second(()) => continue,
-        }
-    }
-    if link.machine.aborts() != planned_after {
-        // Queued just as an abort came: the motion task drops it.
-        return Err(Unfinished::Error(GrblError::Locked));
-    }
+    link.unless_reset(link.machine.submit(job, epoch)).await?.map_err(|Stale| Unfinished::Error(GrblError::Locked))?;
     if let crate::job::Feed::MmPerMin(f) = feed {
         link.feed_mm_per_min.set(f);
     }
@@ -344,7 +331,7 @@ async fn queue<W: Write>(link: &Link<'_, W>, job: Job, planned_after: u32) -> Re
 /// Tells the host when a curve could not start or stopped part way.
 async fn faults<W: Write>(link: &Link<'_, W>) -> ! {
     loop {
-        let fault = link.machine.faults.wait().await;
+        let fault = link.machine.next_fault().await;
         let mut text: String<REPORT_LINE_MAX_BYTES> = String::new();
         let _ = match fault {
             MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}; queued moves dropped", e),
