@@ -120,17 +120,17 @@ fn cases() -> Vec<CurveCase> {
     vec![
         CurveCase {
             what: "line 0°, 50 mm",
-            shape: || Shape::Line { to: Point::new(5_000, 0) },
+            shape: || Shape::Straight { to: Point::new(5_000, 0) },
             ideal: Ideal::Line { dx: 5_000.0, dy: 0.0 },
         },
         CurveCase {
             what: "line 30°, 50 mm",
-            shape: || Shape::Line { to: Point::new(4_330, 2_500) },
+            shape: || Shape::Straight { to: Point::new(4_330, 2_500) },
             ideal: Ideal::Line { dx: l30x, dy: l30y },
         },
         CurveCase {
             what: "line 45°, 50 mm",
-            shape: || Shape::Line { to: Point::new(3_536, 3_536) },
+            shape: || Shape::Straight { to: Point::new(3_536, 3_536) },
             ideal: Ideal::Line { dx: l45x, dy: l45y },
         },
         CurveCase {

@@ -423,7 +423,7 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
             }
             let min = [start.x.min(to.x) as f32, start.y.min(to.y) as f32];
             let max = [start.x.max(to.x) as f32, start.y.max(to.y) as f32];
-            Some((Shape::Line { to: *to }, Some(IdealBox { min, max })))
+            Some((Shape::Straight { to: *to }, Some(IdealBox { min, max })))
         }
         Request::Ellipse(e) => {
             let finite = e.a_mm.is_finite() && e.b_mm.is_finite() && e.start_deg.is_finite();

@@ -92,7 +92,7 @@ fn chain(a: &[Point], b: &[Point]) -> Vec<Point> {
 }
 
 fn line_to(to: Point, at: Point, settings: &Settings) -> Curve {
-    match Curve::new(&Shape::Line { to }, at, settings) {
+    match Curve::new(&Shape::Straight { to }, at, settings) {
         Ok(c) => c,
         Err(e) => panic!("a line to {to:?} was refused: {e:?}"),
     }

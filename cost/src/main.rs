@@ -57,9 +57,9 @@ fn cases() -> [(&'static str, Shape); 10] {
         Err(_) => panic!("expression"),
     };
     [
-        ("line0", Shape::Line { to: Point::new(5_000, 0) }),
-        ("line30", Shape::Line { to: Point::new(4_330, 2_500) }),
-        ("line45", Shape::Line { to: Point::new(3_536, 3_536) }),
+        ("line0", Shape::Straight { to: Point::new(5_000, 0) }),
+        ("line30", Shape::Straight { to: Point::new(4_330, 2_500) }),
+        ("line45", Shape::Straight { to: Point::new(3_536, 3_536) }),
         (
             "circle",
             Shape::Arc {

@@ -98,28 +98,58 @@ fn a_function_that_fails_part_way_is_refused_with_where() {
     }
 }
 
-#[test]
-fn the_guard_stops_a_curve_at_the_edge() {
-    // A curve set up past the builder (as a defect upstream would) stops at the last point
-    // inside the travel.
-    let mut s = settings();
-    s.max_travel_mm = [10.0, 10.0];
-    let shape = Shape::Line { to: Point::new(5_000, 0) };
-    let mut curve = Curve::new(&shape, Point::ORIGIN, &s).unwrap();
-    let mut buf = [Step::new(0, 0); 700];
-    let mut at = Point::ORIGIN;
-    let end = loop {
+/// Every step `curve` hands out in batches of `batch` steps, and how it ended.
+fn run_out(curve: &mut Curve, start: Point, batch: usize) -> (std::vec::Vec<Point>, Result<(), CurveError>) {
+    let mut buf = std::vec![Step::new(0, 0); batch];
+    let mut path = std::vec![start];
+    loop {
         let filled = curve.fill(&mut buf);
         for step in &buf[..filled.steps] {
-            at = at.stepped(*step);
+            path.push(path.last().unwrap().stepped(*step));
         }
         if let Some(end) = filled.end {
-            break end;
+            return (path, end);
         }
-    };
-    assert_eq!(end, Err(CurveError::Travel));
-    assert_eq!(at, Point::new(1_000, 0));
-    assert_eq!(curve.next_step(), Ok(None));
+    }
+}
+
+#[test]
+fn the_guard_stops_a_curve_at_the_edge() {
+    // Curves set up past the builder (as a defect upstream would) on a ±10 mm travel: each
+    // takes the very steps it takes without the limit, up to the last point inside, and stops
+    // there, at the edge, with `Travel`, in batches of any size.
+    let mut s = settings();
+    s.max_travel_mm = [10.0, 10.0];
+    let free = Settings { max_travel_mm: [1_000.0, 1_000.0], ..settings() };
+    let start = Point::new(300, -200);
+    let shapes = [
+        Shape::Straight { to: Point::new(5_000, 0) },
+        Shape::Straight { to: Point::new(-4_000, -3_000) },
+        // 15 mm amplitude: its first crest is 3 mm beyond the edge.
+        Shape::Sine { amplitude_steps: 1_500.0, omega_rad_per_step: 0.002, phase_rad: 0.0, length_steps: 1_500 },
+        // y = x² rises 2 mm per mm at x = 1: it leaves the top at x ≈ 3.5 mm.
+        Shape::Function { expr: crate::expr::parse("x^2").unwrap(), x0_mm: 0.0, x1_mm: 5.0 },
+        Shape::Ellipse {
+            center: Point::new(300, 0),
+            a_steps: 1_600,
+            b_steps: 200,
+            to: start,
+            rotation: Rotation::CounterClockwise,
+        },
+    ];
+    for shape in &shapes {
+        let (whole, _) = run_out(&mut Curve::new(shape, start, &free).unwrap(), start, 64);
+        let edge = whole.iter().position(|p| p.x.abs() > 1_000 || p.y.abs() > 1_000).unwrap();
+        for batch in [1, 7, 700] {
+            let mut curve = Curve::new(shape, start, &s).unwrap();
+            let (path, end) = run_out(&mut curve, start, batch);
+            assert_eq!(end, Err(CurveError::Travel), "{shape:?}");
+            assert_eq!(path[..], whole[..edge], "{shape:?} in batches of {batch}");
+            let last = *path.last().unwrap();
+            assert_eq!(last.x.abs().max(last.y.abs()), 1_000, "{shape:?} stops at the edge");
+            assert_eq!(curve.next_step(), Ok(None));
+        }
+    }
 }
 
 proptest! {

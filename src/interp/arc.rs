@@ -9,8 +9,10 @@
 
 use crate::geom::{Point, Rotation, Step};
 use crate::interp::conic::{GATE_SCALE, Tracer};
-use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, Tangent};
+use crate::interp::setup::CurveSetupError;
 use crate::math;
+use crate::method::Method;
 
 #[cfg(test)]
 mod tests;
@@ -43,8 +45,15 @@ pub enum ArcError {
     /// A radius, semi-axis or point offset exceeds [`MAX_RADIUS_STEPS`] (for ellipses
     /// [`MAX_ELLIPSE_AXIS_STEPS`](crate::interp::ellipse::MAX_ELLIPSE_AXIS_STEPS)).
     TooLarge,
-    /// An angle is NaN or infinite.
-    NotFinite,
+}
+
+impl From<ArcError> for CurveSetupError {
+    fn from(e: ArcError) -> Self {
+        match e {
+            ArcError::TooLarge => CurveSetupError::OutOfRange,
+            ArcError::ZeroRadius | ArcError::StartOffCurve | ArcError::EndOffCurve => CurveSetupError::BadParameter,
+        }
+    }
 }
 
 /// A circular arc or full circle; see the module documentation.

@@ -93,10 +93,13 @@
 //! wrapping arithmetic, so the worst that can happen there is a less well chosen finishing step.
 
 use crate::geom::{Rotation, Step};
-use crate::interp::{Filled, Method, Tangent};
+use crate::interp::interpolator::{Filled, Tangent};
 use crate::math;
+use crate::method::Method;
 
 mod run;
+
+use run::{Run, to_local};
 #[cfg(test)]
 pub(crate) mod test_support;
 #[cfg(test)]
@@ -140,27 +143,6 @@ fn quadrant(x: i32, y: i32) -> u8 {
         2
     } else {
         3
-    }
-}
-
-/// `(x, y)` in the own frame `(u, v)` of quadrant `q`: the quadrant turned onto the first one,
-/// so that its points have `u > 0`, `v >= 0`.
-fn to_local(q: u8, x: i32, y: i32) -> (i32, i32) {
-    match q {
-        0 => (x, y),
-        1 => (y, -x),
-        2 => (-x, -y),
-        _ => (-y, x),
-    }
-}
-
-/// The inverse of [`to_local`].
-fn from_local(q: u8, u: i32, v: i32) -> (i32, i32) {
-    match q {
-        0 => (u, v),
-        1 => (-v, u),
-        2 => (-u, -v),
-        _ => (v, -u),
     }
 }
 
@@ -298,7 +280,7 @@ pub(crate) struct Tracer {
     /// Quiet steps left in the run under way (see the module documentation); 0 outside runs.
     /// During a run `f` is not kept: `run` holds the state.
     quiet: u32,
-    run: run::Run,
+    run: Run,
     /// Quiet runs compute in `i32` (see [`run::NARROW_SIZE_MAX`]).
     narrow: bool,
 }
@@ -382,7 +364,7 @@ impl Tracer {
             last,
             tail_steps: 0,
             quiet: 0,
-            run: run::Run::default(),
+            run: Run::default(),
             narrow: wx.max(wy) * half_axes.0.max(half_axes.1) as i64 <= run::NARROW_SIZE_MAX,
         }
     }
@@ -406,7 +388,7 @@ impl Tracer {
             }
             if self.quiet > 0 {
                 let n = (self.quiet as usize).min(out.len() - i);
-                self.run(&mut out[i..i + n]);
+                self.take_run(&mut out[i..i + n]);
                 i += n;
             } else {
                 match self.step() {
@@ -453,7 +435,7 @@ impl Tracer {
     /// `F` at the current point.
     #[cfg(test)]
     pub(crate) fn discriminant(&self) -> i64 {
-        if self.quiet > 0 { self.run_discriminant() } else { self.f }
+        if self.quiet > 0 { self.run.discriminant() } else { self.f }
     }
 
     /// Steps taken by the straight finish so far.
@@ -463,6 +445,52 @@ impl Tracer {
     }
 
     /// Change of `F` for a step `sx` along X (and `sy` along Y) from the current point.
+    /// How many of the next steps need no check beyond the curve rule: none unless the point
+    /// lies strictly inside its quadrant; fewer than it takes to reach the next axis, to reach
+    /// the end point or to pass the gate, and no more than the budget. If any, starts a run.
+    fn begin_run(&mut self) -> u32 {
+        if self.phase != Phase::Curve || self.crossed > self.needed {
+            return 0;
+        }
+        // Climbing toward a tip, the quadrant counted is the one before the point's own: there
+        // `u` is 0 in this frame.
+        let q = self.quadrant;
+        let (u, v) = to_local(q, self.x, self.y);
+        if u < 2 || v < 1 {
+            return 0;
+        }
+        let mut quiet = ((u - 1) as u32).min(self.budget);
+        if self.crossed == self.needed {
+            let g = self.gate.value((self.x, self.y));
+            if g >= 0 {
+                return 0;
+            }
+            let to_end = (self.ex - self.x).unsigned_abs().max((self.ey - self.y).unsigned_abs());
+            let to_gate = ((-g) >> GATE_STEP_SHIFT).min(u32::MAX as i64) as u32;
+            quiet = quiet.min(to_end.saturating_sub(1)).min(to_gate);
+        }
+        if quiet > 0 {
+            self.run = Run::new(q, (u, v), (self.wx, self.wy), self.f, self.mirror, self.method, self.narrow);
+        }
+        quiet
+    }
+
+    /// Takes `out.len()` steps of the run under way (no more than are left) by the curve rule
+    /// alone; at the end of the run, the tracer's own state takes over again.
+    fn take_run(&mut self, out: &mut [Step]) {
+        self.run.take(out);
+        (self.x, self.y) = self.run.point();
+        let n = out.len() as u32;
+        self.budget -= n;
+        self.quiet -= n;
+        if self.quiet == 0 {
+            self.f = self.run.discriminant();
+            if let Some(s) = out.last() {
+                self.last = (s.x as i32, if self.mirror { -(s.y as i32) } else { s.y as i32 });
+            }
+        }
+    }
+
     fn df_x(&self, sx: i32) -> i64 {
         self.wx * (2 * sx as i64 * self.x as i64 + 1)
     }

@@ -24,8 +24,9 @@
 use crate::geom::{Point, Rotation, Step};
 use crate::interp::arc::{ARC_END_TOLERANCE_STEPS, ArcError, narrow, offset};
 use crate::interp::conic::{GATE_SCALE, Tracer};
-use crate::interp::{CurveError, Filled, Interpolator, Method, Tangent};
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, Tangent};
 use crate::math;
+use crate::method::Method;
 
 #[cfg(test)]
 mod tests;

@@ -1,6 +1,6 @@
 //! Explicit curves y = g(x), stepped column by column: [`ExplicitCurve`], the stepping shared by
 //! the sine curve (`crate::interp::sine`) and the function curve (`crate::interp::function`),
-//! with the limits every explicit curve is held to ([`RowRange`], [`jump_limit_steps`],
+//! with the limits every explicit curve is held to ([`jump_limit_steps`],
 //! [`MAX_CURVE_OFFSET_STEPS`]).
 //!
 //! [`ExplicitCurve`] sees the curve only through [`CurveFn`]: the ideal y at each whole-step
@@ -33,19 +33,16 @@
 //!
 //! Each column value is computed just before its chord is stepped. If it cannot be computed
 //! (the function's domain error, [`CurveError::Overflow`] beyond [`MAX_CURVE_OFFSET_STEPS`]),
-//! the chord rises or falls by more than the curve's `max_jump_steps`
-//! ([`CurveError::Jump`]), or its end row lies outside the curve's [`RowRange`]
-//! ([`CurveError::Travel`]), the curve ends with that error *before* any step of the chord,
+//! or the chord rises or falls by more than the curve's `max_jump_steps`
+//! ([`CurveError::Jump`]), the curve ends with that error *before* any step of the chord,
 //! the pen standing at `(k, r(k))`; afterwards `next_step` returns `Ok(None)`. Since the
 //! planner's look-ahead runs a clone of the curve ahead of the pen, it meets the error as early
 //! as any end and brings the pen to a stop there.
 //!
-//! * A jump is an error, never a travel: the machine has no pen lift, so crossing a pole would
-//!   draw a line the function does not contain.
-//! * A row range ([`RowRange`]) bounds the rows a curve may reach: every step of a chord lies
-//!   between the rows of its two columns, so a curve stops at the last column inside it. The
-//!   machine passes [`RowRange::ANY`]: its travel is kept by the drawing builder, which refuses a
-//!   curve whose lattice path leaves it, and by the guard of [`crate::interp::Curve`].
+//! A jump is an error, never a travel: the machine has no pen lift, so crossing a pole would
+//! draw a line the function does not contain. The machine's travel is not this module's: the
+//! drawing builder refuses a curve whose lattice path leaves it, and the guard of
+//! [`crate::interp::Curve`] stops one at the edge.
 //!
 //! [`Interpolator::tangent`] is the direction of the current chord, `(1, h(k+1) - h(k))`
 //! normalised and pointing in the direction of travel (the derivative by finite difference). It
@@ -89,8 +86,10 @@
 //!   an integer, so all of the above stays in the exact range, and all step arithmetic is `i32`.
 
 use crate::geom::{Point, Step};
-use crate::interp::{CurveError, CurveSetupError, Filled, Interpolator, KINK_CHORD, Method, Tangent};
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, KINK_CHORD, Tangent};
+use crate::interp::setup::CurveSetupError;
 use crate::math;
+use crate::method::Method;
 
 #[cfg(test)]
 pub(crate) mod test_support;
@@ -104,34 +103,6 @@ pub const MAX_CURVE_OFFSET_STEPS: i32 = 1_000_000;
 
 /// [`MAX_CURVE_OFFSET_STEPS`] as an `f32` (exactly: it is below 2²⁴).
 const MAX_CURVE_OFFSET_STEPS_F32: f32 = MAX_CURVE_OFFSET_STEPS as f32;
-
-/// The rows an explicit curve may reach, relative to its start, both ends included: the
-/// machine's travel on Y as seen from the start. A column whose row lies outside ends the curve
-/// with [`CurveError::Travel`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub struct RowRange {
-    pub min: i32,
-    pub max: i32,
-}
-
-impl RowRange {
-    /// Every row: no travel limit.
-    pub const ANY: RowRange = RowRange { min: i32::MIN, max: i32::MAX };
-
-    /// The rows `r` with `|start_y + r| <= limit_steps`, for a curve that starts at the absolute
-    /// row `start_y` on a machine whose travel is ±`limit_steps` (a negative limit allows no
-    /// row at all).
-    pub fn within_travel(start_y: i32, limit_steps: i32) -> RowRange {
-        let (start, limit) = (i64::from(start_y), i64::from(limit_steps));
-        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
-        RowRange { min: clamp(-limit - start), max: clamp(limit - start) }
-    }
-
-    pub fn contains(self, row: i32) -> bool {
-        self.min <= row && row <= self.max
-    }
-}
 
 /// The jump limit of an explicit curve, in rows: the `max_jump_mm` setting (`$204`) at
 /// `y_steps_per_mm`, rounded down, and at least one row, or any slope at all would be a jump.
@@ -244,8 +215,6 @@ pub struct ExplicitCurve<G> {
     /// Number of columns to travel (|length|).
     columns: i32,
     max_jump_steps: i32,
-    /// Rows every column must lie in.
-    rows: RowRange,
     /// g(0), in g's unit: the curve is translated by it so that it starts at the pen.
     origin: f32,
     /// Steps per unit of g.
@@ -265,16 +234,9 @@ pub struct ExplicitCurve<G> {
 
 impl<G: CurveFn> ExplicitCurve<G> {
     /// A curve over `length_steps` columns (negative: toward -x), refusing jumps of more than
-    /// `max_jump_steps` rows between neighbouring columns (`i32::MAX`: no limit) and columns
-    /// outside `rows` ([`RowRange::ANY`]: no limit; the start, row 0, is not checked). Evaluates
+    /// `max_jump_steps` rows between neighbouring columns (`i32::MAX`: no limit). Evaluates
     /// g at the start; an error there is [`CurveSetupError::Start`] and nothing moves.
-    pub fn new(
-        g: G,
-        length_steps: i32,
-        max_jump_steps: i32,
-        rows: RowRange,
-        method: Method,
-    ) -> Result<Self, CurveSetupError> {
+    pub fn new(g: G, length_steps: i32, max_jump_steps: i32, method: Method) -> Result<Self, CurveSetupError> {
         let steps_per_unit = g.y_steps_per_unit();
         if max_jump_steps < 0 || !steps_per_unit.is_finite() {
             return Err(CurveSetupError::BadParameter);
@@ -293,7 +255,6 @@ impl<G: CurveFn> ExplicitCurve<G> {
             dir,
             columns: length_steps.abs(),
             max_jump_steps,
-            rows,
             origin,
             steps_per_unit,
             // Before column 0: the pen stands at the end of no chord.
@@ -357,13 +318,7 @@ impl<G: CurveFn> ExplicitCurve<G> {
     fn column(&self, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
         let h = self.offset(column)?;
         let r = nearest_step(h);
-        if (r - r0).abs() > self.max_jump_steps {
-            Err(CurveError::Jump)
-        } else if !self.rows.contains(r) {
-            Err(CurveError::Travel)
-        } else {
-            Ok((h, r))
-        }
+        if (r - r0).abs() > self.max_jump_steps { Err(CurveError::Jump) } else { Ok((h, r)) }
     }
 
     /// The steps of a chord from value `h0` (row `r0`) to value `h1` (row `r1`), one column on.

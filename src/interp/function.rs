@@ -24,9 +24,11 @@
 
 use crate::expr::{EvalError, Expr};
 use crate::geom::{Point, Step};
-use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, RowRange};
-use crate::interp::{CurveError, CurveSetupError, Filled, Interpolator, Method, Tangent};
+use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS};
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, Tangent};
+use crate::interp::setup::CurveSetupError;
 use crate::math;
+use crate::method::Method;
 
 #[cfg(test)]
 mod tests;
@@ -99,9 +101,7 @@ impl FunctionInterp {
     /// `round((x1 - x0)·steps_per_mm[0])` columns. A rise or fall of more than `max_jump_steps`
     /// between neighbouring columns ends the curve with [`CurveError::Jump`] (the caller derives
     /// it from the `max_jump_mm` setting with
-    /// [`jump_limit_steps`](crate::interp::explicit::jump_limit_steps)), a column outside `rows`
-    /// with [`CurveError::Travel`] (the caller derives it from the travel limits with
-    /// [`RowRange::within_travel`]).
+    /// [`jump_limit_steps`](crate::interp::explicit::jump_limit_steps)).
     ///
     /// f(x0) is evaluated here: a domain error there is [`CurveSetupError::Start`] and nothing
     /// moves.
@@ -111,7 +111,6 @@ impl FunctionInterp {
         x1_mm: f32,
         steps_per_mm: [f32; 2],
         max_jump_steps: i32,
-        rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let [x_spm, y_spm] = steps_per_mm;
@@ -135,7 +134,7 @@ impl FunctionInterp {
             columns_f32: columns as f32,
             y_steps_per_mm: y_spm,
         };
-        Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, rows, method)? })
+        Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, method)? })
     }
 
     /// Where the steps handed out so far have taken the pen, relative to the start.

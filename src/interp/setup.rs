@@ -1,9 +1,9 @@
 //! Why a curve could not be set up: [`CurveSetupError`], shared by every interpolator that
 //! checks its parameters before the first step (explicit curves, arcs, ellipses).
 //!
-//! Owns nothing else: the errors a curve meets on the way are [`crate::interp::CurveError`].
+//! Owns nothing else: the errors a curve meets on the way are [`CurveError`].
 
-use crate::interp::CurveError;
+use crate::interp::interpolator::CurveError;
 
 /// Why a curve could not be set up; nothing moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

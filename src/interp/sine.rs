@@ -11,9 +11,8 @@
 //! in rows per column) is large, neighbouring columns lie far apart and the chord between them
 //! is a stroke the curve does not contain. It is therefore held to the same rules as a
 //! function: a rise or fall of more than `max_jump_steps` rows between neighbouring columns
-//! ends it with [`CurveError::Jump`], and a column outside its [`RowRange`] (the machine's
-//! travel) with [`CurveError::Travel`], both before any step toward that column. Otherwise, once
-//! set up, it never fails.
+//! ends it with [`CurveError::Jump`] before any step toward that column. Otherwise, once set up,
+//! it never fails.
 //!
 //! # Phase
 //!
@@ -34,9 +33,11 @@
 //! `|A|·2⁻²¹` (4.8e-7·|A|) of `A·(sin(θ_k) - sin(φ))`: 0.05 step at A = 100_000.
 
 use crate::geom::{Point, Step};
-use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, RowRange, jump_limit_steps};
-use crate::interp::{CurveError, CurveSetupError, Filled, Interpolator, Method, Tangent};
+use crate::interp::explicit::{CurveFn, ExplicitCurve, MAX_CURVE_OFFSET_STEPS, jump_limit_steps};
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, Tangent};
+use crate::interp::setup::CurveSetupError;
 use crate::math;
+use crate::method::Method;
 
 #[cfg(test)]
 mod tests;
@@ -144,9 +145,8 @@ impl SineInterp {
     ///
     /// A rise or fall of more than `max_jump_steps` rows between neighbouring columns
     /// (`i32::MAX`: no limit; a negative limit is [`CurveSetupError::BadParameter`]) ends the
-    /// curve with [`CurveError::Jump`], a column outside `rows` ([`RowRange::ANY`]: no limit)
-    /// with [`CurveError::Travel`]; the caller derives them from the settings with
-    /// [`jump_limit_steps`] and [`RowRange::within_travel`]. With
+    /// curve with [`CurveError::Jump`]; the caller derives the limit from the settings with
+    /// [`jump_limit_steps`]. With
     /// [`fits_jump_limit`] no jump can occur: the sine rises by at most |A·ω| per column, the
     /// values by at most |A|·[`SINE_RISE_ERROR_PER_AMPLITUDE_STEP`] more, and the rounded rows
     /// of two values at most an integer `J` apart are at most `J` apart.
@@ -156,7 +156,6 @@ impl SineInterp {
         phase_rad: f32,
         length_steps: i32,
         max_jump_steps: i32,
-        rows: RowRange,
         method: Method,
     ) -> Result<Self, CurveSetupError> {
         let span_rad = omega_rad_per_step * length_steps as f32;
@@ -176,7 +175,7 @@ impl SineInterp {
             phase_turns: turns_q64(phase_rad),
             turns_per_column: if length_steps < 0 { per_step.wrapping_neg() } else { per_step },
         };
-        let curve = ExplicitCurve::new(f, length_steps, max_jump_steps, rows, method)?;
+        let curve = ExplicitCurve::new(f, length_steps, max_jump_steps, method)?;
         // |h| <= 2·|A| <= MAX_CURVE_OFFSET_STEPS: the end is always within reach.
         let end = curve.nominal_end().map_err(|_| CurveSetupError::OutOfRange)?;
         Ok(SineInterp { curve, end })

@@ -6,7 +6,7 @@ extern crate std;
 use super::*;
 use crate::geom::{Point, Step, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator, Method};
-use crate::interp::{LineInterp, Tangent};
+use crate::interp::{StraightInterp, Tangent};
 use crate::job::Feed;
 use crate::settings::{MAX_PULSE_RATE_HZ, Settings};
 use std::vec::Vec;
@@ -39,7 +39,7 @@ fn limits_with(change: impl FnOnce(&mut Settings)) -> Limits {
 #[derive(Clone, Debug)]
 struct Chords {
     /// Each chord with the steps it has left.
-    chords: Vec<(LineInterp, u64)>,
+    chords: Vec<(StraightInterp, u64)>,
     index: usize,
     fail_after_steps: Option<u64>,
     taken: u64,
@@ -55,7 +55,7 @@ impl Chords {
             .windows(2)
             .map(|p| {
                 let (dx, dy) = (p[1].x - p[0].x, p[1].y - p[0].y);
-                (LineInterp::new(dx, dy, method), line_steps(dx, dy, method))
+                (StraightInterp::new(dx, dy, method), line_steps(dx, dy, method))
             })
             .collect();
         Chords { chords, index: 0, fail_after_steps: None, taken: 0, ended: false, centre: None, at: (0, 0) }
@@ -95,7 +95,7 @@ impl Chords {
 }
 
 /// The offset a line covers, by walking a copy of it.
-fn chord_offset(line: &LineInterp) -> (f64, f64) {
+fn chord_offset(line: &StraightInterp) -> (f64, f64) {
     let mut copy = line.clone();
     let (mut x, mut y) = (0i64, 0i64);
     while let Ok(Some(s)) = copy.next_step() {
@@ -130,7 +130,7 @@ impl Interpolator for Chords {
         Ok(None)
     }
 
-    /// A single chord that cannot fail is a straight line, as [`LineInterp`] is.
+    /// A single chord that cannot fail is a straight line, as [`StraightInterp`] is.
     fn straight_steps_left(&self) -> Option<u64> {
         match self.chords[..] {
             [(_, left)] if self.fail_after_steps.is_none() && self.centre.is_none() => Some(left),

@@ -101,7 +101,7 @@ impl CpuModel {
 /// The name of `kind` in a model's table.
 pub fn kind_name(kind: ShapeKind) -> &'static str {
     match kind {
-        ShapeKind::Line => "line",
+        ShapeKind::Straight => "line",
         ShapeKind::Arc => "arc",
         ShapeKind::Ellipse => "ellipse",
         ShapeKind::Sine => "sine",
@@ -174,7 +174,7 @@ mod tests {
         assert!(model.pulse_instructions > 0.0);
         assert!(model.step_instructions.iter().flatten().all(|&v| v > 0.0));
         // 168 MHz at 1.3 cycles per instruction: a 100-instruction step takes 0.77 µs.
-        let line = model.step_seconds(ShapeKind::Line, Method::Diagonal);
+        let line = model.step_seconds(ShapeKind::Straight, Method::Diagonal);
         assert!((line - model.step_instructions[0][1] * 1.3 / 168e6).abs() < 1e-12);
     }
 

@@ -1,22 +1,45 @@
 //! Quiet runs: the steps strictly inside a quadrant, where the curve rule alone decides,
 //! taken in a tight loop in the quadrant's own frame (see [`crate::interp::conic`], "Batches"
-//! and "Arithmetic"). Owns the run's state between batches and the loops.
+//! and "Arithmetic"). Owns the quadrant frames, a run's state between batches and the loops;
+//! the tracer decides when a run starts and how long it lasts.
 
 use core::ops::{Add, AddAssign};
 
-use super::{GATE_STEP_SHIFT, Phase, Tracer, from_local, to_local};
 use crate::geom::Step;
-use crate::interp::Method;
+use crate::method::Method;
 
 /// Largest `W·S` (largest weight times largest semi-axis, in steps) whose quiet runs compute in
 /// `i32`: all circles (`W = 1`) and ellipses up to about 160 steps. The run's values are at most
 /// `396·W·S` (see [`crate::interp::conic`], "Arithmetic"), below 2³¹ up to `W·S = 2²²`.
 pub(super) const NARROW_SIZE_MAX: i64 = 1 << 22;
 
+/// `(x, y)` in the own frame `(u, v)` of quadrant `q`: the quadrant turned onto the first one,
+/// so that its points have `u > 0`, `v >= 0`.
+pub(super) fn to_local(q: u8, x: i32, y: i32) -> (i32, i32) {
+    match q {
+        0 => (x, y),
+        1 => (y, -x),
+        2 => (-x, -y),
+        _ => (-y, x),
+    }
+}
+
+/// The inverse of [`to_local`].
+pub(super) fn from_local(q: u8, u: i32, v: i32) -> (i32, i32) {
+    match q {
+        0 => (u, v),
+        1 => (-v, u),
+        2 => (-u, -v),
+        _ => (v, -u),
+    }
+}
+
 /// A quiet run under way: the curve rule's state in the quadrant's own frame, kept from one
 /// batch to the next.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Run {
+    /// The quadrant whose frame the run is in.
+    quadrant: u8,
     /// The point in the quadrant's own frame.
     u: i32,
     v: i32,
@@ -31,37 +54,25 @@ pub(super) struct Run {
     along_v: i64,
     /// The machine steps for −u, +v and both.
     moves: [Step; 3],
+    method: Method,
+    /// The loops compute in `i32` (see [`NARROW_SIZE_MAX`]).
+    narrow: bool,
 }
 
-impl Tracer {
-    /// How many of the next steps need no check beyond the curve rule: none unless the point
-    /// lies strictly inside its quadrant; fewer than it takes to reach the next axis, to reach
-    /// the end point or to pass the gate, and no more than the budget. If any, starts a run.
-    pub(super) fn begin_run(&mut self) -> u32 {
-        if self.phase != Phase::Curve || self.crossed > self.needed {
-            return 0;
-        }
-        // Climbing toward a tip, the quadrant counted is the one before the point's own: there
-        // `u` is 0 in this frame.
-        let q = self.quadrant;
-        let (u, v) = to_local(q, self.x, self.y);
-        if u < 2 || v < 1 {
-            return 0;
-        }
-        let mut quiet = ((u - 1) as u32).min(self.budget);
-        if self.crossed == self.needed {
-            let g = self.gate.value((self.x, self.y));
-            if g >= 0 {
-                return 0;
-            }
-            let to_end = (self.ex - self.x).unsigned_abs().max((self.ey - self.y).unsigned_abs());
-            let to_gate = ((-g) >> GATE_STEP_SHIFT).min(u32::MAX as i64) as u32;
-            quiet = quiet.min(to_end.saturating_sub(1)).min(to_gate);
-        }
-        if quiet == 0 {
-            return 0;
-        }
-        let (wu, wv) = if q & 1 == 0 { (self.wx, self.wy) } else { (self.wy, self.wx) };
+impl Run {
+    /// A run from `(u, v)` in the frame of quadrant `q`, where `F` is `f`, for a curve with
+    /// weights `(wx, wy)` (Y mirrored in machine steps when `mirror`).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn new(
+        q: u8,
+        (u, v): (i32, i32),
+        (wx, wy): (i64, i64),
+        f: i64,
+        mirror: bool,
+        method: Method,
+        narrow: bool,
+    ) -> Run {
+        let (wu, wv) = if q & 1 == 0 { (wx, wy) } else { (wy, wx) };
         // −u and +v in the frame, and as machine steps.
         let (mu, mv) = match q {
             0 => ((-1, 0), (0, 1)),
@@ -69,47 +80,39 @@ impl Tracer {
             2 => ((1, 0), (0, -1)),
             _ => ((0, 1), (1, 0)),
         };
-        let y_sign = if self.mirror { -1 } else { 1 };
+        let y_sign = if mirror { -1 } else { 1 };
         let step = |m: (i8, i8)| Step::new(m.0, m.1 * y_sign);
         let moves = [step(mu), step(mv), step((mu.0 + mv.0, mu.1 + mv.1))];
         let du = wu * (1 - 2 * u as i64);
         let dv = wv * (2 * v as i64 + 1);
-        let (lead, along_u, along_v) = match self.method {
-            Method::Classic => (self.f, du, dv),
-            Method::Diagonal => (4 * (self.f + du + dv), 2 * du + wu, 2 * dv + wv),
+        let (lead, along_u, along_v) = match method {
+            Method::Classic => (f, du, dv),
+            Method::Diagonal => (4 * (f + du + dv), 2 * du + wu, 2 * dv + wv),
         };
-        self.run = Run { u, v, wu, wv, lead, along_u, along_v, moves };
-        quiet
+        Run { quadrant: q, u, v, wu, wv, lead, along_u, along_v, moves, method, narrow }
     }
 
-    /// Takes `out.len()` steps of the run under way (no more than are left) by the curve rule
-    /// alone; at the end of the run, the tracer's own state takes over again.
-    pub(super) fn run(&mut self, out: &mut [Step]) {
+    /// Takes `out.len()` steps by the curve rule alone (the caller knows they are quiet).
+    pub(super) fn take(&mut self, out: &mut [Step]) {
         match (self.method, self.narrow) {
-            (Method::Classic, true) => run_classic::<i32>(&mut self.run, out),
-            (Method::Classic, false) => run_classic::<i64>(&mut self.run, out),
-            (Method::Diagonal, true) => run_diagonal::<i32>(&mut self.run, out),
-            (Method::Diagonal, false) => run_diagonal::<i64>(&mut self.run, out),
-        }
-        (self.x, self.y) = from_local(self.quadrant, self.run.u, self.run.v);
-        let n = out.len() as u32;
-        self.budget -= n;
-        self.quiet -= n;
-        if self.quiet == 0 {
-            self.f = self.run_discriminant();
-            if let Some(s) = out.last() {
-                self.last = (s.x as i32, if self.mirror { -(s.y as i32) } else { s.y as i32 });
-            }
+            (Method::Classic, true) => run_classic::<i32>(self, out),
+            (Method::Classic, false) => run_classic::<i64>(self, out),
+            (Method::Diagonal, true) => run_diagonal::<i32>(self, out),
+            (Method::Diagonal, false) => run_diagonal::<i64>(self, out),
         }
     }
 
-    /// `F` at the current point of the run under way.
-    pub(super) fn run_discriminant(&self) -> i64 {
-        let r = &self.run;
+    /// The current point, in the curve's frame.
+    pub(super) fn point(&self) -> (i32, i32) {
+        from_local(self.quadrant, self.u, self.v)
+    }
+
+    /// `F` at the current point.
+    pub(super) fn discriminant(&self) -> i64 {
         match self.method {
-            Method::Classic => r.lead,
+            Method::Classic => self.lead,
             // du = (along_u − wu)/2, dv = (along_v − wv)/2.
-            Method::Diagonal => (r.lead >> 2) - ((r.along_u - r.wu) >> 1) - ((r.along_v - r.wv) >> 1),
+            Method::Diagonal => (self.lead >> 2) - ((self.along_u - self.wu) >> 1) - ((self.along_v - self.wv) >> 1),
         }
     }
 }

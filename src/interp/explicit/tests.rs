@@ -9,7 +9,6 @@ use proptest::prelude::*;
 use std::vec::Vec;
 
 const METHODS: [Method; 2] = [Method::Classic, Method::Diagonal];
-const ANY: RowRange = RowRange::ANY;
 
 /// Curve values at columns 0..=n: a random walk mixing flat, steep and exactly-half rises,
 /// from an arbitrary origin, as `f32` (what a curve's g hands out).
@@ -80,7 +79,7 @@ fn check_curve(g: &[f32], scale: f32, backwards: bool, slack: f64) -> Result<(),
     let rises: Vec<i32> = r.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
     for method in METHODS {
         let g = Sampled { g, scale, fail_at: None };
-        let curve = ExplicitCurve::new(g, dir * n, i32::MAX, ANY, method).unwrap();
+        let curve = ExplicitCurve::new(g, dir * n, i32::MAX, method).unwrap();
         prop_assert_eq!(curve.nominal_end(), Ok(Point::new(dir * n, r[n as usize])));
         let steps = assert_same_in_batches(&curve, 10_000_000);
         let mut curve = curve;
@@ -118,7 +117,7 @@ proptest! {
         let r = rounded(&computed(&g, 1.0));
         let first_jump = r.windows(2).position(|w| (w[1] - w[0]).abs() > max_jump);
         for method in METHODS {
-            let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, ANY, method).unwrap();
+            let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, method).unwrap();
             let w = walk(&mut curve, method, 100_000);
             match first_jump {
                 None => prop_assert_eq!(w.last(), Point::new(dir * n, r[n as usize])),
@@ -138,7 +137,7 @@ proptest! {
         let err = [CurveError::Domain, CurveError::DivisionByZero, CurveError::Overflow][which];
         let r = rounded(&computed(&g, 1.0));
         for method in METHODS {
-            match ExplicitCurve::new(sampled(&g, Some((at, err))), n as i32, i32::MAX, ANY, method) {
+            match ExplicitCurve::new(sampled(&g, Some((at, err))), n as i32, i32::MAX, method) {
                 Err(e) => prop_assert_eq!((e, at), (CurveSetupError::Start(err), 0)),
                 Ok(mut curve) => {
                     assert_same_in_batches(&curve, 100_000);
@@ -146,40 +145,6 @@ proptest! {
                     prop_assert_eq!(w.end, Err(err));
                     prop_assert_eq!(w.last(), Point::new(at as i32 - 1, r[at - 1]));
                     prop_assert!(w.path.iter().all(|p| (p.x as usize) < at));
-                }
-            }
-        }
-    }
-
-    /// No step ever leaves the rows: the curve ends, with the first error met (a jump is
-    /// reported before the travel), at the last column before the first column that jumps
-    /// or lies outside them.
-    #[test]
-    fn a_column_outside_the_rows_ends_the_curve_at_the_last_column_inside(
-        g in sampled_curve(),
-        below in 0i32..300,
-        above in 0i32..300,
-        max_jump in prop_oneof![Just(i32::MAX), 0i32..30],
-        backwards: bool,
-    ) {
-        let n = g.len() as i32 - 1;
-        let dir = if backwards { -1 } else { 1 };
-        let r = rounded(&computed(&g, 1.0));
-        let rows = RowRange { min: -below, max: above };
-        let jumps = |k: usize| (r[k] - r[k - 1]).abs() > max_jump;
-        let first = (1..r.len()).find(|&k| jumps(k) || !rows.contains(r[k]));
-        for method in METHODS {
-            let mut curve = ExplicitCurve::new(sampled(&g, None), dir * n, max_jump, rows, method).unwrap();
-            assert_same_in_batches(&curve, 100_000);
-            let w = walk(&mut curve, method, 100_000);
-            prop_assert!(w.path.iter().all(|p| rows.contains(p.y)), "a step outside {:?}", rows);
-            match first {
-                None => prop_assert_eq!((w.end, w.last()), (Ok(()), Point::new(dir * n, r[n as usize]))),
-                Some(k) => {
-                    let error = if jumps(k) { CurveError::Jump } else { CurveError::Travel };
-                    prop_assert_eq!(w.end, Err(error));
-                    prop_assert_eq!(w.last(), Point::new(dir * (k as i32 - 1), r[k - 1]));
-                    prop_assert!(w.path.iter().all(|p| p.x * dir < k as i32), "stepped toward column {}", k);
                 }
             }
         }
@@ -258,16 +223,7 @@ fn rounding_to_rows_is_exact_with_ties_toward_plus_y() {
 }
 
 #[test]
-fn the_row_range_is_the_travel_seen_from_the_start() {
-    assert_eq!(RowRange::within_travel(0, 20_000), RowRange { min: -20_000, max: 20_000 });
-    assert_eq!(RowRange::within_travel(5_000, 20_000), RowRange { min: -25_000, max: 15_000 });
-    assert_eq!(RowRange::within_travel(-20_000, 20_000), RowRange { min: 0, max: 40_000 });
-    // Beyond i32: clamped, never wrapped.
-    assert_eq!(RowRange::within_travel(i32::MIN, i32::MAX), RowRange { min: 1, max: i32::MAX });
-    // A start outside the travel: only the rows back inside.
-    assert_eq!(RowRange::within_travel(20_005, 20_000), RowRange { min: -40_005, max: -5 });
-    assert!(!RowRange::within_travel(0, -1).contains(0));
-    assert!(RowRange::ANY.contains(i32::MIN) && RowRange::ANY.contains(i32::MAX));
+fn the_jump_limit_is_at_least_one_row() {
     // The jump limit: `$204` in rows, at least one.
     assert_eq!(jump_limit_steps(5.0, 100.0), 500);
     assert_eq!(jump_limit_steps(0.001, 100.0), 1);
@@ -278,17 +234,17 @@ fn the_row_range_is_the_travel_seen_from_the_start() {
 fn a_steep_rise_advances_x_halfway_up() {
     // One column rising four rows: the chord (0,0)-(1,4) crosses the middle at row 2.
     let g = [0.0, 4.0];
-    let mut diagonal = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, ANY, Method::Diagonal).unwrap();
+    let mut diagonal = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, Method::Diagonal).unwrap();
     let w = walk(&mut diagonal, Method::Diagonal, 10);
     let pts = |v: &[(i32, i32)]| v.iter().map(|&(x, y)| Point::new(x, y)).collect::<Vec<_>>();
     assert_eq!(w.path, pts(&[(0, 0), (0, 1), (1, 2), (1, 3), (1, 4)]));
     // Classic goes through the corner nearer to the chord: up two, across, up two.
-    let mut classic = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, ANY, Method::Classic).unwrap();
+    let mut classic = ExplicitCurve::new(sampled(&g, None), 1, i32::MAX, Method::Classic).unwrap();
     let w = walk(&mut classic, Method::Classic, 10);
     assert_eq!(w.path, pts(&[(0, 0), (0, 1), (0, 2), (1, 2), (1, 3), (1, 4)]));
     // Falling, toward -x: the same, mirrored.
     let g = [0.0, -4.0];
-    let mut diagonal = ExplicitCurve::new(sampled(&g, None), -1, i32::MAX, ANY, Method::Diagonal).unwrap();
+    let mut diagonal = ExplicitCurve::new(sampled(&g, None), -1, i32::MAX, Method::Diagonal).unwrap();
     let w = walk(&mut diagonal, Method::Diagonal, 10);
     assert_eq!(w.path, pts(&[(0, 0), (0, -1), (-1, -2), (-1, -3), (-1, -4)]));
 }
@@ -297,23 +253,20 @@ fn a_steep_rise_advances_x_halfway_up() {
 fn values_beyond_the_machine_overflow_and_bad_parameters_are_refused() {
     let g = [0.0, 10.0, 2e6];
     for method in METHODS {
-        let mut curve = ExplicitCurve::new(sampled(&g, None), 2, i32::MAX, ANY, method).unwrap();
+        let mut curve = ExplicitCurve::new(sampled(&g, None), 2, i32::MAX, method).unwrap();
         let w = walk(&mut curve, method, 100);
         assert_eq!((w.end, w.last()), (Err(CurveError::Overflow), Point::new(1, 10)));
         let f = |_| Ok(0.0);
-        assert_eq!(ExplicitCurve::new(f, 10, -1, ANY, method).err(), Some(CurveSetupError::BadParameter));
+        assert_eq!(ExplicitCurve::new(f, 10, -1, method).err(), Some(CurveSetupError::BadParameter));
         assert_eq!(
-            ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, ANY, method).err(),
+            ExplicitCurve::new(f, MAX_CURVE_OFFSET_STEPS + 1, 0, method).err(),
             Some(CurveSetupError::OutOfRange)
         );
-        assert_eq!(ExplicitCurve::new(f, i32::MIN, 0, ANY, method).err(), Some(CurveSetupError::OutOfRange));
+        assert_eq!(ExplicitCurve::new(f, i32::MIN, 0, method).err(), Some(CurveSetupError::OutOfRange));
         let nan = |_| Ok(f32::NAN);
-        assert_eq!(
-            ExplicitCurve::new(nan, 10, 0, ANY, method).err(),
-            Some(CurveSetupError::Start(CurveError::Overflow))
-        );
+        assert_eq!(ExplicitCurve::new(nan, 10, 0, method).err(), Some(CurveSetupError::Start(CurveError::Overflow)));
         let infinite_scale = Sampled { g: &g, scale: f32::INFINITY, fail_at: None };
-        assert_eq!(ExplicitCurve::new(infinite_scale, 2, 0, ANY, method).err(), Some(CurveSetupError::BadParameter));
+        assert_eq!(ExplicitCurve::new(infinite_scale, 2, 0, method).err(), Some(CurveSetupError::BadParameter));
     }
 }
 
@@ -322,7 +275,7 @@ fn a_kink_ends_a_batch_right_after_the_step_that_reaches_it() {
     // |x - 5| over ten columns: down one row a column, then up, the turn at column 5.
     let g: Vec<f32> = (0..=10).map(|k: i32| (k - 5).abs() as f32).collect();
     for method in METHODS {
-        let mut curve = ExplicitCurve::new(sampled(&g, None), 10, i32::MAX, ANY, method).unwrap();
+        let mut curve = ExplicitCurve::new(sampled(&g, None), 10, i32::MAX, method).unwrap();
         let before = curve.tangent();
         let mut buf = [Step::NONE; 64];
         let filled = curve.fill(&mut buf);
@@ -340,7 +293,7 @@ fn a_kink_ends_a_batch_right_after_the_step_that_reaches_it() {
     // A gentle bend is no kink: slopes 0.05 apart turn by less than the chord.
     let g: Vec<f32> = (0..=40).map(|k: i32| 0.025 * (k * k) as f32).collect();
     for method in METHODS {
-        let mut curve = ExplicitCurve::new(sampled(&g, None), 40, i32::MAX, ANY, method).unwrap();
+        let mut curve = ExplicitCurve::new(sampled(&g, None), 40, i32::MAX, method).unwrap();
         let mut buf = [Step::NONE; 500];
         let filled = curve.fill(&mut buf);
         assert_eq!(filled.end, Some(Ok(())));

@@ -10,7 +10,6 @@ use proptest::prelude::*;
 use std::vec::Vec;
 
 const METHODS: [Method; 2] = [Method::Classic, Method::Diagonal];
-const ANY: RowRange = RowRange::ANY;
 
 /// Runs `src` over [x0, x1] mm at `spm` steps/mm; returns the walk and the ideal values
 /// (steps, relative) at its columns computed by `f`.
@@ -23,7 +22,7 @@ fn draw(
     method: Method,
     f: impl Fn(f64) -> f64,
 ) -> (Walk, Vec<f64>, i32) {
-    let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], max_jump, ANY, method).unwrap();
+    let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], max_jump, method).unwrap();
     let (x0, x1, spm) = (f64::from(x0), f64::from(x1), f64::from(spm));
     let n = ((x1 - x0) * spm).round() as i32;
     let dir = if n < 0 { -1 } else { 1 };
@@ -98,15 +97,14 @@ fn a_square_root_is_followed_up_its_vertical_start() {
 fn one_over_x_stops_before_zero() {
     for method in METHODS {
         // Generous jump limit: the curve reaches x = -0.1 mm and fails on the division at 0.
-        let mut interp =
-            FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 1000, ANY, method).unwrap();
+        let mut interp = FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 1000, method).unwrap();
         let w = walk(&mut interp, method, 10_000);
         assert_eq!(w.end, Err(CurveError::DivisionByZero));
         // x = -0.1 mm: 1/x - 1/x0 = -10 + 1 = -9 mm.
         assert_eq!(w.last(), Point::new(9, -90));
         assert!(w.path.iter().all(|p| p.x <= 9));
         // A tighter limit stops it earlier, at the first rise of more than 30 steps.
-        let mut interp = FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 30, ANY, method).unwrap();
+        let mut interp = FunctionInterp::new(parse("1/x").unwrap(), -1.0, 1.0, [10.0, 10.0], 30, method).unwrap();
         let w = walk(&mut interp, method, 10_000);
         assert_eq!(w.end, Err(CurveError::Jump));
         // -1/0.3 → -1/0.2 falls 16.7 steps; -1/0.2 → -1/0.1 falls 50.
@@ -120,8 +118,7 @@ fn tan_stops_at_its_pole_as_a_jump() {
     for method in METHODS {
         // tan(x) on [1, 2] mm at 100 steps/mm: x = 1.57 gives 1255.8 mm, x = 1.58 gives
         // -108.6 mm; a 1000-step jump limit stops it before the pole.
-        let mut interp =
-            FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, ANY, method).unwrap();
+        let mut interp = FunctionInterp::new(parse("tan(x)").unwrap(), 1.0, 2.0, [100.0, 100.0], 1000, method).unwrap();
         let w = walk(&mut interp, method, 1_000_000);
         assert_eq!(w.end, Err(CurveError::Jump));
         let last = w.last();
@@ -131,27 +128,13 @@ fn tan_stops_at_its_pole_as_a_jump() {
         assert!((last.y as f64 - ideal).abs() <= 0.5 + slack(1_300.0, 100.0));
         // Without a jump limit a pole between two columns goes unseen: over [0, π] at one
         // step/mm the columns are 0, π/3, 2π/3 and π, drawn as their polyline. Hence the limit.
-        let mut interp = FunctionInterp::new(
-            parse("tan(x)").unwrap(),
-            0.0,
-            core::f32::consts::PI,
-            [1.0, 1.0],
-            i32::MAX,
-            ANY,
-            method,
-        )
-        .unwrap();
+        let mut interp =
+            FunctionInterp::new(parse("tan(x)").unwrap(), 0.0, core::f32::consts::PI, [1.0, 1.0], i32::MAX, method)
+                .unwrap();
         assert_eq!(walk(&mut interp, method, 100_000).end, Ok(()));
         // Started exactly at π/2, the pole is an error and nothing moves.
-        let at_pole = FunctionInterp::new(
-            parse("tan(x)").unwrap(),
-            core::f32::consts::FRAC_PI_2,
-            3.0,
-            [1.0, 1.0],
-            10,
-            ANY,
-            method,
-        );
+        let at_pole =
+            FunctionInterp::new(parse("tan(x)").unwrap(), core::f32::consts::FRAC_PI_2, 3.0, [1.0, 1.0], 10, method);
         assert_eq!(at_pole.err(), Some(CurveSetupError::Start(CurveError::DivisionByZero)));
     }
 }
@@ -162,43 +145,14 @@ fn a_square_root_leaving_its_domain_ends_at_the_edge() {
         // sqrt(-1-x) is defined for x <= -1: from x = -3 mm it climbs down to x = -1 mm
         // (column 20 at 10 steps/mm) and fails at the next column.
         let mut interp =
-            FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, ANY, method).unwrap();
+            FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), -3.0, 0.0, [10.0, 10.0], 1000, method).unwrap();
         let w = walk(&mut interp, method, 10_000);
         assert_eq!(w.end, Err(CurveError::Domain));
         assert_eq!(w.last(), Point::new(20, (-libm::sqrt(2.0) * 10.0).round() as i32));
         assert!(w.path.iter().all(|p| p.x <= 20));
         // Started outside the domain, it does not start at all.
-        let outside = FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), 0.0, 1.0, [10.0, 10.0], 1000, ANY, method);
+        let outside = FunctionInterp::new(parse("sqrt(-1-x)").unwrap(), 0.0, 1.0, [10.0, 10.0], 1000, method);
         assert_eq!(outside.err(), Some(CurveSetupError::Start(CurveError::Domain)));
-    }
-}
-
-#[test]
-fn a_function_leaving_the_travel_part_way_stops_at_the_last_column_inside() {
-    // y = 250·sin²(πx/2) mm on [0, 4] mm at 100 steps/mm, the pen at row 1_000 of a ±20_000-row
-    // travel: rows above 19_000 (relative) are outside. The first hump (up to 25_000 rows)
-    // passes them, at most 393 rows per column, within the 500-row jump limit.
-    let (spm, start_y, limit) = (100.0f32, 1_000, 20_000);
-    let rows = RowRange::within_travel(start_y, limit);
-    let row = |k: i32| {
-        let s = libm::sin(core::f64::consts::PI * (k as f64 / 100.0) / 2.0);
-        libm::floor(250.0 * s * s * 100.0 + 0.5) as i32
-    };
-    let first_out = (0..=400).find(|&k| row(k) > 19_000).unwrap();
-    let last_in = first_out - 1;
-    for method in METHODS {
-        let e = parse("250*sin(pi*x/2)^2").unwrap();
-        let mut interp = FunctionInterp::new(e, 0.0, 4.0, [spm, spm], 500, rows, method).unwrap();
-        assert_eq!(interp.nominal_end(), Ok(Point::new(400, 0)), "its end is inside");
-        let w = walk(&mut interp, method, 1_000_000);
-        assert_eq!(w.end, Err(CurveError::Travel));
-        assert_eq!(w.last(), Point::new(last_in, row(last_in)));
-        assert!(w.path.iter().all(|p| p.x <= last_in), "stepped toward column {first_out}");
-        assert!(w.path.iter().all(|p| (start_y + p.y).abs() <= limit), "a step outside the travel");
-        // Without the limit it draws both humps to its end.
-        let e = parse("250*sin(pi*x/2)^2").unwrap();
-        let mut free = FunctionInterp::new(e, 0.0, 4.0, [spm, spm], 500, ANY, method).unwrap();
-        assert_eq!(walk(&mut free, method, 1_000_000).end, Ok(()));
     }
 }
 
@@ -220,7 +174,7 @@ fn a_realistic_expression_is_drawn_end_to_end() {
 fn steps_per_mm_differ_per_axis() {
     // y = x/2 on [0, 10] mm at 40 X steps/mm and 100 Y steps/mm: 400 columns, 500 rows.
     let mut interp =
-        FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, ANY, Method::Diagonal).unwrap();
+        FunctionInterp::new(parse("x/2").unwrap(), 0.0, 10.0, [40.0, 100.0], 10, Method::Diagonal).unwrap();
     let w = walk(&mut interp, Method::Diagonal, 10_000);
     assert_eq!(w.last(), Point::new(400, 500));
     assert_eq!(w.steps(), 500);
@@ -230,7 +184,7 @@ fn steps_per_mm_differ_per_axis() {
 fn the_tangent_follows_the_curve_in_the_direction_of_travel() {
     let e = parse("x^2/10").unwrap();
     // At x = -10 mm the slope is 2x/10 = -2.
-    let mut fwd = FunctionInterp::new(e.clone(), -10.0, 10.0, [20.0, 20.0], 100, ANY, Method::Diagonal).unwrap();
+    let mut fwd = FunctionInterp::new(e.clone(), -10.0, 10.0, [20.0, 20.0], 100, Method::Diagonal).unwrap();
     let t = fwd.tangent();
     let want = (1.0 / 5f32.sqrt(), -2.0 / 5f32.sqrt());
     assert!((t.x - want.0).abs() < 0.01 && (t.y - want.1).abs() < 0.01, "{t:?}");
@@ -240,7 +194,7 @@ fn the_tangent_follows_the_curve_in_the_direction_of_travel() {
     }
     assert!(fwd.tangent().x > 0.999, "{:?}", fwd.tangent());
     // Drawn from x = 10 mm toward -x, the curve falls to the left.
-    let back = FunctionInterp::new(e, 10.0, -10.0, [20.0, 20.0], 100, ANY, Method::Classic).unwrap();
+    let back = FunctionInterp::new(e, 10.0, -10.0, [20.0, 20.0], 100, Method::Classic).unwrap();
     let t = back.tangent();
     assert!((t.x + want.0).abs() < 0.01 && (t.y - want.1).abs() < 0.01, "{t:?}");
 }
@@ -249,7 +203,7 @@ fn the_tangent_follows_the_curve_in_the_direction_of_travel() {
 fn bad_parameters_are_refused_and_an_empty_range_takes_no_step() {
     let e = parse("x").unwrap();
     let new = |x0: f32, x1: f32, spm: [f32; 2], jump: i32| {
-        FunctionInterp::new(e.clone(), x0, x1, spm, jump, ANY, Method::Diagonal).err()
+        FunctionInterp::new(e.clone(), x0, x1, spm, jump, Method::Diagonal).err()
     };
     assert_eq!(new(f32::NAN, 1.0, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
     assert_eq!(new(0.0, f32::INFINITY, [10.0, 10.0], 10), Some(CurveSetupError::BadParameter));
@@ -257,7 +211,7 @@ fn bad_parameters_are_refused_and_an_empty_range_takes_no_step() {
     assert_eq!(new(0.0, 1.0, [10.0, -1.0], 10), Some(CurveSetupError::BadParameter));
     assert_eq!(new(0.0, 1.0, [10.0, 10.0], -1), Some(CurveSetupError::BadParameter));
     assert_eq!(new(-1e6, 1e6, [10.0, 10.0], 10), Some(CurveSetupError::OutOfRange));
-    let mut empty = FunctionInterp::new(e, 3.0, 3.0, [10.0, 10.0], 10, ANY, Method::Classic).unwrap();
+    let mut empty = FunctionInterp::new(e, 3.0, 3.0, [10.0, 10.0], 10, Method::Classic).unwrap();
     assert_eq!(empty.next_step(), Ok(None));
 }
 
@@ -268,7 +222,7 @@ fn columns_keep_their_precision_along_the_whole_range() {
     for (x0, x1, spm) in
         [(-250.0f32, 250.0f32, 200.0f32), (400.0, -100.0, 200.0), (0.1, 0.3, 80.0), (-3.0, 997.0, 100.0)]
     {
-        let f = FunctionInterp::new(parse("x").unwrap(), x0, x1, [spm, spm], 10, ANY, Method::Diagonal).unwrap();
+        let f = FunctionInterp::new(parse("x").unwrap(), x0, x1, [spm, spm], 10, Method::Diagonal).unwrap();
         let g = &f.curve_fn();
         let n = g.columns;
         assert_eq!(n as f64, ((f64::from(x1) - f64::from(x0)) * f64::from(spm)).abs().round());
@@ -317,7 +271,7 @@ fn a_function_kinks_where_its_slope_jumps_and_fill_stops_there() {
             ("2*abs(x-1)", -2.0, 3.0, &[30]),
             ("floor(x)", 0.5, 4.5, &[4, 5, 14, 15, 24, 25, 34, 35]),
         ] {
-            let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [10.0, 10.0], 100, ANY, method).unwrap();
+            let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [10.0, 10.0], 100, method).unwrap();
             let (events, _) = reference(interp.clone(), 100_000);
             let mut at = Point::ORIGIN;
             let mut columns = Vec::new();
@@ -338,8 +292,7 @@ fn a_function_kinks_where_its_slope_jumps_and_fill_stops_there() {
             assert_eq!(interp.position().x, kinks_at[0]);
         }
         // A smooth function has none.
-        let smooth =
-            FunctionInterp::new(parse("x^2/10").unwrap(), -10.0, 10.0, [20.0, 20.0], 100, ANY, method).unwrap();
+        let smooth = FunctionInterp::new(parse("x^2/10").unwrap(), -10.0, 10.0, [20.0, 20.0], 100, method).unwrap();
         let (events, _) = reference(smooth, 100_000);
         assert!(!events.iter().any(|e| matches!(e, Event::Kink(_))));
     }
@@ -354,7 +307,7 @@ fn errors_end_a_batch_where_next_step_meets_them() {
             ("sqrt(-1-x)", -3.0, 0.0, 1000),
             ("tan(x)", 1.0, 2.0, 1000),
         ] {
-            let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [10.0, 10.0], jump, ANY, method).unwrap();
+            let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [10.0, 10.0], jump, method).unwrap();
             assert_same_in_batches(&interp, 100_000);
         }
     }
@@ -384,7 +337,7 @@ proptest! {
     ) {
         let (src, x0, x1) = BATCH_EXPRESSIONS[which];
         let method = if diagonal { Method::Diagonal } else { Method::Classic };
-        let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], 500, ANY, method).unwrap();
+        let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [spm, spm], 500, method).unwrap();
         assert_same_steps_in_batches(&interp, &sizes, 1_000_000);
     }
 }

@@ -44,7 +44,7 @@ fn check_sine(a: f64, omega: f64, phase: f64, length: i32) -> Result<(), TestCas
     // What fits the jump limit never stops at a jump.
     let max_jump = libm::ceilf((a * omega).abs() + a.abs() * SINE_RISE_ERROR_PER_AMPLITUDE_STEP) as i32;
     for method in METHODS {
-        let sine = SineInterp::new(a, omega, phase, length, max_jump, RowRange::ANY, method).unwrap();
+        let sine = SineInterp::new(a, omega, phase, length, max_jump, method).unwrap();
         let used = computed(&sine);
         let error = used.iter().zip(&h).map(|(u, i)| (u - i).abs()).fold(0.0, f64::max);
         prop_assert!(
@@ -138,7 +138,7 @@ proptest! {
         diagonal: bool,
     ) {
         let method = if diagonal { Method::Diagonal } else { Method::Classic };
-        let sine = SineInterp::new(a, omega, phase, length, max_jump, RowRange::ANY, method).unwrap();
+        let sine = SineInterp::new(a, omega, phase, length, max_jump, method).unwrap();
         assert_same_steps_in_batches(&sine, &sizes, 10_000_000);
     }
 
@@ -188,14 +188,14 @@ fn one_period_peaks_and_troughs_where_the_sine_does() {
     use core::f32::consts::PI;
     for method in METHODS {
         // A = 10, one period over 40 steps.
-        let mut sine = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, 40, i32::MAX, RowRange::ANY, method).unwrap();
+        let mut sine = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, 40, i32::MAX, method).unwrap();
         let w = walk(&mut sine, method, 200);
         assert_eq!(w.last(), Point::new(40, 0));
         assert_eq!(w.path.iter().map(|p| p.y).max(), Some(10));
         assert_eq!(w.path.iter().map(|p| p.y).min(), Some(-10));
         assert!(w.path.contains(&Point::new(10, 10)) && w.path.contains(&Point::new(30, -10)));
         // Drawn toward -x it first falls: sin(-ωk) < 0.
-        let mut back = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, -40, i32::MAX, RowRange::ANY, method).unwrap();
+        let mut back = SineInterp::new(10.0, 2.0 * PI / 40.0, 0.0, -40, i32::MAX, method).unwrap();
         let w = walk(&mut back, method, 200);
         assert_eq!(w.last(), Point::new(-40, 0));
         assert!(w.path.contains(&Point::new(-10, -10)) && w.path.contains(&Point::new(-30, 10)));
@@ -206,7 +206,7 @@ fn one_period_peaks_and_troughs_where_the_sine_does() {
 fn a_sine_steeper_than_the_jump_limit_stops_before_its_first_steep_chord() {
     for method in METHODS {
         // A = 1000 rows, ω = 1 rad/step: the first column is already 841 rows up.
-        let mut sine = SineInterp::new(1000.0, 1.0, 0.0, 100, 500, RowRange::ANY, method).unwrap();
+        let mut sine = SineInterp::new(1000.0, 1.0, 0.0, 100, 500, method).unwrap();
         let w = walk(&mut sine, method, 10);
         assert_eq!((w.end, w.steps()), (Err(CurveError::Jump), 0));
         // A = 100 rows, ω = 0.05 rad/step from the crest (phase 90°): level at first, steepest
@@ -215,37 +215,15 @@ fn a_sine_steeper_than_the_jump_limit_stops_before_its_first_steep_chord() {
         let (a, omega, phase) = (100.0f32, 0.05f32, core::f32::consts::FRAC_PI_2);
         let rows = rounded(&ideal(f64::from(a), f64::from(omega), f64::from(phase), 200));
         let first = rows.windows(2).position(|w| (w[1] - w[0]).abs() > 4).unwrap();
-        let mut sine = SineInterp::new(a, omega, phase, 200, 4, RowRange::ANY, method).unwrap();
+        let mut sine = SineInterp::new(a, omega, phase, 200, 4, method).unwrap();
         let w = walk(&mut sine, method, 10_000);
         assert_eq!(w.end, Err(CurveError::Jump));
         assert_eq!(w.last(), Point::new(first as i32, rows[first]));
         assert!(w.path.iter().all(|p| p.x <= first as i32));
         // ...and a limit of |A·ω| lets it through.
-        let mut sine = SineInterp::new(a, omega, phase, 200, 5, RowRange::ANY, method).unwrap();
+        let mut sine = SineInterp::new(a, omega, phase, 200, 5, method).unwrap();
         assert_eq!(walk(&mut sine, method, 10_000).end, Ok(()));
-        assert_eq!(
-            SineInterp::new(a, omega, phase, 200, -1, RowRange::ANY, method).err(),
-            Some(CurveSetupError::BadParameter)
-        );
-    }
-}
-
-#[test]
-fn a_sine_leaving_the_travel_stops_at_the_last_column_inside() {
-    // A = 100 rows, half a period over 200 columns, from a pen at row 50 of a ±120-row
-    // travel: rows -170..=70 relative. The crest, 100 rows up, is outside.
-    let (start_y, limit) = (50, 120);
-    let rows = RowRange::within_travel(start_y, limit);
-    let omega = core::f32::consts::PI / 200.0;
-    let h = rounded(&ideal(100.0, f64::from(omega), 0.0, 200));
-    let first_out = h.iter().position(|&r| r > 70).unwrap();
-    for method in METHODS {
-        let mut sine = SineInterp::new(100.0, omega, 0.0, 200, i32::MAX, rows, method).unwrap();
-        assert_eq!(sine.end(), Point::new(200, 0), "its end is inside");
-        let w = walk(&mut sine, method, 10_000);
-        assert_eq!(w.end, Err(CurveError::Travel));
-        assert_eq!(w.last(), Point::new(first_out as i32 - 1, h[first_out - 1]));
-        assert!(w.path.iter().all(|p| (start_y + p.y).abs() <= limit), "a step outside the travel");
+        assert_eq!(SineInterp::new(a, omega, phase, 200, -1, method).err(), Some(CurveSetupError::BadParameter));
     }
 }
 
@@ -253,7 +231,7 @@ fn a_sine_leaving_the_travel_stops_at_the_last_column_inside() {
 fn the_curve_starts_at_the_pen_whatever_the_phase() {
     use core::f32::consts::{FRAC_PI_2, PI};
     // cos-shaped: f(0) = 5, so the path starts at 0 and falls to -10 at half a period.
-    let mut sine = SineInterp::new(5.0, PI / 20.0, FRAC_PI_2, 40, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
+    let mut sine = SineInterp::new(5.0, PI / 20.0, FRAC_PI_2, 40, i32::MAX, Method::Diagonal).unwrap();
     let w = walk(&mut sine, Method::Diagonal, 200);
     assert_eq!(w.path[0], Point::ORIGIN);
     assert!(w.path.contains(&Point::new(20, -10)));
@@ -264,16 +242,16 @@ fn the_curve_starts_at_the_pen_whatever_the_phase() {
 #[test]
 fn the_tangent_points_along_the_travel() {
     // A·ω = 1: at the start the curve rises at 45°.
-    let sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
+    let sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, Method::Diagonal).unwrap();
     let t = sine.tangent();
     let s = core::f32::consts::FRAC_1_SQRT_2;
     assert!((t.x - s).abs() < 0.01 && (t.y - s).abs() < 0.01, "{t:?}");
     // Toward -x it falls to the left.
-    let sine = SineInterp::new(10.0, 0.1, 0.0, -100, i32::MAX, RowRange::ANY, Method::Classic).unwrap();
+    let sine = SineInterp::new(10.0, 0.1, 0.0, -100, i32::MAX, Method::Classic).unwrap();
     let t = sine.tangent();
     assert!((t.x + s).abs() < 0.01 && (t.y + s).abs() < 0.01, "{t:?}");
     // At the crest (x = π/2/ω ≈ 15.7) it is level.
-    let mut sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, RowRange::ANY, Method::Diagonal).unwrap();
+    let mut sine = SineInterp::new(10.0, 0.1, 0.0, 100, i32::MAX, Method::Diagonal).unwrap();
     while sine.position().x < 15 {
         sine.next_step().unwrap();
     }
@@ -284,14 +262,13 @@ fn the_tangent_points_along_the_travel() {
 fn a_smooth_sine_has_no_kinks_and_a_sampled_one_does() {
     // Many steps per radian: the chords turn by far less than the kink chord.
     for method in METHODS {
-        let sine = SineInterp::new(1_000.0, 0.003, 0.0, 6_000, i32::MAX, RowRange::ANY, method).unwrap();
+        let sine = SineInterp::new(1_000.0, 0.003, 0.0, 6_000, i32::MAX, method).unwrap();
         let (events, _) = reference(sine.clone(), 100_000);
         assert!(!events.iter().any(|e| matches!(e, Event::Kink(_))));
         assert_same_in_batches(&sine, 100_000);
         // Five columns a period: the chords turn sharply where the sine changes direction,
         // twice a period.
-        let sine =
-            SineInterp::new(20.0, 2.0 * core::f32::consts::PI / 5.0, 0.3, 50, i32::MAX, RowRange::ANY, method).unwrap();
+        let sine = SineInterp::new(20.0, 2.0 * core::f32::consts::PI / 5.0, 0.3, 50, i32::MAX, method).unwrap();
         let (events, _) = reference(sine.clone(), 100_000);
         assert!(events.iter().filter(|e| matches!(e, Event::Kink(_))).count() >= 20);
         assert_same_in_batches(&sine, 100_000);
@@ -309,7 +286,7 @@ fn what_fits_the_jump_limit_never_jumps() {
     for (a, omega) in [(10_000.0f32, 0.049_99f32), (100.0, 4.999), (400_000.0, 0.001_249), (-250.0, -1.999)] {
         assert!(fits_jump_limit(a, omega, &settings), "{a}·{omega}");
         for method in METHODS {
-            let mut sine = SineInterp::new(a, omega, 0.7, 3_000, limit, RowRange::ANY, method).unwrap();
+            let mut sine = SineInterp::new(a, omega, 0.7, 3_000, limit, method).unwrap();
             assert_eq!(walk(&mut sine, method, 100_000_000).end, Ok(()), "{a}·{omega}");
         }
     }
@@ -317,8 +294,7 @@ fn what_fits_the_jump_limit_never_jumps() {
 
 #[test]
 fn bad_parameters_are_refused_and_length_zero_takes_no_step() {
-    let new =
-        |a: f32, w: f32, p: f32, l: i32| SineInterp::new(a, w, p, l, i32::MAX, RowRange::ANY, Method::Diagonal).err();
+    let new = |a: f32, w: f32, p: f32, l: i32| SineInterp::new(a, w, p, l, i32::MAX, Method::Diagonal).err();
     assert_eq!(new(f32::NAN, 0.1, 0.0, 10), Some(CurveSetupError::BadParameter));
     assert_eq!(new(1.0, f32::INFINITY, 0.0, 10), Some(CurveSetupError::BadParameter));
     assert_eq!(new(1.0, 0.1, f32::NEG_INFINITY, 10), Some(CurveSetupError::BadParameter));
@@ -328,7 +304,7 @@ fn bad_parameters_are_refused_and_length_zero_takes_no_step() {
     // The largest amplitude reaches exactly the largest offset, and no further.
     assert_eq!(new(MAX_SINE_AMPLITUDE_STEPS, core::f32::consts::PI, -core::f32::consts::FRAC_PI_2, 1), None);
     for method in METHODS {
-        let mut sine = SineInterp::new(100.0, 0.3, 1.0, 0, i32::MAX, RowRange::ANY, method).unwrap();
+        let mut sine = SineInterp::new(100.0, 0.3, 1.0, 0, i32::MAX, method).unwrap();
         assert_eq!(sine.end(), Point::ORIGIN);
         assert_eq!(sine.next_step(), Ok(None));
     }

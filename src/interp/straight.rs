@@ -6,12 +6,13 @@
 //! (Bresenham's rule): every step moves the major axis and, when the error says so, the minor one
 //! too; max(|dx|, |dy|) steps, error <= 0.5 step.
 
-use super::{CurveError, Filled, Interpolator, Method, Tangent};
 use crate::geom::Step;
+use crate::interp::interpolator::{CurveError, Filled, Interpolator, Tangent};
+use crate::method::Method;
 
 /// Interpolates a straight line; see the module documentation.
 #[derive(Clone, Debug)]
-pub struct LineInterp {
+pub struct StraightInterp {
     /// Absolute end offsets.
     xe: i64,
     ye: i64,
@@ -27,7 +28,7 @@ pub struct LineInterp {
     tangent: Tangent,
 }
 
-impl LineInterp {
+impl StraightInterp {
     /// A line from the current point to the point `(dx, dy)` steps away.
     pub fn new(dx: i32, dy: i32, method: Method) -> Self {
         let (xe, ye) = ((dx as i64).abs(), (dy as i64).abs());
@@ -36,7 +37,7 @@ impl LineInterp {
             // Bresenham: error term of the minor axis, scaled by 2.
             Method::Diagonal => 2 * xe.min(ye) - xe.max(ye),
         };
-        LineInterp {
+        StraightInterp {
             xe,
             ye,
             sx: Step::sign(dx),
@@ -97,7 +98,7 @@ impl LineInterp {
     }
 }
 
-impl Interpolator for LineInterp {
+impl Interpolator for StraightInterp {
     fn next_step(&mut self) -> Result<Option<Step>, CurveError> {
         if self.left_x == 0 && self.left_y == 0 {
             return Ok(None);
@@ -122,18 +123,35 @@ impl Interpolator for LineInterp {
         let n = out.len().min(usize::try_from(left).unwrap_or(usize::MAX));
         let Some(out) = out.get_mut(..n) else { return Filled::more(0) };
         match self.method {
-            Method::Classic => {
-                for slot in out.iter_mut() {
-                    *slot = self.classic();
-                }
-            }
+            Method::Classic => self.fill_classic(out),
             Method::Diagonal => self.fill_diagonal(out),
         }
         if n as u64 == left { Filled::ended(n, Ok(())) } else { Filled::more(n) }
     }
 }
 
-impl LineInterp {
+impl StraightInterp {
+    /// `out.len()` classic steps (no more than are left), with the state in registers: the
+    /// steps of [`classic`](Self::classic).
+    fn fill_classic(&mut self, out: &mut [Step]) {
+        let (along_x, along_y) = (Step::new(self.sx, 0), Step::new(0, self.sy));
+        let (xe, ye) = (self.xe, self.ye);
+        let (mut f, mut left_x, mut left_y) = (self.f, self.left_x, self.left_y);
+        for slot in out.iter_mut() {
+            // Exhausted axes first: the comparison alone would overshoot a zero-length axis.
+            if left_y == 0 || (left_x != 0 && f >= 0) {
+                f -= ye;
+                left_x -= 1;
+                *slot = along_x;
+            } else {
+                f += xe;
+                left_y -= 1;
+                *slot = along_y;
+            }
+        }
+        (self.f, self.left_x, self.left_y) = (f, left_x, left_y);
+    }
+
     /// `out.len()` diagonal steps (no more than are left), with the state in registers.
     fn fill_diagonal(&mut self, out: &mut [Step]) {
         let x_major = self.xe >= self.ye;
@@ -175,7 +193,7 @@ mod tests {
     use std::vec::Vec;
 
     fn walk(dx: i32, dy: i32, method: Method) -> Vec<Point> {
-        let mut line = LineInterp::new(dx, dy, method);
+        let mut line = StraightInterp::new(dx, dy, method);
         let mut p = Point::ORIGIN;
         let mut path = Vec::from([p]);
         while let Some(s) = line.next_step().unwrap() {
@@ -220,7 +238,7 @@ mod tests {
     #[test]
     fn classic_follows_the_textbook_table_in_the_first_quadrant() {
         // End (4, 3): F starts at 0 → +X, F=-3 → +Y, F=1 → +X, F=-2 → +Y, F=2 → +X, F=-1 → +Y, F=3 → +X.
-        let mut line = LineInterp::new(4, 3, Method::Classic);
+        let mut line = StraightInterp::new(4, 3, Method::Classic);
         let mut steps = Vec::new();
         while let Some(s) = line.next_step().unwrap() {
             steps.push(s);
@@ -247,13 +265,13 @@ mod tests {
     fn fill_hands_out_exactly_the_steps_of_next_step() {
         for (dx, dy) in [(7, 3), (-7, 3), (3, -7), (0, 5), (-5, 0), (4, 4), (1000, 999), (-999, -1000), (0, 0)] {
             for method in [Method::Classic, Method::Diagonal] {
-                let mut one = LineInterp::new(dx, dy, method);
+                let mut one = StraightInterp::new(dx, dy, method);
                 let mut expected = Vec::new();
                 while let Some(s) = one.next_step().unwrap() {
                     expected.push(s);
                 }
                 for batch in [1, 3, 16, 4096] {
-                    let mut line = LineInterp::new(dx, dy, method);
+                    let mut line = StraightInterp::new(dx, dy, method);
                     let (mut got, mut buf) = (Vec::new(), std::vec![Step::NONE; batch]);
                     loop {
                         let filled = line.fill(&mut buf);
@@ -275,7 +293,7 @@ mod tests {
     #[test]
     fn a_zero_line_takes_no_step() {
         for m in [Method::Classic, Method::Diagonal] {
-            assert_eq!(LineInterp::new(0, 0, m).next_step(), Ok(None));
+            assert_eq!(StraightInterp::new(0, 0, m).next_step(), Ok(None));
         }
     }
 
@@ -284,7 +302,7 @@ mod tests {
         // ±500 mm at 200 steps/mm, corner to corner.
         let (dx, dy) = (200_000, -199_999);
         for m in [Method::Classic, Method::Diagonal] {
-            let mut line = LineInterp::new(dx, dy, m);
+            let mut line = StraightInterp::new(dx, dy, m);
             let mut p = Point::ORIGIN;
             let mut n = 0u64;
             while let Some(s) = line.next_step().unwrap() {
