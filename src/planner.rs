@@ -92,58 +92,33 @@
 //! current segment and every queued one. Every emitted step is a step of the path, so the
 //! position (the sum of emitted steps) stays exact.
 
+mod block;
 mod limits;
 mod ring;
+mod run;
 mod scan;
+mod segment;
+mod sizes;
+mod state;
 mod stepgen;
 #[cfg(test)]
 mod tests;
 
 pub use limits::{CENTRIPETAL_SHARE, Limits, LimitsError, MIN_FEED_MM_PER_MIN, plot_time_lower_bound};
+pub use scan::BLOCK_MARGIN;
+pub use sizes::{
+    CHUNK_RING_LEN, CHUNK_STEPS, PLANNER_BLOCKS, PLANNER_SEGMENTS, SCAN_STEPS_PER_PUSH, STEP_RING_LEN,
+    STRAIGHT_CHUNK_STEPS,
+};
+pub use state::Planner;
+pub use stepgen::Emitted;
 
 use crate::interp::{Interpolator, Method};
 use crate::job::Feed;
 use ring::{CopyRing, Ring, StepRing};
-use scan::{Block, Chunk, ScanPoint, Segment};
-pub use stepgen::Emitted;
-use stepgen::Run;
-
-/// Segments the planner holds (pushed and not yet fully emitted): its look-ahead depth in
-/// segments. At the default limits 16 segments of a 2,000-segment polyline circle of 100 mm
-/// diameter (0.16 mm each) are enough braking distance to cruise at about 3,000 mm/min.
-pub const PLANNER_SEGMENTS: usize = 16;
-
-/// Blocks of steps with one cap each (see the module documentation), for all queued segments.
-/// A line takes one; a curve one per few percent of change of its caps. When they run out the
-/// scan waits, and the motion brakes for the scan's front.
-pub const PLANNER_BLOCKS: usize = 64;
-
-/// Steps scanned ahead of the motion, at most: the look-ahead horizon on curves (a straight
-/// line brakes for its own end). A curve runs no faster than it can brake within it: 16,384
-/// steps are 82 mm at 200 steps/mm, enough to brake from 1,000 mm/s at 10,000 mm/s² (50 mm),
-/// so a curve can reach the drivers' 200 kHz; at the defaults (100 steps/mm, 6,000 mm/min,
-/// 500 mm/s²) sixteen times the braking distance. 32 KiB of steps. A power of two.
-pub const STEP_RING_LEN: usize = 16_384;
-
-/// Chunks in the ring, at most: a chunk is at least one step, usually [`CHUNK_STEPS`] or a
-/// straight run, so a curve's chunks cover the whole ring. When they run out the scan waits,
-/// as for blocks.
-pub const CHUNK_RING_LEN: usize = STEP_RING_LEN / CHUNK_STEPS;
-
-/// Steps per chunk on a curve: the scan reads the tangent, and works out the caps, once per
-/// chunk. 32 steps turn by 6° on a circle of 300 steps radius, so the caps follow the curve
-/// closely; kinks do not wait for a chunk's end (a fill stops at each).
-pub const CHUNK_STEPS: usize = 32;
-
-/// Steps per chunk on a straight line ([`Interpolator::is_straight`]): its steps all have the
-/// same length and caps.
-pub const STRAIGHT_CHUNK_STEPS: usize = 256;
-
-/// Steps scanned by [`Planner::push`] at once: a short segment is planned in full at once.
-pub const SCAN_STEPS_PER_PUSH: usize = 64;
-
-/// Caps of a curve's later blocks sit this far (relative) below those of their first chunk.
-pub const BLOCK_MARGIN: f32 = 0.02;
+use run::Run;
+use segment::{ScanPoint, Segment};
+use state::Request;
 
 /// The planner holds as many segments as it can ([`Planner::is_full`]); try again after the next
 /// [`Planner::next_cmd`].
@@ -165,45 +140,6 @@ pub enum PlannerState {
     Held,
     /// Decelerating for an abort; afterwards idle with nothing queued.
     Aborting,
-}
-
-/// What the user last asked for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Request {
-    Run,
-    Hold,
-    Abort,
-}
-
-/// The speed profile and look-ahead queue; see the module documentation.
-///
-/// `C` is the interpolator type of the motion task (an enum over the curve kinds); `N` the
-/// look-ahead depth in segments ([`PLANNER_SEGMENTS`]).
-pub struct Planner<C: Interpolator, const N: usize> {
-    limits: Limits,
-    /// Limits to apply once the planner is idle.
-    pending_limits: Option<Limits>,
-    /// Pushed segments not yet fully scanned, in order; the scan works on the front one.
-    segments: Ring<Segment<C>, N>,
-    /// Segments pushed and not yet fully emitted (scanned or not).
-    held: usize,
-    /// Where the scan stands on the front segment.
-    scan: ScanPoint,
-    /// Steps scanned and not yet emitted.
-    steps: StepRing,
-    /// The scanned steps, cut into chunks with one length per step.
-    chunks: CopyRing<Chunk, CHUNK_RING_LEN>,
-    /// The scanned steps, cut into blocks with one cap each.
-    blocks: CopyRing<Block, PLANNER_BLOCKS>,
-    request: Request,
-    /// Speed of the last step while moving, mm/s; `None` at rest.
-    speed: Option<f32>,
-    /// The run being emitted.
-    run: Run,
-    /// Fraction of a tick carried to the next step, in units of 2⁻³² tick.
-    carry: u32,
-    /// Steps emitted since the scan last ran: it scans that many again, and more.
-    emitted_since_scan: usize,
 }
 
 impl<C: Interpolator, const N: usize> Planner<C, N> {

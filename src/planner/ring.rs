@@ -2,7 +2,7 @@
 //! ([`Ring`]), and the scanned steps, chunks and blocks ([`CopyRing`]).
 
 use crate::geom::Step;
-use crate::planner::STEP_RING_LEN;
+use crate::planner::sizes::STEP_RING_LEN;
 
 /// A queue of values that are moved in and out (the segments, which own their curves).
 pub(crate) struct Ring<T, const N: usize> {

@@ -2,126 +2,25 @@
 //! the steps into chunks (one step length each) and blocks (one cap each); plans the blocks'
 //! exit speeds (the backward pass). Floating point here runs once per chunk, not per step.
 
-use crate::interp::{CurveError, Interpolator, Method, Tangent};
+use crate::interp::{CurveError, Interpolator, Tangent};
 use crate::math;
+use crate::planner::block::{Block, Chunk};
 use crate::planner::limits::{Bend, Caps, StepGeometry, UnitDir};
-use crate::planner::{BLOCK_MARGIN, CHUNK_STEPS, Planner, STRAIGHT_CHUNK_STEPS};
+use crate::planner::segment::ScanPoint;
+use crate::planner::sizes::{CHUNK_STEPS, STRAIGHT_CHUNK_STEPS};
+use crate::planner::state::Planner;
 
 /// Caps of a segment's first block sit this far below those of its first chunk: only float
 /// noise, so a straight line runs at its own caps.
 const FIRST_BLOCK_MARGIN: f32 = 1e-4;
 
+/// Caps of a curve's later blocks sit this far (relative) below those of their first chunk.
+pub const BLOCK_MARGIN: f32 = 0.02;
+
 /// A chunk allowing this much (relative) more speed than its block starts a new block.
 const BLOCK_SPLIT_GAIN: f32 = 0.1;
 
-/// One queued curve, waiting to be scanned or being scanned.
-pub(crate) struct Segment<C> {
-    pub curve: C,
-    pub method: Method,
-    /// The feed, mm/s (unbounded for rapid).
-    pub requested_mm_per_s: f32,
-}
-
-/// Where the scan stands on the front segment.
-#[derive(Clone, Copy)]
-pub(crate) struct ScanPoint {
-    /// The segment's first chunk is still to come.
-    fresh: bool,
-    /// The tangent at the scan point, and the geometry of a step along it.
-    tangent: Tangent,
-    at: StepGeometry,
-    /// The last chunk ran straight (the tangent did not change over it): the next one extends
-    /// it if it runs straight on.
-    straight: bool,
-    /// The last step scanned reached a kink from this direction (mm): the next step is a chunk
-    /// and a block of its own, passed by the junction rule.
-    kink_from_mm: Option<[f32; 2]>,
-}
-
-impl ScanPoint {
-    pub const fn new() -> Self {
-        ScanPoint {
-            fresh: true,
-            tangent: Tangent { x: 1.0, y: 0.0 },
-            at: StepGeometry { step_mm: 0.0, dir_mm: [1.0, 0.0] },
-            straight: false,
-            kink_from_mm: None,
-        }
-    }
-}
-
-/// Distances along the path are also counted in whole nanometres, so that the scan's block
-/// lengths and the generator's progress agree exactly and the motion ends exactly at the end.
-pub(crate) const NM_PER_MM: f32 = 1.0e6;
-
-/// Consecutive scanned steps that advance the same distance along the ideal curve.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Chunk {
-    /// Steps not yet emitted.
-    pub left: u32,
-    /// Distance one step advances along the ideal curve, mm, and in whole nanometres.
-    pub step_mm: f32,
-    pub step_nm: u32,
-}
-
-impl Chunk {
-    fn new(left: u32, step_mm: f32) -> Chunk {
-        // Saturating float-to-int conversion; steps are micrometres long, far from either end.
-        Chunk { left, step_mm, step_nm: (step_mm * NM_PER_MM + 0.5) as u32 }
-    }
-
-    /// Length of `n` of its steps, nm.
-    pub fn nm(&self, n: u32) -> u32 {
-        self.step_nm.saturating_mul(n)
-    }
-}
-
-/// Consecutive scanned steps of one segment sharing one cap.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Block {
-    pub steps: u32,
-    /// Length, and distance emitted so far, nm (`u32`: up to 4.2 m, longer than any path on the
-    /// machine).
-    pub len_nm: u32,
-    /// Length of the straight rest of its line beyond the scan's front, nm: known steps of the
-    /// same caps, so the block brakes for the line's end, not for the scan's front.
-    pub ahead_nm: u32,
-    pub done_steps: u32,
-    pub done_nm: u32,
-    pub caps: Caps,
-    /// Direction (mm) at the block's start, and at its end.
-    pub entry_dir_mm: [f32; 2],
-    pub exit_dir_mm: [f32; 2],
-    /// The scan is still adding steps: its end is the scan's front.
-    pub open: bool,
-    /// The last block of its segment: a junction follows.
-    pub ends_segment: bool,
-    /// A block without steps: the segment's curve fails here.
-    pub error: Option<CurveError>,
-    /// Highest speed allowed at the end, from the backward pass.
-    pub exit_mm_per_s: f32,
-    /// Changed by the scan since the last backward pass.
-    pub dirty: bool,
-}
-
 impl Block {
-    /// Where the motion must have braked to `exit_mm_per_s`, nm into the block: its end, or the
-    /// end of its line.
-    pub fn end_nm(&self) -> u32 {
-        self.len_nm.saturating_add(self.ahead_nm)
-    }
-
-    /// Distance left to [`Self::end_nm`] after `at_nm` into the block, mm.
-    pub fn left_mm(&self, at_nm: u32) -> f32 {
-        self.end_nm().saturating_sub(at_nm) as f32 / NM_PER_MM
-    }
-
-    /// Highest speed at `at_nm` into the block from which the motion can still brake to
-    /// `exit_mm_per_s` at the block's (known) end.
-    pub fn brake_limit(&self, at_nm: u32) -> f32 {
-        math::sqrt(self.exit_mm_per_s * self.exit_mm_per_s + 2.0 * self.caps.accel_mm_per_s2 * self.left_mm(at_nm))
-    }
-
     /// Whether steps with caps `own` can join this block.
     fn takes(&self, own: Caps) -> bool {
         let cap = self.caps.speed_mm_per_s;

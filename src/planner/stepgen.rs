@@ -7,9 +7,11 @@
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator};
 use crate::math;
+use crate::planner::block::{Block, Chunk, NM_PER_MM};
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
-use crate::planner::scan::{Block, Chunk, NM_PER_MM};
-use crate::planner::{Planner, Request};
+use crate::planner::run::{Pace, Ramp, Run};
+use crate::planner::sizes::{CHUNK_STEPS, PLANNER_BLOCKS};
+use crate::planner::state::{Planner, Request};
 
 /// 2³², the scale of a step's fraction of a tick.
 const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
@@ -36,54 +38,6 @@ pub struct Emitted {
     /// `Some(Err(e))`: a curve fails after these steps (the machine is then at rest; the next
     /// call goes on with the next segment).
     pub end: Option<Result<(), CurveError>>,
-}
-
-/// Steps of one chunk of one block, timed one way.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Run {
-    /// Steps in the run, and how many of them are still to emit.
-    steps: u32,
-    pub left: u32,
-    pace: Pace,
-}
-
-#[derive(Clone, Copy, Debug)]
-enum Pace {
-    /// Every step takes `ticks` and `frac` / 2³² ticks, the fractions carried over.
-    Cruise { ticks: u32, frac: u32 },
-    /// Each step at the speed the acceleration rule allows.
-    Ramp(Ramp),
-}
-
-/// The figures of the acceleration rule for the steps of one chunk of one block.
-#[derive(Clone, Copy, Debug)]
-struct Ramp {
-    /// A step at speed `w` takes `ticks_mm / w` ticks (its length in mm times the tick rate).
-    ticks_mm: f32,
-    /// `2·a·δ`: what one step adds to (or takes from) `v²`.
-    gain: f32,
-    /// `2·a`, for the distance left to brake.
-    two_a: f32,
-    cap2: f32,
-    exit2: f32,
-    /// `v²` from rest, and the floor of a hold's or an abort's braking.
-    start2: f32,
-    /// The step's length, nm, and the distance left in the block before the run, nm.
-    step_nm: u32,
-    left_nm: u32,
-    /// A hold or an abort: decelerate to the start rate.
-    braking: bool,
-    min_ticks: u32,
-}
-
-impl Run {
-    pub const EMPTY: Run = Run { steps: 0, left: 0, pace: Pace::Cruise { ticks: 0, frac: 0 } };
-
-    /// Ends the run after the steps emitted so far: the next step is planned afresh.
-    pub fn cut(&mut self) {
-        self.steps -= self.left;
-        self.left = 0;
-    }
 }
 
 /// What planning the next run found.
@@ -223,13 +177,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             return RunStart::Empty;
         }
         // Keep the scan ahead: twice what was emitted since it last ran, and a chunk more.
-        if self.steps.free() >= crate::planner::CHUNK_STEPS {
-            self.scan(2 * self.emitted_since_scan + crate::planner::CHUNK_STEPS);
+        if self.steps.free() >= CHUNK_STEPS {
+            self.scan(2 * self.emitted_since_scan + CHUNK_STEPS);
             self.emitted_since_scan = 0;
         }
         // Every pass returns, drops a finished block, or scans where the motion has caught up
         // with the scan; the bound only guards against the unforeseen.
-        for _ in 0..(N + crate::planner::PLANNER_BLOCKS + 8) {
+        for _ in 0..(N + PLANNER_BLOCKS + 8) {
             let Some(block) = self.blocks.front() else {
                 // Nothing scanned: scan on (at rest or at the start rate), unless nothing is left.
                 if self.scan_chunk().is_some() {

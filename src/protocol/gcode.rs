@@ -70,9 +70,12 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod curves;
+mod modal;
 mod motion;
 mod system;
 mod words;
+
+pub use modal::{Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 
 use super::GrblError;
 use crate::drawing::{self, Request};
@@ -130,13 +133,8 @@ impl Iterator for Commands {
     }
 }
 
-pub const MM_PER_INCH: f32 = 25.4;
-
 /// Largest N line number, GRBL's.
 pub const LINE_NUMBER_MAX: f32 = 9_999_999.0;
-
-/// Largest T tool number, GRBL's.
-pub const TOOL_NUMBER_MAX: f32 = 255.0;
 
 /// Longest G4 dwell: one hour.
 pub const DWELL_MAX_MS: u32 = 3_600_000;
@@ -150,51 +148,6 @@ pub const ARC_RADIUS_ERROR_MAX_RATIO: f32 = 0.001;
 
 /// Arc sweeps closer than this to zero count as a full turn (GRBL's epsilon).
 const ARC_ANGLE_EPSILON_RAD: f32 = 5e-7;
-
-/// Length units of X, Y, I, J, R and F (G20/G21).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Units {
-    Mm,
-    Inch,
-}
-
-impl Units {
-    pub const fn mm_per_unit(self) -> f32 {
-        match self {
-            Units::Mm => 1.0,
-            Units::Inch => MM_PER_INCH,
-        }
-    }
-}
-
-/// G90/G91.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Distance {
-    Absolute,
-    Incremental,
-}
-
-/// The motion modal group: G0, G1, G2, G3, G80.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum MotionMode {
-    Rapid,
-    Linear,
-    ArcCw,
-    ArcCcw,
-    Off,
-}
-
-/// M3/M4/M5: kept for `$G` only, the plotter has no spindle.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Spindle {
-    Cw,
-    Ccw,
-    Off,
-}
 
 /// What a report request asks for; the serial task formats it with [`crate::protocol::report`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

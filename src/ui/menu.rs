@@ -25,24 +25,30 @@
 //! The forms of the drawing modes (their fields, the ranges and checks of what is typed, and
 //! the job built from it) are [`Form`] and [`Field`]; this module routes the keys to them.
 
-use crate::drawing::DrawError;
 use crate::geom::Step;
-use crate::job::{Control, Job};
+use crate::job::Control;
 use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::ui::entry::EntryError;
 use crate::ui::layout::{SETTINGS_VIEW_LINES, SETTINGS_VISIBLE_LINES};
 
+mod action;
+mod error;
 mod form;
+mod mode;
 #[cfg(test)]
 mod tests;
+mod unit;
 
+pub use action::MenuAction;
+pub use error::UiError;
 pub use form::{
     ARC_START_RANGE_DEG, ARC_SWEEP_RANGE_DEG, CIRCLE_RADIUS_RANGE_MM, ELLIPSE_SEMI_AXIS_RANGE_MM, FORM_MAX_FIELDS,
     FUNCTION_X_RANGE_MM, Field, Form, LINE_DELTA_RANGE_MM, NumberField, SINE_AMPLITUDE_RANGE_MM, SINE_LENGTH_RANGE_MM,
-    SINE_PERIOD_RANGE_MM, SINE_PHASE_RANGE_DEG, Unit,
+    SINE_PERIOD_RANGE_MM, SINE_PHASE_RANGE_DEG,
 };
+pub use mode::Mode;
+pub use unit::Unit;
 
 /// The eight jog keys, around `5` as they sit on the keypad (`2` is above `5`): `2` is +Y, `8`
 /// −Y, `4` −X, `6` +X, and `1`, `3`, `7`, `9` the diagonals.
@@ -63,109 +69,6 @@ pub fn jog_step(key: Key) -> Option<Step> {
         Key::Digit(d) => JOG_KEYS.iter().find(|(k, _)| *k == d).map(|&(_, s)| s),
         _ => None,
     }
-}
-
-/// What the menu asks the machine to do.
-// A started job carries its curve by value (no heap).
-#[allow(clippy::large_enum_variant)]
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum MenuAction {
-    None,
-    /// Queue a job.
-    Start(Job),
-    /// Hold, resume or abort the motion in progress.
-    Control(Control),
-    /// Start jogging in one of the 8 step directions until [`MenuAction::JogStop`].
-    JogStart(Step),
-    JogStop,
-}
-
-/// A top-level mode.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Mode {
-    Jog,
-    Line,
-    Circle,
-    Ellipse,
-    Sine,
-    Function,
-    Settings,
-}
-
-impl Mode {
-    /// Every mode, in menu order: `1` picks the first.
-    pub const ALL: [Mode; 7] =
-        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings];
-
-    /// Screen title.
-    pub const fn title(self) -> &'static str {
-        match self {
-            Mode::Jog => "JOG",
-            Mode::Line => "LINE",
-            Mode::Circle => "CIRCLE/ARC",
-            Mode::Ellipse => "ELLIPSE",
-            Mode::Sine => "SINE",
-            Mode::Function => "FUNCTION",
-            Mode::Settings => "SETTINGS",
-        }
-    }
-
-    /// Entry in the mode list.
-    pub const fn label(self) -> &'static str {
-        match self {
-            Mode::Jog => "Jog",
-            Mode::Line => "Line",
-            Mode::Circle => "Circle/arc",
-            Mode::Ellipse => "Ellipse",
-            Mode::Sine => "Sine wave",
-            Mode::Function => "Function y=f(x)",
-            Mode::Settings => "Settings",
-        }
-    }
-
-    /// Position in [`Mode::ALL`].
-    pub fn index(self) -> usize {
-        Mode::ALL.iter().position(|&m| m == self).unwrap_or(0)
-    }
-
-    /// The fields of the mode's form; empty for modes without one.
-    pub const fn fields(self) -> &'static [Field] {
-        match self {
-            Mode::Line => form::LINE_FIELDS,
-            Mode::Circle => form::CIRCLE_FIELDS,
-            Mode::Ellipse => form::ELLIPSE_FIELDS,
-            Mode::Sine => form::SINE_FIELDS,
-            Mode::Function => form::FUNCTION_FIELDS,
-            Mode::Jog | Mode::Settings => &[],
-        }
-    }
-}
-
-/// Why the menu refused a key or a job; shown until the next key.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum UiError {
-    Entry(EntryError),
-    /// `#` on an empty field that has no default.
-    Empty,
-    OutOfRange {
-        min: f32,
-        max: f32,
-        unit: Unit,
-    },
-    /// Zero where the field needs a length.
-    Zero,
-    /// A function's x1 equals its x0.
-    SameEnds,
-    /// The drawing builder refused the drawing (beyond the travel, too steep, too fine, a
-    /// function undefined part way...).
-    Drawing(DrawError),
-    /// The machine is moving or has jobs queued.
-    Busy,
-    /// An alarm locks motion.
-    Alarm,
 }
 
 /// A keypad jog in progress.

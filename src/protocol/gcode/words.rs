@@ -1,7 +1,7 @@
 //! The words of a line and the block they make: compaction, G-code numbers, the letter values,
 //! and the G and M commands sorted into GRBL's modal groups, before any check against the state.
 
-use super::{Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
+use super::modal::{Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 use crate::protocol::GrblError;
 use crate::protocol::framing::LINE_MAX_BYTES;
 

@@ -6,7 +6,10 @@ use core::ops::RangeInclusive;
 
 use core::f32::consts::TAU;
 
-use super::{MenuAction, Mode, UiError};
+use super::action::MenuAction;
+use super::error::UiError;
+use super::mode::Mode;
+use super::unit::Unit;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job};
@@ -39,23 +42,6 @@ pub const FUNCTION_X_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
 
 /// Most fields one form has.
 pub const FORM_MAX_FIELDS: usize = 4;
-
-/// Unit of a number field.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub enum Unit {
-    Mm,
-    Deg,
-}
-
-impl Unit {
-    pub const fn symbol(self) -> &'static str {
-        match self {
-            Unit::Mm => "mm",
-            Unit::Deg => "deg",
-        }
-    }
-}
 
 /// A number to type: its name, unit, range, and what an empty field means.
 #[derive(Clone, Debug, PartialEq)]
@@ -105,32 +91,46 @@ const fn deg(label: &'static str, range: RangeInclusive<f32>, hint: &'static str
     Field::Number(NumberField { label, unit: Unit::Deg, range, default: Some(0.0), zero_allowed: true, hint })
 }
 
-pub(super) const LINE_FIELDS: &[Field] = &[
+const LINE_FIELDS: &[Field] = &[
     mm("dX", LINE_DELTA_RANGE_MM, true, "X offset from the pen"),
     mm("dY", LINE_DELTA_RANGE_MM, true, "Y offset from the pen"),
 ];
-pub(super) const CIRCLE_FIELDS: &[Field] = &[
+const CIRCLE_FIELDS: &[Field] = &[
     mm("Radius", CIRCLE_RADIUS_RANGE_MM, false, HINT_NUMBER),
     deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
     deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
 ];
-pub(super) const ELLIPSE_FIELDS: &[Field] = &[
+const ELLIPSE_FIELDS: &[Field] = &[
     mm("a (X)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along X"),
     mm("b (Y)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along Y"),
     deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
     deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
 ];
-pub(super) const SINE_FIELDS: &[Field] = &[
+const SINE_FIELDS: &[Field] = &[
     mm("Amplitude", SINE_AMPLITUDE_RANGE_MM, true, HINT_NUMBER),
     mm("Period", SINE_PERIOD_RANGE_MM, false, "One wave along X"),
     deg("Phase", SINE_PHASE_RANGE_DEG, "Empty = 0"),
     mm("Length", SINE_LENGTH_RANGE_MM, false, "Along X, - = leftwards"),
 ];
-pub(super) const FUNCTION_FIELDS: &[Field] = &[
+const FUNCTION_FIELDS: &[Field] = &[
     Field::Preset,
     mm("x0", FUNCTION_X_RANGE_MM, true, "Start x (at the pen)"),
     mm("x1", FUNCTION_X_RANGE_MM, true, "End x"),
 ];
+
+impl Mode {
+    /// The fields of the mode's form; empty for modes without one.
+    pub const fn fields(self) -> &'static [Field] {
+        match self {
+            Mode::Line => LINE_FIELDS,
+            Mode::Circle => CIRCLE_FIELDS,
+            Mode::Ellipse => ELLIPSE_FIELDS,
+            Mode::Sine => SINE_FIELDS,
+            Mode::Function => FUNCTION_FIELDS,
+            Mode::Jog | Mode::Settings => &[],
+        }
+    }
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Form {

@@ -6,7 +6,8 @@ use super::*;
 use crate::drawing::{DrawError, Request};
 use crate::geom::{Point, Rotation};
 use crate::interp::Shape;
-use crate::job::Feed;
+use crate::job::{Feed, Job};
+use crate::ui::entry::EntryError;
 use crate::ui::presets::FunctionPreset;
 use std::vec::Vec;
 

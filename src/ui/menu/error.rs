@@ -1,0 +1,30 @@
+//! Why the menu refused a key or a job: the [`UiError`] it shows until the next key.
+
+use super::unit::Unit;
+use crate::drawing::DrawError;
+use crate::ui::entry::EntryError;
+
+/// Why the menu refused a key or a job; shown until the next key.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum UiError {
+    Entry(EntryError),
+    /// `#` on an empty field that has no default.
+    Empty,
+    OutOfRange {
+        min: f32,
+        max: f32,
+        unit: Unit,
+    },
+    /// Zero where the field needs a length.
+    Zero,
+    /// A function's x1 equals its x0.
+    SameEnds,
+    /// The drawing builder refused the drawing (beyond the travel, too steep, too fine, a
+    /// function undefined part way...).
+    Drawing(DrawError),
+    /// The machine is moving or has jobs queued.
+    Busy,
+    /// An alarm locks motion.
+    Alarm,
+}

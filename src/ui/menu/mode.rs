@@ -1,0 +1,52 @@
+//! The menu's top-level modes: their order in the mode list, their titles and labels. The
+//! fields of a mode's form are the forms' own (`form`).
+
+/// A top-level mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Mode {
+    Jog,
+    Line,
+    Circle,
+    Ellipse,
+    Sine,
+    Function,
+    Settings,
+}
+
+impl Mode {
+    /// Every mode, in menu order: `1` picks the first.
+    pub const ALL: [Mode; 7] =
+        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings];
+
+    /// Screen title.
+    pub const fn title(self) -> &'static str {
+        match self {
+            Mode::Jog => "JOG",
+            Mode::Line => "LINE",
+            Mode::Circle => "CIRCLE/ARC",
+            Mode::Ellipse => "ELLIPSE",
+            Mode::Sine => "SINE",
+            Mode::Function => "FUNCTION",
+            Mode::Settings => "SETTINGS",
+        }
+    }
+
+    /// Entry in the mode list.
+    pub const fn label(self) -> &'static str {
+        match self {
+            Mode::Jog => "Jog",
+            Mode::Line => "Line",
+            Mode::Circle => "Circle/arc",
+            Mode::Ellipse => "Ellipse",
+            Mode::Sine => "Sine wave",
+            Mode::Function => "Function y=f(x)",
+            Mode::Settings => "Settings",
+        }
+    }
+
+    /// Position in [`Mode::ALL`].
+    pub fn index(self) -> usize {
+        Mode::ALL.iter().position(|&m| m == self).unwrap_or(0)
+    }
+}
