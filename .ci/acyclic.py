@@ -14,12 +14,11 @@ still on the module that re-exports it. A parent's `pub use child::Item` alone i
 dependency on the child (it only offers the child's item); the parent depends on the child
 when its own code uses the item. Declaring a child module (`mod x;`) is no dependency either.
 
-A module and the modules inside it are one family, as in Rust's module tree: dependencies
-between a module and its own ancestors or descendants (a child using its parent's items, a
-parent using its children's) do not count, unless --family is given. Every strongly connected
-component of more than one module is a cycle; each is listed with the dependencies that make it
-up and where they are written, and the script exits with status 1. With --edges it first
-prints every dependency it found.
+A module and its own children count like any two modules: a child that uses its parent's items
+while the parent uses the child's is a circle. Every strongly connected component of more than
+one module is a cycle; each is listed with the dependencies that make it up and where they are
+written, and the script exits with status 1. With --edges it first prints every dependency it
+found.
 """
 import bisect
 import os
@@ -479,19 +478,6 @@ def main():
             for target in sorted(edges[module], key=lambda m: m.name):
                 first = evidence[(module, target)][0]
                 print(f"{module.name} -> {target.name}    line {first.line}: {first.text}")
-
-    # A module and the modules inside it form one family, as Rust's module tree does: a child
-    # uses its parent's items and the parent re-exports or uses its children's. Those edges
-    # are listed with --family; only circles through other modules fail.
-    def related(a, b):
-        def ancestors(m):
-            while m is not None:
-                yield m
-                m = m.parent
-        return a in ancestors(b) or b in ancestors(a)
-
-    if "--family" not in sys.argv[1:]:
-        edges = {m: {t for t in ts if not related(m, t)} for m, ts in edges.items()}
 
     found = cycles(modules, edges)
     count = sum(len(t) for t in edges.values())
