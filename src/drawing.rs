@@ -159,7 +159,7 @@ impl Extent {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Request {
     /// A straight line to the lattice point `to` (absolute).
-    Line {
+    Straight {
         to: Point,
     },
     Ellipse(EllipseParams),
@@ -417,7 +417,7 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
         Point::new(start.x + settings.mm_to_steps(Axis::X, x), start.y + settings.mm_to_steps(Axis::Y, y))
     };
     Ok(match request {
-        Request::Line { to } => {
+        Request::Straight { to } => {
             if *to == start {
                 return Ok(None);
             }

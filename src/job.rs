@@ -70,7 +70,7 @@ impl Job {
 
     /// A jog: a straight move from `from` to `to`; `None` when it goes nowhere.
     pub fn jog_to(from: Point, to: Point, feed: Feed, settings: &Settings) -> Result<Option<Job>, DrawError> {
-        let drawing = drawing::build(&Request::Line { to }, from, settings)?;
+        let drawing = drawing::build(&Request::Straight { to }, from, settings)?;
         Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog }))
     }
 

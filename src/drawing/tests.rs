@@ -39,7 +39,7 @@ fn the_end_and_the_box_are_the_curves_own() {
     let s = settings();
     let start = Point::new(1234, -567);
     for request in [
-        Request::Line { to: Point::new(-3000, 4000) },
+        Request::Straight { to: Point::new(-3000, 4000) },
         ellipse(20.0, 20.0, 30.0, 250.0),
         ellipse(30.0, 15.0, 0.0, 360.0),
         sine(10.0, 0.3, 60.0),
@@ -67,7 +67,7 @@ fn what_leaves_the_travel_is_refused() {
     assert!(build(&ellipse(150.0, 150.0, 0.0, 360.0), Point::new(10_000, 0), &s).unwrap().is_some());
     // A function that leaves between any samples one might take.
     assert_eq!(build(&function("x^2/2", 0.0, 30.0), Point::ORIGIN, &s), Err(DrawError::Travel));
-    assert_eq!(build(&Request::Line { to: Point::new(0, 20_001) }, Point::ORIGIN, &s), Err(DrawError::Travel));
+    assert_eq!(build(&Request::Straight { to: Point::new(0, 20_001) }, Point::ORIGIN, &s), Err(DrawError::Travel));
 }
 
 #[test]

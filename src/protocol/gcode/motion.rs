@@ -169,7 +169,7 @@ impl GcodeState {
     /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
     fn line(&mut self, target_mm: [f32; 2], feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
         let to = drawing::line_target(target_mm, settings).ok_or(GrblError::TravelExceeded)?;
-        self.draw(Request::Line { to }, feed, JobKind::Draw, Some(target_mm), settings)
+        self.draw(Request::Straight { to }, feed, JobKind::Draw, Some(target_mm), settings)
     }
 
     /// G2/G3 from the planned position to `end` (mm).

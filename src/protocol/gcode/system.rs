@@ -147,7 +147,7 @@ impl GcodeState {
             }
         }
         let to = drawing::line_target(target, settings).ok_or(GrblError::TravelExceeded)?;
-        let jog = self.draw(Request::Line { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
+        let jog = self.draw(Request::Straight { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
         Ok(jog.map(Commands::one).unwrap_or_default())
     }
 }

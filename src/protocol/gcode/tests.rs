@@ -46,7 +46,7 @@ fn refused(g: &mut GcodeState, line: &str, code: u8) {
 
 /// A straight job from `from` to (`x`, `y`) steps.
 fn line_from(from: Point, x: i32, y: i32, feed: Feed, kind: JobKind) -> Command {
-    let drawing = crate::drawing::build(&Request::Line { to: Point::new(x, y) }, from, &settings());
+    let drawing = crate::drawing::build(&Request::Straight { to: Point::new(x, y) }, from, &settings());
     Command::Job(Job { drawing: drawing.unwrap().unwrap(), feed, kind })
 }
 
@@ -438,7 +438,7 @@ fn changing_steps_per_mm_keeps_the_pen_on_its_step() {
     assert_eq!(g.position_mm, [12.5, 0.0]);
     let cmds = g.execute("G91 G0 X1", &s, RunState::Idle).unwrap();
     let from = Point::new(1000, 0);
-    let drawing = crate::drawing::build(&Request::Line { to: Point::new(1080, 0) }, from, &s).unwrap().unwrap();
+    let drawing = crate::drawing::build(&Request::Straight { to: Point::new(1080, 0) }, from, &s).unwrap().unwrap();
     assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::Job(Job::draw(drawing, Feed::Rapid))]);
 }
 

@@ -246,7 +246,7 @@ impl Form {
                 let pen_mm = [settings.steps_to_mm(Axis::X, start.x), settings.steps_to_mm(Axis::Y, start.y)];
                 let to = drawing::line_target([pen_mm[0] + dx, pen_mm[1] + dy], settings)
                     .ok_or(UiError::Drawing(DrawError::Travel))?;
-                Request::Line { to }
+                Request::Straight { to }
             }
             Mode::Circle => Request::Ellipse(EllipseParams::circle(self.number(0)?, self.number(1)?, self.sweep(2)?)),
             Mode::Ellipse => Request::Ellipse(EllipseParams {

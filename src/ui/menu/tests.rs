@@ -39,7 +39,7 @@ fn idle() -> Status {
 
 /// A line started from the pen at `from` to (`x`, `y`) steps.
 fn line_from(from: Point, x: i32, y: i32) -> MenuAction {
-    let drawing = crate::drawing::build(&Request::Line { to: Point::new(x, y) }, from, &Settings::default());
+    let drawing = crate::drawing::build(&Request::Straight { to: Point::new(x, y) }, from, &Settings::default());
     MenuAction::Start(Job::draw(drawing.unwrap().unwrap(), Feed::MmPerMin(3_000.0)))
 }
 
