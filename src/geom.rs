@@ -94,6 +94,7 @@ impl Step {
     }
 
     /// True when the step goes to a lattice neighbour (8-neighbourhood, not standing still).
+    #[cfg(test)]
     pub const fn is_neighbour(self) -> bool {
         (self.x >= -1 && self.x <= 1 && self.y >= -1 && self.y <= 1) && !(self.x == 0 && self.y == 0)
     }
