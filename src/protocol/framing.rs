@@ -7,16 +7,18 @@
 //! and acts on the realtime ones at once; [`LineAssembler`] skips them too, so a line is the same
 //! whether or not the sender slipped a `?` into it.
 //!
-//! A line is kept exactly as sent (comments and spaces included, since the `$F` expression needs
-//! its own parentheses); the G-code parser strips comments itself. The assembler owns only
-//! framing: line length, line ends and which bytes may stand in a line. It must not interpret
-//! the line's contents.
+//! As GRBL does, the assembler drops what a line does not need as the bytes arrive, and counts
+//! only what it keeps against [`LINE_MAX_BYTES`]: spaces, tabs and comments (`(...)` and `;` to
+//! the end) of a G-code line or a `$J=` jog, so that a long comment or a line padded with spaces
+//! is no overflow, and any byte inside a comment (UTF-8 text included) is ignored. A `$` command
+//! is kept as sent up to a `;` comment: the plotter's curve commands need their spaces and the
+//! `$F` expression its parentheses. Leading spaces go from every line. Beyond that the assembler
+//! owns only framing (line ends, which bytes may stand in a line); the parsers read the words.
 
 use super::GrblError;
 
-/// Longest line kept, in bytes, comments and spaces included. GRBL keeps 80 bytes after
-/// stripping spaces and comments; a few more leave room for spaces in the plotter's `$`
-/// commands while a sender's character counting (128-byte receive buffer) still holds a line.
+/// Longest line kept, in bytes, after dropping what the module documentation says. GRBL keeps
+/// 80; a few more leave room for the spaces of the plotter's `$` commands.
 pub const LINE_MAX_BYTES: usize = 96;
 
 /// A byte that acts at once instead of being part of a line.
@@ -79,21 +81,46 @@ impl LineEvent<'_> {
 /// Collects bytes into lines; see the module documentation.
 ///
 /// A line ends at LF or CR; an LF right after a CR only completes the CRLF pair and makes no
-/// second (empty) line. Every other byte that is not realtime belongs to the line: printable
-/// ASCII and tab are kept; any other byte marks the whole line as refused. A line that grows past
-/// [`LINE_MAX_BYTES`] is dropped up to its end and reported once, as [`LineEvent::Overflow`],
-/// when that end arrives. A soft reset byte (0x18) drops the partial line, as GRBL's reset
-/// flushes its receive buffer.
+/// second (empty) line. Every other byte that is not realtime belongs to the line: outside
+/// comments, printable ASCII (and tab, in a `$` command) is kept; any other byte marks the whole
+/// line as refused. A line whose kept bytes grow past [`LINE_MAX_BYTES`] is dropped up to its end
+/// and reported once, as [`LineEvent::Overflow`], when that end arrives. A soft reset byte
+/// (0x18) drops the partial line, as GRBL's reset flushes its receive buffer.
 #[derive(Clone, Debug)]
 pub struct LineAssembler {
     buf: [u8; LINE_MAX_BYTES],
     len: usize,
+    kind: Kind,
+    comment: Comment,
     overflow: bool,
     bad_byte: Option<u8>,
     /// The previous line-ending byte was a CR: a following LF belongs to it.
     after_cr: bool,
     /// A line was handed out by the previous `push`; the buffer starts over at the next byte.
     handed_out: bool,
+}
+
+/// What the line under way is, as far as its first bytes tell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Nothing kept yet: spaces are dropped, the first other byte decides.
+    Start,
+    /// A `$` kept: the next byte tells a jog (`$J`) from a `$` command.
+    Dollar,
+    /// G-code or a `$J=` jog: spaces, tabs and comments are dropped.
+    Gcode,
+    /// A `$` command: kept as sent, up to a `;` comment.
+    Command,
+}
+
+/// Whether the byte under way lies in a comment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Comment {
+    None,
+    /// Inside `(...)`, up to the `)`.
+    Paren,
+    /// After `;`, up to the line end.
+    ToEnd,
 }
 
 impl Default for LineAssembler {
@@ -107,6 +134,8 @@ impl LineAssembler {
         LineAssembler {
             buf: [0; LINE_MAX_BYTES],
             len: 0,
+            kind: Kind::Start,
+            comment: Comment::None,
             overflow: false,
             bad_byte: None,
             after_cr: false,
@@ -116,20 +145,24 @@ impl LineAssembler {
 
     /// Drops the partial line (after a soft reset, or when the link reconnects).
     pub fn clear(&mut self) {
-        self.len = 0;
-        self.overflow = false;
-        self.bad_byte = None;
+        self.start_line();
         self.after_cr = false;
         self.handed_out = false;
+    }
+
+    fn start_line(&mut self) {
+        self.len = 0;
+        self.kind = Kind::Start;
+        self.comment = Comment::None;
+        self.overflow = false;
+        self.bad_byte = None;
     }
 
     /// Takes one byte; returns an event when it ended a line. The returned line borrows the
     /// assembler's buffer and is valid until the next `push`.
     pub fn push(&mut self, byte: u8) -> Option<LineEvent<'_>> {
         if self.handed_out {
-            self.len = 0;
-            self.overflow = false;
-            self.bad_byte = None;
+            self.start_line();
             self.handed_out = false;
         }
         if let Some(rt) = realtime(byte) {
@@ -150,19 +183,52 @@ impl LineAssembler {
             }
             _ => {
                 self.after_cr = false;
-                let allowed = byte == b'\t' || (0x20..=0x7E).contains(&byte);
-                if !allowed {
-                    if self.bad_byte.is_none() {
-                        self.bad_byte = Some(byte);
-                    }
-                } else if self.len < LINE_MAX_BYTES {
-                    self.buf[self.len] = byte;
-                    self.len += 1;
-                } else {
-                    self.overflow = true;
-                }
+                self.take(byte);
                 None
             }
+        }
+    }
+
+    /// A byte of the line under way, not a line end: dropped, kept, or refusing the line.
+    fn take(&mut self, byte: u8) {
+        match self.comment {
+            Comment::ToEnd => return,
+            Comment::Paren => {
+                if byte == b')' {
+                    self.comment = Comment::None;
+                }
+                return;
+            }
+            Comment::None => {}
+        }
+        let kind = match (self.kind, byte) {
+            (Kind::Start, b' ' | b'\t') => return,
+            (Kind::Start, b'$') => Kind::Dollar,
+            (Kind::Start, _) => Kind::Gcode,
+            (Kind::Dollar, b'J' | b'j') => Kind::Gcode,
+            (Kind::Dollar, _) => Kind::Command,
+            (kind, _) => kind,
+        };
+        self.kind = kind;
+        match (kind, byte) {
+            (Kind::Gcode, b' ' | b'\t') => {}
+            (Kind::Gcode, b'(') => self.comment = Comment::Paren,
+            (_, b';') => self.comment = Comment::ToEnd,
+            (Kind::Command, b'\t') | (_, 0x20..=0x7E) => self.keep(byte),
+            _ => {
+                if self.bad_byte.is_none() {
+                    self.bad_byte = Some(byte);
+                }
+            }
+        }
+    }
+
+    fn keep(&mut self, byte: u8) {
+        if self.len < LINE_MAX_BYTES {
+            self.buf[self.len] = byte;
+            self.len += 1;
+        } else {
+            self.overflow = true;
         }
     }
 
@@ -209,7 +275,7 @@ mod tests {
     #[test]
     fn lf_cr_and_crlf_each_end_one_line() {
         let mut a = LineAssembler::new();
-        assert_eq!(feed(&mut a, b"G0 X1\nG0 X2\rG0 X3\r\nG0 X4\n"), lines(&["G0 X1", "G0 X2", "G0 X3", "G0 X4"]));
+        assert_eq!(feed(&mut a, b"G0 X1\nG0 X2\rG0 X3\r\nG0 X4\n"), lines(&["G0X1", "G0X2", "G0X3", "G0X4"]));
     }
 
     #[test]
@@ -226,7 +292,7 @@ mod tests {
     #[test]
     fn realtime_bytes_mid_line_are_not_part_of_it() {
         let mut a = LineAssembler::new();
-        assert_eq!(feed(&mut a, b"G1 X?1!0~ Y\x855\x91\n"), lines(&["G1 X10 Y5"]));
+        assert_eq!(feed(&mut a, b"G1 X?1!0~ Y\x855\x91\n"), lines(&["G1X10Y5"]));
         assert_eq!(realtime(b'?'), Some(Realtime::StatusQuery));
         assert_eq!(realtime(b'!'), Some(Realtime::FeedHold));
         assert_eq!(realtime(b'~'), Some(Realtime::CycleStart));
@@ -240,7 +306,7 @@ mod tests {
     #[test]
     fn reset_drops_the_partial_line() {
         let mut a = LineAssembler::new();
-        assert_eq!(feed(&mut a, b"G1 X100\x18G0 X0\n"), lines(&["G0 X0"]));
+        assert_eq!(feed(&mut a, b"G1 X100\x18G0 X0\n"), lines(&["G0X0"]));
     }
 
     #[test]
@@ -248,7 +314,7 @@ mod tests {
         let mut a = LineAssembler::new();
         let mut input = std::vec![b'X'; LINE_MAX_BYTES * 3];
         input.extend_from_slice(b"\r\nG0 X1\n");
-        assert_eq!(feed(&mut a, &input), std::vec![Err(LineEvent::Overflow), Ok("G0 X1".to_string())]);
+        assert_eq!(feed(&mut a, &input), std::vec![Err(LineEvent::Overflow), Ok("G0X1".to_string())]);
     }
 
     #[test]
@@ -266,13 +332,35 @@ mod tests {
     fn control_and_non_ascii_bytes_refuse_the_line_without_eating_the_next() {
         let mut a = LineAssembler::new();
         // "°" in UTF-8 is C2 B0; neither byte is a GRBL realtime command.
-        let got = feed(&mut a, "G0 X1 (10°)\nG0 X2\n".as_bytes());
-        assert_eq!(got, std::vec![Err(LineEvent::BadByte(0xC2)), Ok("G0 X2".to_string())]);
+        let got = feed(&mut a, "G0 X1°\nG0 X2\n$S A5°\n".as_bytes());
+        assert_eq!(
+            got,
+            std::vec![Err(LineEvent::BadByte(0xC2)), Ok("G0X2".to_string()), Err(LineEvent::BadByte(0xC2))]
+        );
         let got = feed(&mut a, b"G0\x07X1\n\tG0\tX3\n");
-        assert_eq!(got, std::vec![Err(LineEvent::BadByte(0x07)), Ok("\tG0\tX3".to_string())]);
+        assert_eq!(got, std::vec![Err(LineEvent::BadByte(0x07)), Ok("G0X3".to_string())]);
         assert_eq!(LineEvent::BadByte(7).error(), Some(GrblError::ExpectedCommandLetter));
         assert_eq!(LineEvent::Overflow.error().map(GrblError::code), Some(11));
         assert_eq!(LineEvent::Line("").error(), None);
+    }
+
+    #[test]
+    fn comments_and_spaces_are_dropped_before_the_length_counts() {
+        let mut a = LineAssembler::new();
+        let long = "c".repeat(100);
+        let input = std::format!("({long})\nG1 X2 Y2 ;{long}\nG1{}X1 Y1\nG1 X7 ; café\n", " ".repeat(90));
+        assert_eq!(feed(&mut a, input.as_bytes()), lines(&["", "G1X2Y2", "G1X1Y1", "G1X7"]));
+        // A comment in the middle, with any bytes in it; an unclosed one ends with its line.
+        assert_eq!(feed(&mut a, "G0 (é\x07 x) X1\nG0 X2 (open\nG0 X3\n".as_bytes()), lines(&["G0X1", "G0X2", "G0X3"]));
+        // Jogs are G-code.
+        assert_eq!(feed(&mut a, b"  $J=G91 X1 (step) F100\n"), lines(&["$J=G91X1F100"]));
+    }
+
+    #[test]
+    fn a_dollar_command_keeps_its_spaces_and_parentheses_up_to_a_semicolon() {
+        let mut a = LineAssembler::new();
+        let got = feed(&mut a, " $F X0 U10 Y=sqrt(x+1) ; café\n$S\tA5\n$$\n".as_bytes());
+        assert_eq!(got, lines(&["$F X0 U10 Y=sqrt(x+1) ", "$S\tA5", "$$"]));
     }
 
     #[test]
