@@ -50,6 +50,15 @@ impl Iterator for WordIter<'_> {
         let n = tail.iter().take_while(|c| c.is_ascii_digit() || matches!(c, b'.' | b'+' | b'-')).count();
         let (number, rest) = tail.split_at(n);
         self.rest = rest;
+        // `1e9`: G-code has no exponents (`E` would be a word of its own, and no command takes
+        // one); say what is wrong with the number rather than with an `E` word.
+        if let [b'E', next, ..] = rest
+            && (next.is_ascii_digit() || matches!(next, b'.' | b'+' | b'-'))
+            && !number.is_empty()
+        {
+            self.rest = &[];
+            return Some(Err(GrblError::BadNumberFormat));
+        }
         Some(parse_number(number).map(|v| (letter, v)))
     }
 }
