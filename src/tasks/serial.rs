@@ -6,6 +6,13 @@
 //! loop, which assembles lines, runs them through the G-code parser and answers `ok` or
 //! `error:N` once their jobs are queued (back-pressure paces a streaming sender). A third loop
 //! reports curves that stopped early. Answers are whole lines, never interleaved.
+//!
+//! Every line gets exactly one answer, in order, whatever the sender does. A sender that
+//! ignores GRBL's flow control and sends more than the pipe holds while the machine is busy
+//! loses whole lines, never parts of them: from the byte that found no room up to the end of a
+//! line, the receiver drops the lines' bytes and counts their ends; once the line loop has
+//! emptied the pipe it answers each of those lines `error:11` (not processed), and only then
+//! does the receiver pass bytes on again, from the start of the next line.
 
 use core::cell::Cell;
 use core::fmt::Write as _;
@@ -31,14 +38,13 @@ use crate::settings::Settings;
 use crate::status::RunState;
 
 /// Bytes between the receiver and the line loop. GRBL senders keep at most 128 unanswered bytes
-/// in flight, so this never fills; should a sender ignore that, see `Link::line_byte`.
-pub const SERIAL_PIPE_BYTES: usize = 128;
+/// in flight, so this never fills for them; it also holds a terminal paste of about 50 lines
+/// beyond what the machine has room for. Beyond that, see the module documentation.
+pub const SERIAL_PIPE_BYTES: usize = 1024;
 /// What a sender may assume it can have in flight (reported by `$I`).
 pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
 /// Longest answer to one line: `$$` lists every setting (about 300 bytes).
 pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
-/// Ends a line damaged by a full pipe: the line assembler refuses lines holding it.
-const LINE_DAMAGED: u8 = 0x00;
 /// How long a byte may wait for room in the pipe before it is dropped: the line loop drains
 /// the pipe far faster unless it is waiting for the machine.
 pub const SERIAL_PIPE_WAIT_MS: u64 = 20;
@@ -58,8 +64,8 @@ struct Link<'m, W> {
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
     /// Feed rate of the motion in progress, for status reports.
     feed_mm_per_min: Cell<f32>,
-    /// The pipe was full: bytes are being dropped up to the end of the damaged line.
-    overflowing: Cell<bool>,
+    /// Lines dropped for want of room in the pipe; see the module documentation.
+    dropped: Dropped,
     /// Resets received and not yet met by the line loop: bytes before them are dropped.
     resets_pending: Cell<u32>,
     /// Cancels a line waiting for the machine when a reset arrives.
@@ -73,7 +79,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         tx: Mutex::new(tx),
         bytes: Pipe::new(),
         feed_mm_per_min: Cell::new(0.0),
-        overflowing: Cell::new(false),
+        dropped: Dropped::default(),
         resets_pending: Cell::new(0),
         reset: Signal::new(),
     };
@@ -132,22 +138,78 @@ impl<W: Write> Link<'_, W> {
     /// Passes a byte of a line to the line loop. When the pipe stays full for
     /// `SERIAL_PIPE_WAIT_MS` (a sender ignoring GRBL's flow control while the line loop waits
     /// for the machine) the byte is dropped rather than waited for, so realtime bytes behind it
-    /// are still read; the damaged line is then ended with a byte no line may hold, so it is
-    /// refused (`error:1`) rather than run in pieces, and the host is told.
+    /// are still read, and its line with it; see the module documentation.
     async fn line_byte(&self, byte: u8) {
-        let ends_line = byte == b'\n' || byte == b'\r';
-        if self.overflowing.get() {
-            if ends_line && self.bytes.free_capacity() >= 2 {
-                let _ = self.bytes.try_write(&[LINE_DAMAGED, byte]);
-                self.overflowing.set(false);
-            }
+        let d = &self.dropped;
+        // An LF right after a CR completes the CRLF pair: no line end of its own.
+        let pair = byte == b'\n' && d.after_cr.get();
+        let cr_dropped = d.cr_dropped.replace(false);
+        d.after_cr.set(byte == b'\r');
+        if pair && (cr_dropped || d.active.get()) {
             return;
         }
-        let wait = Timer::after(Duration::from_millis(SERIAL_PIPE_WAIT_MS));
-        if let Either::Second(()) = select(self.bytes.write_all(&[byte]), wait).await {
-            self.overflowing.set(true);
-            self.send(|a| report::message(a, "Receive buffer full: a line was dropped")).await;
+        if !d.active.get() {
+            let wait = Timer::after(Duration::from_millis(SERIAL_PIPE_WAIT_MS));
+            if let Either::First(()) = select(self.bytes.write_all(&[byte]), wait).await {
+                return;
+            }
+            if pair {
+                // Its CR ended the line already: nothing is lost.
+                return;
+            }
+            d.active.set(true);
+            self.send(|a| report::message(a, "Receive buffer full: lines dropped, each answered error:11")).await;
         }
+        d.cr_dropped.set(byte == b'\r');
+        if byte == b'\n' || byte == b'\r' {
+            d.lines.set(d.lines.get() + 1);
+            d.mid_line.set(false);
+            d.counted.signal(());
+        } else {
+            d.mid_line.set(true);
+        }
+    }
+}
+
+/// The receiver's count of lines dropped for want of room in the pipe.
+#[derive(Default)]
+struct Dropped {
+    /// Bytes of lines are dropped, not passed on, until the line loop has answered the lines
+    /// dropped so far and the receiver stands at the start of a line.
+    active: Cell<bool>,
+    /// Ends of dropped lines, not yet answered.
+    lines: Cell<u32>,
+    /// The last line byte dropped was not a line end: a dropped line is still under way.
+    mid_line: Cell<bool>,
+    /// The last line byte, passed on or dropped, was a CR.
+    after_cr: Cell<bool>,
+    /// The last line byte was a CR, dropped: an LF after it completes a dropped line.
+    cr_dropped: Cell<bool>,
+    /// Wakes the line loop when a dropped line's end is counted.
+    counted: Signal<NoopRawMutex, ()>,
+}
+
+impl Dropped {
+    /// Forgets every dropped line (a reset: lines before it get no answer).
+    fn clear(&self) {
+        self.active.set(false);
+        self.lines.set(0);
+        self.mid_line.set(false);
+        self.after_cr.set(false);
+        self.cr_dropped.set(false);
+    }
+
+    /// The dropped lines to answer now, if the line loop has taken every byte that came before
+    /// them; passing bytes on starts again if no dropped line is under way.
+    fn take(&self, pipe_empty: bool) -> u32 {
+        if !self.active.get() || !pipe_empty {
+            return 0;
+        }
+        let n = self.lines.replace(0);
+        if !self.mid_line.get() {
+            self.active.set(false);
+        }
+        n
     }
 }
 
@@ -177,7 +239,7 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
                     // discards bytes up to this marker and resets the parser when it meets it.
                     link.resets_pending.set(link.resets_pending.get() + 1);
                     link.reset.signal(());
-                    link.overflowing.set(false);
+                    link.dropped.clear();
                     link.bytes.write_all(&[byte]).await;
                 }
                 Some(Realtime::JogCancel | Realtime::Unsupported(_)) => {}
@@ -205,7 +267,19 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
     // machine stops.
     let mut epoch = machine.plan_epoch();
     loop {
-        let n = link.bytes.read(&mut buf).await;
+        let dropped = link.dropped.take(link.bytes.is_empty());
+        if dropped > 0 {
+            // Lines whose bytes found no room: the partial one in the assembler is the first.
+            assembler.clear();
+            for _ in 0..dropped {
+                link.send(|a| report::error(a, GrblError::LineOverflow)).await;
+            }
+            continue;
+        }
+        let n = match select(link.bytes.read(&mut buf), link.dropped.counted.wait()).await {
+            Either::First(n) => n,
+            Either::Second(()) => continue,
+        };
         for &byte in &buf[..n] {
             if byte == 0x18 {
                 link.resets_pending.set(link.resets_pending.get().saturating_sub(1));

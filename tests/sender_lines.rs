@@ -1,0 +1,100 @@
+//! What a sender or a terminal sees of its lines, on the simulated board: every line gets
+//! exactly one answer, in order, however it is sent, and GRBL's rules for what a line holds.
+
+use servoplot::geom::Point;
+use servoplot::sim::{self, SimConfig, SimReport, serial::SimSerial};
+
+/// Bytes pasted at `t_us`, all at once, ignoring flow control.
+fn paste(serial: SimSerial, t_us: u64, text: &str) -> SimSerial {
+    text.bytes().fold(serial, |s, b| s.with_byte_at(t_us, b))
+}
+
+fn run(serial: SimSerial) -> SimReport {
+    let report = sim::run(SimConfig { serial, ..SimConfig::default() });
+    assert!(!report.timed_out, "the machine came to rest: {}", report.answers());
+    report
+}
+
+/// The answers to lines (`ok`, `error:N`), in order, without pushed messages and reports.
+fn answers(report: &SimReport) -> Vec<String> {
+    let text = report.answers();
+    text.lines().filter(|l| *l == "ok" || l.starts_with("error:")).map(str::to_string).collect()
+}
+
+/// `G1 X<k> Y<k>` for k in `range`, one line each: every line's target is a point of its own.
+fn diagonal_lines(range: std::ops::RangeInclusive<u32>) -> String {
+    range.map(|k| format!("G1 X{k}.000 Y{k}.000\n")).collect()
+}
+
+/// Every line pasted gets one answer, in order; a line answered `ok` is drawn, one answered
+/// `error:11` is not; a line sent afterwards is answered and drawn as usual.
+fn check_paste(count: u32) {
+    let first = "G1 X50 F1200\n";
+    let pasted = diagonal_lines(10..=9 + count);
+    let serial = SimSerial::with_input(first.as_bytes());
+    let serial = paste(serial, 1_000, &pasted);
+    // Long after the paste has been dealt with.
+    let report = run(paste(serial, 600_000_000, "G1 X1 Y1\n"));
+    let got = answers(&report);
+    assert_eq!(got.len() as u32, count + 2, "one answer per line: {}", report.answers());
+    assert_eq!(got[0], "ok");
+    assert_eq!(got[got.len() - 1], "ok", "the line sent later: {}", report.answers());
+    let path = report.path();
+    let mut from = 0;
+    for (k, answer) in (10..=9 + count).zip(&got[1..got.len() - 1]) {
+        let target = Point::new(k as i32 * 100, k as i32 * 100);
+        let reached = path[from..].iter().position(|p| *p == target);
+        match answer.as_str() {
+            "ok" => from += reached.unwrap_or_else(|| panic!("line {k} was answered ok but not drawn")),
+            "error:11" => assert_eq!(reached, None, "line {k} was refused but drawn"),
+            other => panic!("line {k}: {other}"),
+        }
+    }
+    assert_eq!(report.position, Point::new(100, 100));
+}
+
+#[test]
+fn a_paste_of_28_lines_while_busy_runs_every_line() {
+    check_paste(28);
+    let report = run(paste(SimSerial::with_input(b"G1 X50 F1200\n"), 1_000, &diagonal_lines(10..=37)));
+    assert_eq!(answers(&report), vec!["ok"; 29], "{}", report.answers());
+    assert!(!report.answers().contains("Receive buffer full"));
+}
+
+#[test]
+fn a_paste_beyond_the_receive_buffer_answers_every_line_in_order() {
+    for count in [60, 150, 400] {
+        check_paste(count);
+    }
+    let report = run(paste(SimSerial::with_input(b"G1 X50 F1200\n"), 1_000, &diagonal_lines(10..=409)));
+    let got = answers(&report);
+    assert!(got.iter().any(|a| a == "error:11"), "the paste overflowed: {}", report.answers());
+    assert!(report.answers().contains("[MSG:Receive buffer full: lines dropped, each answered error:11]"));
+}
+
+#[test]
+fn a_paste_with_crlf_line_ends_beyond_the_buffer_answers_every_line_once() {
+    let pasted = diagonal_lines(10..=209).replace('\n', "\r\n");
+    let serial = paste(SimSerial::with_input(b"G1 X50 F1200\n"), 1_000, &pasted);
+    let report = run(paste(serial, 900_000_000, "G1 X1 Y1\r\n"));
+    assert_eq!(answers(&report).len(), 202, "{}", report.answers());
+    assert_eq!(report.position, Point::new(100, 100));
+}
+
+#[test]
+fn comments_and_spaces_do_not_count_toward_the_line_length() {
+    let long = "c".repeat(100);
+    let program = format!("({long})\nG1 X2 Y2 ;{long}\nG1{}X1 Y1\nG1 X7 ; café\n", " ".repeat(90));
+    let report = run(SimSerial::with_input(program.as_bytes()));
+    assert_eq!(answers(&report), vec!["ok"; 4], "{}", report.answers());
+    assert_eq!(report.position, Point::new(700, 100));
+}
+
+#[test]
+fn a_number_with_an_exponent_is_a_bad_number() {
+    for line in ["$S A5 W1e9 L10\n", "$F X0 U1e9 Y=x\n", "G1 X1e3\n", "G1 X1E-3\n"] {
+        let report = run(SimSerial::with_input(line.as_bytes()));
+        assert_eq!(answers(&report), vec!["error:2"], "{line}: {}", report.answers());
+        assert!(report.path().len() <= 1, "{line} moved");
+    }
+}
