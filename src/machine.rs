@@ -371,6 +371,15 @@ impl Machine {
         self.plan_empty.load(Ordering::Acquire) && self.jobs.is_empty() && self.pulses_idle()
     }
 
+    /// True when the machine waits for its inputs: idle, or stopped in an alarm.
+    pub fn at_rest(&self) -> bool {
+        match self.run_state() {
+            RunState::Idle => self.is_idle(),
+            RunState::Alarm => self.stopped(),
+            _ => false,
+        }
+    }
+
     /// True when nothing is queued, planned or moving.
     pub fn is_idle(&self) -> bool {
         self.run_state() == RunState::Idle && self.jobs.is_empty() && self.pulses_idle()

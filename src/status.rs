@@ -16,7 +16,7 @@ pub enum RunState {
     Hold,
     /// Moving under a jog command (keypad or `$J=`).
     Jog,
-    /// A driver alarm or limit switch stopped the machine.
+    /// A fault stopped the machine (see [`MotionFault`]); motion is refused until `$X`.
     Alarm,
 }
 

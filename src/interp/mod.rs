@@ -147,6 +147,14 @@ impl Curve {
         Ok(Curve { kind, at: start, limit, ended: false })
     }
 
+    /// The same curve, guarded by the travel `limit` (± steps on each axis) instead of the one
+    /// of the settings it was set up with: the motion task guards every curve by the travel of
+    /// the settings it runs under, should they have changed since the curve was built.
+    pub fn keep_within(mut self, limit: [i32; 2]) -> Curve {
+        self.limit = limit;
+        self
+    }
+
     /// Steps the pen is away from the nearest edge of the travel (negative outside).
     fn margin_steps(&self) -> i32 {
         (self.limit[0] - self.at.x.abs()).min(self.limit[1] - self.at.y.abs())

@@ -16,7 +16,7 @@ use crate::drawing::DrawError;
 use crate::geom::Axis;
 use crate::interp::CurveError;
 use crate::settings::{SETTING_INFO, Settings};
-use crate::status::{RunState, Status};
+use crate::status::{MotionFault, RunState, Status};
 
 /// The GRBL version the plotter speaks; senders look for "Grbl 1.1".
 pub const GRBL_VERSION: &str = "1.1h";
@@ -78,6 +78,25 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
 /// The banner after power-up and every soft reset.
 pub fn welcome(out: &mut impl Write) -> fmt::Result {
     write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")
+}
+
+/// GRBL's alarm code for the soft limit: a motion would leave the travel.
+pub const ALARM_SOFT_LIMIT: u8 = 2;
+/// The alarm code for a curve that stopped part way for another reason (not a GRBL code).
+pub const ALARM_CURVE_STOPPED: u8 = 20;
+
+/// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened.
+pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
+    let MotionFault::Curve(e) = fault;
+    let code = if e == CurveError::Travel { ALARM_SOFT_LIMIT } else { ALARM_CURVE_STOPPED };
+    let why = match e {
+        CurveError::Domain => "function undefined",
+        CurveError::DivisionByZero => "division by zero",
+        CurveError::Overflow => "value too large",
+        CurveError::Jump => "jump over $204",
+        CurveError::Travel => "travel limit",
+    };
+    write!(out, "ALARM:{code}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n")
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
@@ -281,6 +300,17 @@ mod tests {
         assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
         assert_eq!(text(|o| build_info(o, 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
         assert!(text(help).starts_with("[HLP:$$ $# $G $I"));
+    }
+
+    #[test]
+    fn an_alarm_is_pushed_with_its_code_and_why() {
+        let travel = text(|o| alarm(o, MotionFault::Curve(CurveError::Travel)));
+        assert_eq!(travel, "ALARM:2\r\n[MSG:Curve stopped: travel limit; queued lines dropped. '$X' to unlock]\r\n");
+        let jump = text(|o| alarm(o, MotionFault::Curve(CurveError::Jump)));
+        assert!(jump.starts_with("ALARM:20\r\n[MSG:Curve stopped: jump over $204;"), "{jump}");
+        for line in travel.lines().chain(jump.lines()) {
+            assert!(line.len() <= REPORT_LINE_MAX_BYTES);
+        }
     }
 
     #[test]

@@ -165,10 +165,10 @@ pub fn run(config: SimConfig) -> SimReport {
             continue;
         }
         let now = clock::now_ticks();
-        if !matrix.started() && serial.input_done() && machine.is_idle() {
+        if !matrix.started() && serial.input_done() && machine.at_rest() {
             matrix.start();
         }
-        let at_rest = serial.input_done() && matrix.script_done() && machine.is_idle();
+        let at_rest = serial.input_done() && matrix.script_done() && machine.at_rest();
         if at_rest {
             let since = *rest_since.get_or_insert(now);
             if now >= since + SIM_SETTLE_US {

@@ -78,8 +78,6 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
-    // The travel guard stopped a curve: the machine goes into alarm once at rest.
-    let mut alarm = false;
     loop {
         if let Some(control) = machine.take_control() {
             apply(machine, &mut planner, control);
@@ -96,17 +94,20 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
         let filled = fill(machine, &mut planner, &mut steps, &mut queued, &mut work).await;
         if queued.steps != steps_before {
             machine.set_plan_empty(false);
-            machine.set_run_state(moving);
+            if machine.run_state() != RunState::Alarm {
+                machine.set_run_state(moving);
+            }
         }
         if let FillEnd::CurveFailed(e) = filled {
-            // The travel guard stopped a curve at the edge: a defect upstream, since the builder
-            // refuses what leaves the travel. Stop there, drop what was planned after it (it
-            // was planned from a point the pen never reached) and raise an alarm once at rest.
-            // The host is told (see the serial task).
-            error!("curve stopped at the travel limit: {:?}", e);
+            // A curve stopped part way (the travel guard at the edge, or a curve failing where
+            // the builder's trace did not): a defect upstream, since the builder refuses both.
+            // Stop there, drop what was planned after it (it was planned from a point the pen
+            // never reached, and its lines were answered `ok`) and raise an alarm at once, as
+            // GRBL does: motion is refused until `$X`. The host is told (see the serial task).
+            error!("curve stopped part way: {:?}", e);
+            machine.set_run_state(RunState::Alarm);
             machine.set_fault(Some(MotionFault::Curve(e)));
             abort(machine, &mut planner);
-            alarm = true;
         }
         if !matches!(filled, FillEnd::QueueFull) && planner.is_idle() && !queued.resting {
             // The motion comes to rest after the steps queued.
@@ -134,10 +135,8 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                         if machine.run_state() != RunState::Idle {
                             info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
                         }
-                        if core::mem::take(&mut alarm) {
-                            // Cleared by `$X`.
-                            machine.set_run_state(RunState::Alarm);
-                        } else if machine.run_state() != RunState::Alarm {
+                        // An alarm stays until `$X`.
+                        if machine.run_state() != RunState::Alarm {
                             machine.set_run_state(RunState::Idle);
                         }
                         wait_for_work(machine, &planner).await;
@@ -195,7 +194,8 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
     info!("job planned to ({}, {}) steps", end.x, end.y);
     machine.set_drawing(job.drawing.kind());
     machine.set_fault(None);
-    if planner.push(job.drawing.into_curve(), job.feed, settings.method).is_err() {
+    let curve = job.drawing.into_curve().keep_within(settings.travel_steps());
+    if planner.push(curve, job.feed, settings.method).is_err() {
         // is_full() was false just now and nothing else pushes.
         error!("planner refused a segment it had room for");
     }

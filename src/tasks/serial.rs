@@ -15,7 +15,6 @@
 //! does the receiver pass bytes on again, from the start of the next line.
 
 use core::cell::Cell;
-use core::fmt::Write as _;
 use core::future::Future;
 
 use embassy_futures::join::join3;
@@ -29,10 +28,9 @@ use embedded_io_async::{Read, Write};
 use heapless::String;
 
 use crate::job::{Control, Job};
-use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
+use crate::machine::{Machine, PlanEpoch, Stale};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
-use crate::protocol::report::REPORT_LINE_MAX_BYTES;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -402,14 +400,10 @@ async fn queue<W: Write>(link: &Link<'_, W>, job: Job, epoch: PlanEpoch) -> Resu
     Ok(())
 }
 
-/// Tells the host when a curve could not start or stopped part way.
+/// Pushes an alarm to the host when a curve stops part way.
 async fn faults<W: Write>(link: &Link<'_, W>) -> ! {
     loop {
         let fault = link.machine.next_fault().await;
-        let mut text: String<REPORT_LINE_MAX_BYTES> = String::new();
-        let _ = match fault {
-            MotionFault::Curve(e) => write!(text, "Curve stopped: {:?}; queued moves dropped", e),
-        };
-        link.send(|a| report::message(a, &text)).await;
+        link.send(|a| report::alarm(a, fault)).await;
     }
 }
