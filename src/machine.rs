@@ -14,7 +14,7 @@
 //! copies a value in or out, and every counter has a single writer.
 
 use core::cell::{Cell, RefCell};
-use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
 
 use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::Mutex;
@@ -25,6 +25,7 @@ use embassy_sync::signal::Signal;
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
+use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
@@ -78,6 +79,8 @@ pub struct Machine {
     aborted: Signal<CriticalSectionRawMutex, ()>,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
+    /// Segments the planner has room for (set by the motion task).
+    plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pulses_done: Signal<CriticalSectionRawMutex, ()>,
     menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
@@ -91,6 +94,12 @@ pub struct Machine {
     /// Steps emitted so far and the sum of their intervals (written only by the pulse engine).
     emitted_steps: AtomicU32,
     emitted_ticks: AtomicU32,
+    /// The step emitted last: its interval in ticks, and its move (X in the low byte, Y in the
+    /// high byte, as stored), for the speed the pen moves at (written only by the pulse engine).
+    last_interval_ticks: AtomicU32,
+    last_step: AtomicU16,
+    /// Machine position minus work position, mm (written by the host link's parser).
+    work_offset_mm: Mutex<CriticalSectionRawMutex, Cell<[f32; 2]>>,
     /// Times the pulse engine found the queue empty while the motion was not at rest
     /// (written only by the pulse engine).
     underruns: AtomicU32,
@@ -111,6 +120,7 @@ impl Machine {
             aborts: AtomicU32::new(0),
             aborted: Signal::new(),
             plan_empty: AtomicBool::new(true),
+            plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
@@ -119,6 +129,9 @@ impl Machine {
             queued_ticks: AtomicU32::new(0),
             emitted_steps: AtomicU32::new(0),
             emitted_ticks: AtomicU32::new(0),
+            last_interval_ticks: AtomicU32::new(0),
+            last_step: AtomicU16::new(0),
+            work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
             underruns: AtomicU32::new(0),
             drawing: AtomicU8::new(0),
             settings: Mutex::new(RefCell::new(settings)),
@@ -172,10 +185,43 @@ impl Machine {
         let [x, y] = &self.position;
         x.store(x.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.x)), Ordering::Relaxed);
         y.store(y.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.y)), Ordering::Relaxed);
+        self.last_interval_ticks.store(cmd.interval_ticks, Ordering::Relaxed);
+        self.last_step.store(u16::from_le_bytes([cmd.step.x as u8, cmd.step.y as u8]), Ordering::Relaxed);
         let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
         self.emitted_ticks.store(t, Ordering::Release);
         let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);
         self.emitted_steps.store(n, Ordering::Release);
+    }
+
+    /// How fast the pen moves now, mm/min: the step being emitted over its interval; 0 at rest
+    /// (stopped, or held once stopped).
+    pub fn speed_mm_per_min(&self, settings: &Settings) -> f32 {
+        let interval = self.last_interval_ticks.load(Ordering::Relaxed);
+        if self.pulses_idle() || interval == 0 {
+            return 0.0;
+        }
+        let [x, y] = self.last_step.load(Ordering::Relaxed).to_le_bytes();
+        let along = |moved: u8, axis: usize| if moved != 0 { 1.0 / settings.steps_per_mm[axis] } else { 0.0 };
+        let (dx, dy) = (along(x, 0), along(y, 1));
+        crate::math::sqrt(dx * dx + dy * dy) * (60.0 * TICK_HZ as f32) / interval as f32
+    }
+
+    /// The work coordinate offset the host link's parser plans with (machine = work + offset),
+    /// mm.
+    pub fn work_offset_mm(&self) -> [f32; 2] {
+        self.work_offset_mm.lock(|o| o.get())
+    }
+
+    /// Sets the work coordinate offset; only the host link's parser calls this.
+    pub fn set_work_offset_mm(&self, offset_mm: [f32; 2]) {
+        if self.work_offset_mm.lock(|o| o.replace(offset_mm)) != offset_mm {
+            self.changed.signal(());
+        }
+    }
+
+    /// Planner segments free: how many more drawings the planner could take now.
+    pub fn plan_free_segments(&self) -> u8 {
+        self.plan_free.load(Ordering::Relaxed)
     }
 
     /// The pulse engine found the queue empty while the motion was not at rest. Only the pulse
@@ -364,6 +410,11 @@ impl Machine {
     /// Whether the planner holds anything. Only the motion task calls this.
     pub fn set_plan_empty(&self, empty: bool) {
         self.plan_empty.store(empty, Ordering::Release);
+    }
+
+    /// How many segments the planner has room for. Only the motion task calls this.
+    pub fn set_plan_free_segments(&self, free: usize) {
+        self.plan_free.store(free.min(usize::from(u8::MAX)) as u8, Ordering::Relaxed);
     }
 
     /// True when nothing is queued, planned or moving, held or not: the position is final.

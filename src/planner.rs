@@ -181,6 +181,11 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         self.held >= N || self.request == Request::Abort
     }
 
+    /// Segments [`push`](Self::push) would still take.
+    pub fn free_segments(&self) -> usize {
+        if self.request == Request::Abort { 0 } else { N.saturating_sub(self.held) }
+    }
+
     /// True when nothing is left to emit and the machine is at rest.
     pub fn is_idle(&self) -> bool {
         self.held == 0 && self.speed.is_none()

@@ -34,6 +34,13 @@ pub const MAX_PULSE_RATE_HZ: f32 = 200_000.0;
 pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, name: "pulse width", unit: "us", min: 2.5, max: 100.0 },
     SettingInfo { id: 3, name: "direction invert mask", unit: "mask", min: 0.0, max: 3.0 },
+    SettingInfo {
+        id: 10,
+        name: "status report (1 machine position, +2 buffer state)",
+        unit: "mask",
+        min: 0.0,
+        max: 3.0,
+    },
     SettingInfo { id: 11, name: "junction deviation", unit: "mm", min: 0.0, max: 5.0 },
     SettingInfo { id: 100, name: "x steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
     SettingInfo { id: 101, name: "y steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
@@ -59,6 +66,9 @@ pub struct Settings {
     pub pulse_width_us: f32,
     /// Bit 0 inverts X's SIGN output, bit 1 Y's ($3).
     pub dir_invert_mask: u8,
+    /// What status reports show ($10): bit 0 set, the machine position (`MPos:`), clear, the
+    /// work position (`WPos:`); bit 1, the buffer state (`Bf:`).
+    pub status_report_mask: u8,
     /// GRBL's junction deviation for look-ahead at corners ($11).
     pub junction_deviation_mm: f32,
     /// Steps per millimetre, X and Y ($100, $101).
@@ -88,6 +98,7 @@ impl Default for Settings {
         Settings {
             pulse_width_us: 5.0,
             dir_invert_mask: 0,
+            status_report_mask: 1,
             junction_deviation_mm: 0.02,
             steps_per_mm: [100.0, 100.0],
             max_rate_mm_per_min: [6_000.0, 6_000.0],
@@ -109,6 +120,7 @@ impl Settings {
         Ok(match id {
             0 => self.pulse_width_us,
             3 => self.dir_invert_mask as f32,
+            10 => self.status_report_mask as f32,
             11 => self.junction_deviation_mm,
             100 | 101 => self.steps_per_mm[(id - 100) as usize],
             110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize],
@@ -138,6 +150,7 @@ impl Settings {
         match id {
             0 => next.pulse_width_us = value,
             3 if whole => next.dir_invert_mask = value as u8,
+            10 if whole => next.status_report_mask = value as u8,
             11 => next.junction_deviation_mm = value,
             100 | 101 => next.steps_per_mm[(id - 100) as usize] = value,
             110 | 111 => next.max_rate_mm_per_min[(id - 110) as usize] = value,

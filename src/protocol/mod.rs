@@ -7,7 +7,8 @@
 //!   bypass lines ([`realtime`]);
 //! - [`gcode`]: one line in, machine [`Command`]s out ([`GcodeState::execute`]), with GRBL's
 //!   modal state, planned position and error rules, plus the plotter's own curve commands;
-//! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...).
+//! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...);
+//! - [`refresh`]: which status reports carry GRBL's occasional `WCO:` and `Ov:` fields.
 //!
 //! It owns no pins, queues or clocks: the serial task feeds it bytes, hands the resulting
 //! commands to the machine and writes the answers. Every line gets exactly one `ok` or
@@ -62,6 +63,7 @@
 
 pub mod framing;
 pub mod gcode;
+pub mod refresh;
 pub mod report;
 
 pub use framing::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};

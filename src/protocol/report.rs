@@ -28,7 +28,7 @@ pub const BUILD_NAME: &str = "servoplot";
 pub const REPORT_LINE_MAX_BYTES: usize = 128;
 
 /// Settings whose values are whole numbers (a bit mask, a choice), listed without decimals.
-const INTEGER_SETTINGS: &[u16] = &[3, 202];
+const INTEGER_SETTINGS: &[u16] = &[3, 10, 202];
 
 /// `ok`: the line was executed.
 pub fn ok(out: &mut impl Write) -> fmt::Result {
@@ -104,18 +104,28 @@ pub fn message(out: &mut impl Write, text: &str) -> fmt::Result {
     write!(out, "[MSG:{text}]\r\n")
 }
 
-/// The status report for `?`: `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `feed_mm_per_min` is the
-/// speed now (0 when stopped); `work_offset_mm`, when given, adds GRBL's `|WCO:x,y,0.000` field
-/// (GRBL sends it every 10 to 30 reports and after the offset changes). Once the pulses have had
-/// to wait for the motion task, `|Un:N` counts those step-queue underruns (not a GRBL field;
-/// senders skip fields they do not know).
-pub fn status(
-    out: &mut impl Write,
-    status: &Status,
-    settings: &Settings,
-    feed_mm_per_min: f32,
-    work_offset_mm: Option<[f32; 2]>,
-) -> fmt::Result {
+/// What a status report shows beyond the machine's own [`Status`].
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct StatusFields {
+    /// How fast the pen moves now, mm/min (0 at rest).
+    pub speed_mm_per_min: f32,
+    /// Machine position minus work position, mm: for `WPos:` and `WCO:`.
+    pub work_offset_mm: [f32; 2],
+    /// Include `|WCO:` (when, see [`crate::protocol::refresh`]).
+    pub wco: bool,
+    /// Include `|Ov:` with the feed, rapid and spindle overrides, percent.
+    pub overrides: Option<[u8; 3]>,
+    /// Planner segments free and receive-window bytes free, for `|Bf:` (shown when `$10` has
+    /// bit 1 set).
+    pub buffer: (u8, u16),
+}
+
+/// The status report for `?`, as GRBL 1.1 writes it:
+/// `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `$10` chooses `MPos:` (bit 0 set) or `WPos:` and
+/// adds `|Bf:` (bit 1); `|WCO:` and `|Ov:` follow when `fields` asks for them. Once the pulses
+/// have had to wait for the motion task, `|Un:N` counts those step-queue underruns (not a GRBL
+/// field; senders skip fields they do not know).
+pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields: &StatusFields) -> fmt::Result {
     let state = match status.state {
         RunState::Idle => "Idle",
         RunState::Run => "Run",
@@ -123,15 +133,24 @@ pub fn status(
         RunState::Jog => "Jog",
         RunState::Alarm => "Alarm",
     };
-    write!(out, "<{state}|MPos:")?;
-    let x = settings.steps_to_mm(Axis::X, status.position.x);
-    let y = settings.steps_to_mm(Axis::Y, status.position.y);
+    let machine = settings.status_report_mask & 1 != 0;
+    write!(out, "<{state}|{}:", if machine { "MPos" } else { "WPos" })?;
+    let [ox, oy] = if machine { [0.0; 2] } else { fields.work_offset_mm };
+    let x = settings.steps_to_mm(Axis::X, status.position.x) - ox;
+    let y = settings.steps_to_mm(Axis::Y, status.position.y) - oy;
     xyz(out, x, y)?;
-    let feed = if feed_mm_per_min.is_finite() { crate::math::round(feed_mm_per_min.abs()) as u32 } else { 0 };
+    if settings.status_report_mask & 2 != 0 {
+        write!(out, "|Bf:{},{}", fields.buffer.0, fields.buffer.1)?;
+    }
+    let speed = fields.speed_mm_per_min;
+    let feed = if speed.is_finite() { crate::math::round(speed.abs()) as u32 } else { 0 };
     write!(out, "|FS:{feed},0")?;
-    if let Some([x, y]) = work_offset_mm {
+    if fields.wco {
         out.write_str("|WCO:")?;
-        xyz(out, x, y)?;
+        xyz(out, fields.work_offset_mm[0], fields.work_offset_mm[1])?;
+    }
+    if let Some([feed, rapid, spindle]) = fields.overrides {
+        write!(out, "|Ov:{feed},{rapid},{spindle}")?;
     }
     if status.underruns > 0 {
         write!(out, "|Un:{}", status.underruns)?;
@@ -245,26 +264,49 @@ mod tests {
         Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None, underruns: 0 }
     }
 
+    /// The fields of a report with speed `speed` and nothing occasional.
+    fn at(speed: f32) -> StatusFields {
+        StatusFields { speed_mm_per_min: speed, ..StatusFields::default() }
+    }
+
     #[test]
     fn status_reports_match_grbl_exactly() {
-        let s = Settings::default(); // 100 steps/mm
+        let s = Settings::default(); // 100 steps/mm, $10=1
         assert_eq!(
-            text(|o| status(o, &st(RunState::Idle, 1000, 500), &s, 0.0, None)),
+            text(|o| status(o, &st(RunState::Idle, 1000, 500), &s, &at(0.0))),
             "<Idle|MPos:10.000,5.000,0.000|FS:0,0>\r\n"
         );
         assert_eq!(
-            text(|o| status(o, &st(RunState::Run, -1, -123_456), &s, 1499.6, None)),
+            text(|o| status(o, &st(RunState::Run, -1, -123_456), &s, &at(1499.6))),
             "<Run|MPos:-0.010,-1234.560,0.000|FS:1500,0>\r\n"
         );
+        let wco = StatusFields { work_offset_mm: [-2.5, 0.0], wco: true, ..at(0.0) };
         assert_eq!(
-            text(|o| status(o, &st(RunState::Hold, 0, 0), &s, 0.0, Some([-2.5, 0.0]))),
+            text(|o| status(o, &st(RunState::Hold, 0, 0), &s, &wco)),
             "<Hold:0|MPos:0.000,0.000,0.000|FS:0,0|WCO:-2.500,0.000,0.000>\r\n"
         );
-        assert!(text(|o| status(o, &st(RunState::Jog, 0, 0), &s, 600.0, None)).starts_with("<Jog|"));
-        assert!(text(|o| status(o, &st(RunState::Alarm, 0, 0), &s, 0.0, None)).starts_with("<Alarm|"));
+        let ov = StatusFields { overrides: Some([100, 100, 100]), ..at(600.0) };
+        assert_eq!(
+            text(|o| status(o, &st(RunState::Jog, 0, 0), &s, &ov)),
+            "<Jog|MPos:0.000,0.000,0.000|FS:600,0|Ov:100,100,100>\r\n"
+        );
+        assert!(text(|o| status(o, &st(RunState::Alarm, 0, 0), &s, &at(0.0))).starts_with("<Alarm|"));
         // Once the pulses have had to wait for the motion task, the count follows.
         let late = Status { underruns: 3, ..st(RunState::Run, 0, 0) };
-        assert_eq!(text(|o| status(o, &late, &s, 6000.0, None)), "<Run|MPos:0.000,0.000,0.000|FS:6000,0|Un:3>\r\n");
+        assert_eq!(text(|o| status(o, &late, &s, &at(6000.0))), "<Run|MPos:0.000,0.000,0.000|FS:6000,0|Un:3>\r\n");
+    }
+
+    #[test]
+    fn the_report_mask_chooses_work_or_machine_position_and_the_buffer_state() {
+        let mut s = Settings::default();
+        let fields = StatusFields { work_offset_mm: [2.5, -1.0], buffer: (15, 128), ..at(0.0) };
+        let idle = st(RunState::Idle, 1000, 500);
+        s.set(10, 0.0).unwrap();
+        assert_eq!(text(|o| status(o, &idle, &s, &fields)), "<Idle|WPos:7.500,6.000,0.000|FS:0,0>\r\n");
+        s.set(10, 3.0).unwrap();
+        assert_eq!(text(|o| status(o, &idle, &s, &fields)), "<Idle|MPos:10.000,5.000,0.000|Bf:15,128|FS:0,0>\r\n");
+        s.set(10, 2.0).unwrap();
+        assert_eq!(text(|o| status(o, &idle, &s, &fields)), "<Idle|WPos:7.500,6.000,0.000|Bf:15,128|FS:0,0>\r\n");
     }
 
     #[test]
@@ -273,7 +315,7 @@ mod tests {
         s.set(100, 80.0).unwrap();
         s.set(101, 200.0).unwrap();
         assert_eq!(
-            text(|o| status(o, &st(RunState::Idle, -1, -1), &s, 0.0, None)),
+            text(|o| status(o, &st(RunState::Idle, -1, -1), &s, &at(0.0))),
             "<Idle|MPos:-0.013,-0.005,0.000|FS:0,0>\r\n"
         );
         // -0.0004 mm rounds to zero and shows as zero.
@@ -283,11 +325,20 @@ mod tests {
 
     #[test]
     fn the_longest_status_line_fits_the_stated_maximum() {
-        let s = Settings::default();
-        let line = text(|o| status(o, &st(RunState::Hold, -50_000, -50_000), &s, 60_000.0, Some([-500.0, -500.0])));
+        let mut s = Settings::default();
+        s.set(10, 2.0).unwrap();
+        let longest = StatusFields {
+            speed_mm_per_min: 60_000.0,
+            work_offset_mm: [-500.0, -500.0],
+            wco: true,
+            overrides: Some([200, 100, 200]),
+            buffer: (255, 65_535),
+        };
+        let late = Status { underruns: u32::MAX, ..st(RunState::Hold, -50_000, -50_000) };
+        let line = text(|o| status(o, &late, &s, &longest));
         assert!(line.len() <= REPORT_LINE_MAX_BYTES, "{} bytes", line.len());
         let mut fixed: heapless::String<REPORT_LINE_MAX_BYTES> = heapless::String::new();
-        status(&mut fixed, &st(RunState::Hold, -50_000, -50_000), &s, 60_000.0, Some([-500.0, -500.0])).unwrap();
+        status(&mut fixed, &late, &s, &longest).unwrap();
         assert_eq!(fixed.as_str(), line);
     }
 

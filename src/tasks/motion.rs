@@ -115,6 +115,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             queued.resting = true;
         }
         machine.set_queued(queued.steps, queued.ticks);
+        machine.set_plan_free_segments(planner.free_segments());
         if queued.steps != steps_before {
             kick();
         }

@@ -31,6 +31,8 @@ use crate::job::{Control, Job};
 use crate::machine::{Machine, PlanEpoch, Stale};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::refresh::Refresh;
+use crate::protocol::report::StatusFields;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -46,6 +48,9 @@ pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
 /// How long a byte may wait for room in the pipe before it is dropped: the line loop drains
 /// the pipe far faster unless it is waiting for the machine.
 pub const SERIAL_PIPE_WAIT_MS: u64 = 20;
+/// Feed, rapid and spindle overrides, percent, for `Ov:`: fixed, the plotter does not take
+/// GRBL's override bytes yet.
+const OVERRIDES_PERCENT: [u8; 3] = [100, 100, 100];
 /// Bytes taken from the UART, or from the pipe, at a time.
 pub const SERIAL_CHUNK_BYTES: usize = 32;
 /// After a UART read error (noise, overrun), the receiver waits this long before reading on.
@@ -60,8 +65,8 @@ struct Link<'m, W> {
     machine: &'m Machine,
     tx: Mutex<NoopRawMutex, W>,
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
-    /// Feed rate of the motion in progress, for status reports.
-    feed_mm_per_min: Cell<f32>,
+    /// When status reports carry `WCO:` and `Ov:`.
+    refresh: Cell<Refresh>,
     /// Lines dropped for want of room in the pipe; see the module documentation.
     dropped: Dropped,
     /// Resets received and not yet met by the line loop: bytes before them are dropped.
@@ -76,7 +81,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         machine,
         tx: Mutex::new(tx),
         bytes: Pipe::new(),
-        feed_mm_per_min: Cell::new(0.0),
+        refresh: Cell::new(Refresh::new()),
         dropped: Dropped::default(),
         resets_pending: Cell::new(0),
         reset: Signal::new(),
@@ -102,10 +107,23 @@ impl<W: Write> Link<'_, W> {
     }
 
     async fn status_report(&self) {
-        let status = self.machine.status();
-        let settings = self.machine.settings();
-        let feed = if status.state == RunState::Idle { 0.0 } else { self.feed_mm_per_min.get() };
-        self.send(|a| report::status(a, &status, &settings, feed, None)).await;
+        let machine = self.machine;
+        let status = machine.status();
+        let settings = machine.settings();
+        let work_offset_mm = machine.work_offset_mm();
+        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm);
+        let mut refresh = self.refresh.get();
+        let occasional = refresh.next(work_offset_mm, OVERRIDES_PERCENT, busy);
+        self.refresh.set(refresh);
+        let rx_free = SERIAL_RX_WINDOW_BYTES.saturating_sub(self.bytes.len());
+        let fields = StatusFields {
+            speed_mm_per_min: machine.speed_mm_per_min(&settings),
+            work_offset_mm,
+            wco: occasional.wco,
+            overrides: occasional.overrides.then_some(OVERRIDES_PERCENT),
+            buffer: (machine.plan_free_segments(), rx_free as u16),
+        };
+        self.send(|a| report::status(a, &status, &settings, &fields)).await;
     }
 
     /// Runs `work` unless a reset comes first (or is already on its way).
@@ -285,6 +303,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 link.machine_stopped().await;
                 link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
+                machine.set_work_offset_mm(gcode.work_offset_mm());
                 epoch = machine.plan_epoch();
                 link.send(report::welcome).await;
                 continue;
@@ -323,6 +342,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         }
                         Err(e) => Err(Unfinished::Error(e)),
                     }
+                    .inspect(|()| machine.set_work_offset_mm(gcode.work_offset_mm()))
                 }
                 Some(other) => Err(Unfinished::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
             };
@@ -392,12 +412,7 @@ async fn carry_out<W: Write>(
 /// abort before it is queued drops it with `error:9`, since it was planned from a point the pen
 /// will not reach.
 async fn queue<W: Write>(link: &Link<'_, W>, job: Job, epoch: PlanEpoch) -> Result<(), Unfinished> {
-    let feed = job.feed;
-    link.unless_reset(link.machine.submit(job, epoch)).await?.map_err(|Stale| Unfinished::Error(GrblError::Locked))?;
-    if let crate::job::Feed::MmPerMin(f) = feed {
-        link.feed_mm_per_min.set(f);
-    }
-    Ok(())
+    link.unless_reset(link.machine.submit(job, epoch)).await?.map_err(|Stale| Unfinished::Error(GrblError::Locked))
 }
 
 /// Pushes an alarm to the host when a curve stops part way.
