@@ -79,6 +79,8 @@ pub struct Machine {
     aborted: Signal<CriticalSectionRawMutex, ()>,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
+    /// The host link is in check mode (`$C`): reported as [`RunState::Check`] while idle.
+    check_mode: AtomicBool,
     /// Segments the planner has room for (set by the motion task).
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
@@ -120,6 +122,7 @@ impl Machine {
             aborts: AtomicU32::new(0),
             aborted: Signal::new(),
             plan_empty: AtomicBool::new(true),
+            check_mode: AtomicBool::new(false),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
@@ -285,9 +288,10 @@ impl Machine {
         }
     }
 
+    /// Sets the motion's state. Check mode is not one: see [`set_check_mode`](Self::set_check_mode).
     pub fn set_run_state(&self, state: RunState) {
         let v = match state {
-            RunState::Idle => 0,
+            RunState::Idle | RunState::Check => 0,
             RunState::Run => 1,
             RunState::Hold => 2,
             RunState::Jog => 3,
@@ -298,10 +302,26 @@ impl Machine {
         }
     }
 
+    /// The host link enters or leaves check mode (`$C`); only the serial task calls this.
+    pub fn set_check_mode(&self, on: bool) {
+        if self.check_mode.swap(on, Ordering::Relaxed) != on {
+            self.changed.signal(());
+        }
+    }
+
+    /// The state to report and to act on: the run state, or [`RunState::Check`] while the host
+    /// link checks its lines at rest.
+    pub fn state(&self) -> RunState {
+        match self.run_state() {
+            RunState::Idle if self.check_mode.load(Ordering::Relaxed) => RunState::Check,
+            state => state,
+        }
+    }
+
     /// A snapshot for displays and reports.
     pub fn status(&self) -> Status {
         Status {
-            state: self.run_state(),
+            state: self.state(),
             position: self.position(),
             queued_jobs: self.queued_jobs() as u8,
             fault: self.fault(),

@@ -18,6 +18,9 @@ pub enum RunState {
     Jog,
     /// A fault stopped the machine (see [`MotionFault`]); motion is refused until `$X`.
     Alarm,
+    /// The host link's check mode (`$C`): lines are parsed and every drawing built and checked,
+    /// but nothing moves.
+    Check,
 }
 
 /// Why the last job stopped early, shown on the LCD and reported to the host.

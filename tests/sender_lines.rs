@@ -98,3 +98,29 @@ fn a_number_with_an_exponent_is_a_bad_number() {
         assert!(report.path().len() <= 1, "{line} moved");
     }
 }
+
+#[test]
+fn check_mode_checks_every_line_and_moves_nothing() {
+    // As GRBL's stream.py -c runs a file: `$C`, the file, `$C`; then a real move.
+    let program = "$C\nG91 G1 X150 F3000\nG1 X100\n$O R10\n$S A5 W100 L10\nG4 P1\nM0\nG1 Y-5\n";
+    let serial = SimSerial::with_input(program.as_bytes()).with_byte_at(50_000, b'?');
+    let report = run(paste(serial, 100_000, "$C\nG1 X1\n"));
+    let text = report.answers();
+    // X150 then X100 more leaves the travel: the parser plans on in check mode.
+    assert_eq!(answers(&report), ["ok", "ok", "error:15", "ok", "error:33", "ok", "ok", "ok", "ok", "ok"], "{text}");
+    assert!(text.contains("[MSG:Enabled]\r\nok\r\n"), "{text}");
+    assert!(text.contains("<Check|"), "{text}");
+    // Leaving it answers the line, then starts over like a reset.
+    assert!(text.contains("[MSG:Disabled]\r\nok\r\n\r\nGrbl 1.1h"), "{text}");
+    // Nothing moved but the last line, from where the pen really was, in absolute mode again.
+    assert!(report.path().iter().all(|p| p.y == 0 && (0..=100).contains(&p.x)), "{:?}", report.path().last());
+    assert_eq!(report.position, Point::new(100, 0));
+}
+
+#[test]
+fn check_mode_is_entered_only_at_rest() {
+    let serial = SimSerial::with_input(b"G1 X50 F600\n").with_byte_at(1_000_000, b'$').with_byte_at(1_000_000, b'C');
+    let report = run(serial.with_byte_at(1_000_000, b'\n'));
+    assert_eq!(answers(&report), ["ok", "error:8"], "{}", report.answers());
+    assert_eq!(report.position, Point::new(5_000, 0));
+}

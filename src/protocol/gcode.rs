@@ -39,8 +39,11 @@
 //! `$` help, `$$` settings, `$N=value` set one, `$G` parser state, `$#` offsets, `$I` build info,
 //! `$X` unlock, `$H` (no homing: error 5), `$RST=$` / `$RST=#` / `$RST=*` restore settings /
 //! clear the G92 offset / both, `$J=` jog (GRBL's rules: only G20/G21, G90/G91, G53, X Y Z, N and
-//! a required F; the line's modes apply to the jog only). GRBL's `$C` (check mode), `$N`
-//! (startup lines) and `$SLP` are not supported (error 3).
+//! a required F; the line's modes apply to the jog only), `$C` check mode (at rest only, error 8
+//! otherwise: every line is parsed and every drawing built and checked against the travel and
+//! the lattice, from the position the lines before it plan, and nothing moves; `$C` again
+//! leaves it with a soft reset, as GRBL does). GRBL's `$N` (startup lines) and `$SLP` are not
+//! supported (error 3).
 //!
 //! # Plotter curve commands
 //!
@@ -189,6 +192,9 @@ pub enum Command {
     Report(Report),
     /// `$X`: leave the alarm state (GRBL answers `[MSG:Caution: Unlocked]`).
     Unlock,
+    /// `$C`: enter check mode (`[MSG:Enabled]`), or leave it (`[MSG:Disabled]`, then a soft
+    /// reset once the line is answered, as GRBL does, so the parser plans from the pen again).
+    CheckMode { on: bool },
 }
 
 /// GRBL's parser state; see the module documentation.

@@ -132,6 +132,7 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
         RunState::Hold => "Hold:0",
         RunState::Jog => "Jog",
         RunState::Alarm => "Alarm",
+        RunState::Check => "Check",
     };
     let machine = settings.status_report_mask & 1 != 0;
     write!(out, "<{state}|{}:", if machine { "MPos" } else { "WPos" })?;

@@ -73,6 +73,8 @@ struct Link<'m, W> {
     resets_pending: Cell<u32>,
     /// Cancels a line waiting for the machine when a reset arrives.
     reset: Signal<NoopRawMutex, ()>,
+    /// The line being answered left check mode: the parser starts over once it is answered.
+    restart_after_answer: Cell<bool>,
 }
 
 /// Speaks GRBL on the host link forever.
@@ -85,6 +87,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         dropped: Dropped::default(),
         resets_pending: Cell::new(0),
         reset: Signal::new(),
+        restart_after_answer: Cell::new(false),
     };
     link.send(report::welcome).await;
     join3(receive(&link, rx), lines(&link), faults(&link)).await;
@@ -111,7 +114,7 @@ impl<W: Write> Link<'_, W> {
         let status = machine.status();
         let settings = machine.settings();
         let work_offset_mm = machine.work_offset_mm();
-        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm);
+        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check);
         let mut refresh = self.refresh.get();
         let occasional = refresh.next(work_offset_mm, OVERRIDES_PERCENT, busy);
         self.refresh.set(refresh);
@@ -244,7 +247,11 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
         for &byte in &buf[..n] {
             match realtime(byte) {
                 Some(Realtime::StatusQuery) => link.status_report().await,
-                Some(Realtime::FeedHold) => link.machine.request(Control::Hold),
+                // Nothing moves in check mode: a hold there would only stop the check.
+                Some(Realtime::FeedHold) if link.machine.state() != RunState::Check => {
+                    link.machine.request(Control::Hold)
+                }
+                Some(Realtime::FeedHold) => {}
                 Some(Realtime::CycleStart) => link.machine.request(Control::Resume),
                 Some(Realtime::JogCancel) if link.machine.run_state() == RunState::Jog => {
                     link.machine.request(Control::Abort)
@@ -302,10 +309,7 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 assembler.clear();
                 link.machine_stopped().await;
                 link.reset.reset();
-                gcode.reset(machine.position(), &machine.settings());
-                machine.set_work_offset_mm(gcode.work_offset_mm());
-                epoch = machine.plan_epoch();
-                link.send(report::welcome).await;
+                restart(link, &mut gcode, &mut epoch).await;
                 continue;
             }
             if link.resets_pending.get() > 0 {
@@ -324,12 +328,14 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         gcode.sync_position(machine.position(), &machine.settings());
                     }
                     let settings = machine.settings();
-                    if machine.is_idle() {
+                    let state = machine.state();
+                    if state == RunState::Idle && machine.is_idle() {
                         // The keypad, an abort or a curve that stopped early may have moved the
-                        // pen elsewhere than the parser planned.
+                        // pen elsewhere than the parser planned. (In check mode the parser
+                        // plans on from the lines it checked.)
                         gcode.sync_position(machine.position(), &settings);
                     }
-                    match gcode.execute(line, &settings, machine.run_state()) {
+                    match gcode.execute(line, &settings, state) {
                         Ok(commands) => {
                             let mut r = Ok(());
                             for command in commands {
@@ -351,8 +357,22 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 Err(Unfinished::Error(e)) => link.send(|a| report::error(a, e)).await,
                 Err(Unfinished::Reset) => {}
             }
+            if link.restart_after_answer.take() {
+                restart(link, &mut gcode, &mut epoch).await;
+            }
         }
     }
+}
+
+/// After a soft reset, or on leaving check mode: the parser starts over from the pen, and the
+/// host gets the banner.
+async fn restart<W: Write>(link: &Link<'_, W>, gcode: &mut GcodeState, epoch: &mut PlanEpoch) {
+    let machine = link.machine;
+    machine.set_check_mode(false);
+    gcode.reset(machine.position(), &machine.settings());
+    machine.set_work_offset_mm(gcode.work_offset_mm());
+    *epoch = machine.plan_epoch();
+    link.send(report::welcome).await;
 }
 
 /// Carries out one command of a parsed line.
@@ -364,7 +384,10 @@ async fn carry_out<W: Write>(
     epoch: PlanEpoch,
 ) -> Result<(), Unfinished> {
     let machine = link.machine;
+    let checking = machine.state() == RunState::Check;
     match command {
+        // Check mode: the line was parsed and its drawing built and checked; nothing runs.
+        Command::Job(_) | Command::Dwell { .. } | Command::Pause if checking => {}
         Command::Job(job) => queue(link, job, epoch).await?,
         Command::Dwell { ms } => {
             link.unless_reset(async {
@@ -396,6 +419,14 @@ async fn carry_out<W: Write>(
                 Report::BuildInfo => report::build_info(a, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES),
             })
             .await
+        }
+        Command::CheckMode { on: true } => {
+            machine.set_check_mode(true);
+            link.send(|a| report::message(a, "Enabled")).await;
+        }
+        Command::CheckMode { on: false } => {
+            link.send(|a| report::message(a, "Disabled")).await;
+            link.restart_after_answer.set(true);
         }
         Command::Unlock => {
             if machine.run_state() == RunState::Alarm {

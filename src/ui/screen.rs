@@ -196,6 +196,7 @@ fn state_name(state: RunState) -> &'static str {
         RunState::Hold => "HOLD",
         RunState::Jog => "JOG",
         RunState::Alarm => "ALARM",
+        RunState::Check => "CHECK",
     }
 }
 

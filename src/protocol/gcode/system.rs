@@ -27,6 +27,11 @@ impl GcodeState {
             b"#" => report(Report::Parameters),
             b"I" => report(Report::BuildInfo),
             b"X" => Ok(Commands::one(Command::Unlock)),
+            b"C" => match state {
+                RunState::Check => Ok(Commands::one(Command::CheckMode { on: false })),
+                RunState::Idle => Ok(Commands::one(Command::CheckMode { on: true })),
+                _ => Err(GrblError::NotIdle),
+            },
             b"H" => Err(GrblError::SettingDisabled),
             b"SLP" => Err(GrblError::InvalidStatement),
             [b'R', b'S', b'T', b'=', what] => self.restore(*what, settings, state),

@@ -404,7 +404,9 @@ fn system_commands() {
     assert_eq!(run(&mut g, "$I"), report(Report::BuildInfo));
     assert_eq!(run(&mut g, "$x"), Ok(std::vec![Command::Unlock]));
     refused(&mut g, "$H", 5);
-    refused(&mut g, "$C", 3);
+    assert_eq!(run(&mut g, "$C"), Ok(std::vec![Command::CheckMode { on: true }]));
+    assert_eq!(run_in(&mut g, "$C", RunState::Check), Ok(std::vec![Command::CheckMode { on: false }]));
+    refused_in(&mut g, "$C", RunState::Run, 8);
     refused(&mut g, "$SLP", 3);
     refused(&mut g, "$N", 3);
     refused(&mut g, "$Q", 3);
