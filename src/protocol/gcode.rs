@@ -24,8 +24,8 @@
 //! - G4 P dwell (seconds), G17 (G18/G19 refused), G20/G21, G90/G91, G91.1, G92 / G92.1 (work
 //!   offset), G53 (machine coordinates for one G0/G1 line), G80, and the header no-ops G40, G49,
 //!   G54, G61, G94;
-//! - M0 (pause), M1 (ignored), M2/M30 (program end), M3/M4/M5 and S (accepted, no spindle), M9,
-//!   T (kept for `$G`).
+//! - M0 (pause), M1 (ignored), M2/M30 (program end), M3/M4/M5 and S (accepted, no spindle),
+//!   M8/M9 (accepted, no coolant), T (kept for `$G`, as GRBL keeps them).
 //!
 //! **Z words.** The plotter has no Z axis; senders move Z to lift and lower a pen. A Z word is
 //! accepted and ignored: a move with only Z answers `ok` and does nothing, a move with Z and X/Y
@@ -78,7 +78,7 @@ mod motion;
 mod system;
 mod words;
 
-pub use modal::{Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
+pub use modal::{Coolant, Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 
 use super::GrblError;
 use crate::drawing::{self, Request};
@@ -204,6 +204,7 @@ pub struct GcodeState {
     units: Units,
     distance: Distance,
     spindle: Spindle,
+    coolant: Coolant,
     /// `None` until an F word: the default feed rate applies.
     feed_mm_per_min: Option<f32>,
     spindle_speed: f32,
@@ -230,6 +231,7 @@ impl GcodeState {
             units: Units::Mm,
             distance: Distance::Absolute,
             spindle: Spindle::Off,
+            coolant: Coolant::Off,
             feed_mm_per_min: None,
             spindle_speed: 0.0,
             tool: 0,
@@ -281,6 +283,10 @@ impl GcodeState {
 
     pub fn spindle(&self) -> Spindle {
         self.spindle
+    }
+
+    pub fn coolant(&self) -> Coolant {
+        self.coolant
     }
 
     pub fn spindle_speed(&self) -> f32 {

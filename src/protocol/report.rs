@@ -11,7 +11,7 @@
 use core::fmt::{self, Write};
 
 use super::GrblError;
-use super::gcode::{Distance, GcodeState, MotionMode, Spindle, Units};
+use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, Units};
 use crate::drawing::DrawError;
 use crate::geom::Axis;
 use crate::interp::CurveError;
@@ -203,7 +203,11 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
     };
     let feed = crate::math::round(gcode.feed_mm_per_min(settings)) as u32;
     let speed = crate::math::round(gcode.spindle_speed()) as u32;
-    write!(out, "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} M9 T{} F{feed} S{speed}]\r\n", gcode.tool())
+    let coolant = match gcode.coolant() {
+        Coolant::Flood => "M8",
+        Coolant::Off => "M9",
+    };
+    write!(out, "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} {coolant} T{} F{feed} S{speed}]\r\n", gcode.tool())
 }
 
 /// `$#`: GRBL's coordinate offsets. Only G92 can be set; the others are always zero.
@@ -399,6 +403,13 @@ mod tests {
         assert_eq!(text(|o| parser_state(o, &g, &s)), "[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]\r\n");
         g.execute("G91 G20 G1 F10 M3 S1000 T2", &s, RunState::Idle).unwrap();
         assert_eq!(text(|o| parser_state(o, &g, &s)), "[GC:G1 G54 G17 G20 G91 G94 M3 M9 T2 F254 S1000]\r\n");
+        // M8 is kept as GRBL keeps it; M9 or a program end turns it off.
+        g.execute("M8", &s, RunState::Idle).unwrap();
+        assert!(text(|o| parser_state(o, &g, &s)).contains(" M3 M8 T2 "));
+        assert_eq!(g.execute("M8 M9", &s, RunState::Idle), Err(GrblError::ModalGroupViolation));
+        g.execute("M2", &s, RunState::Idle).unwrap();
+        assert!(text(|o| parser_state(o, &g, &s)).contains(" M5 M9 T2 "));
+        g.execute("G91 G20 G1 F10 M3", &s, RunState::Idle).unwrap();
         g.execute("G90 G21 G0 X10 Y-5", &s, RunState::Idle).unwrap();
         g.execute("G92 X0 Y0", &s, RunState::Idle).unwrap();
         let p = text(|o| parameters(o, &g));

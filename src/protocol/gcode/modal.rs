@@ -6,6 +6,15 @@ pub const MM_PER_INCH: f32 = 25.4;
 /// Largest T tool number, GRBL's.
 pub const TOOL_NUMBER_MAX: f32 = 255.0;
 
+/// M8/M9: flood coolant on or off. Kept for `$G` only, as GRBL keeps it: the plotter has no
+/// coolant output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum Coolant {
+    Flood,
+    Off,
+}
+
 /// Length units of X, Y, I, J, R and F (G20/G21).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]

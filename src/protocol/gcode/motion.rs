@@ -6,7 +6,7 @@ use core::f32::consts::TAU;
 use super::words::{Block, NonModal, ProgramStop};
 use super::{
     ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM, Command, Commands,
-    DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
+    Coolant, DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
 };
 use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
@@ -32,6 +32,9 @@ impl GcodeState {
         }
         if let Some(s) = block.spindle {
             self.spindle = s;
+        }
+        if let Some(c) = block.coolant {
+            self.coolant = c;
         }
         if let Some(m) = block.motion {
             self.motion = m;
@@ -155,6 +158,7 @@ impl GcodeState {
             self.motion = MotionMode::Linear;
             self.distance = Distance::Absolute;
             self.spindle = Spindle::Off;
+            self.coolant = Coolant::Off;
         }
         out.stop = block.stop;
         Ok(out)

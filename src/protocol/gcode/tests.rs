@@ -137,7 +137,7 @@ fn modal_group_and_command_rules() {
     refused(&mut g, "G38.2 X1", 20);
     refused(&mut g, "G55", 20);
     refused(&mut g, "G93", 20);
-    refused(&mut g, "M8", 20);
+    refused(&mut g, "M7", 20);
     refused(&mut g, "M6", 20);
     refused(&mut g, "G92 G0 X1", 24);
     refused(&mut g, "G1 G92 X1", 24);

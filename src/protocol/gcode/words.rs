@@ -1,7 +1,7 @@
 //! The words of a line and the block they make: compaction, G-code numbers, the letter values,
 //! and the G and M commands sorted into GRBL's modal groups, before any check against the state.
 
-use super::modal::{Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
+use super::modal::{Coolant, Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
 use crate::protocol::GrblError;
 use crate::protocol::framing::LINE_MAX_BYTES;
 
@@ -168,6 +168,7 @@ pub(super) struct Block {
     pub(super) units: Option<Units>,
     pub(super) distance: Option<Distance>,
     pub(super) spindle: Option<Spindle>,
+    pub(super) coolant: Option<Coolant>,
     pub(super) stop: Option<ProgramStop>,
     pub(super) words: Words,
 }
@@ -260,7 +261,10 @@ impl Block {
                 self.spindle = Some([Spindle::Cw, Spindle::Ccw, Spindle::Off][int as usize - 3]);
                 Group::Spindle
             }
-            9 => Group::Coolant,
+            8 | 9 => {
+                self.coolant = Some(if int == 8 { Coolant::Flood } else { Coolant::Off });
+                Group::Coolant
+            }
             _ => return Err(GrblError::Unsupported),
         };
         self.enter(group)
