@@ -124,3 +124,24 @@ fn check_mode_is_entered_only_at_rest() {
     assert_eq!(answers(&report), ["ok", "error:8"], "{}", report.answers());
     assert_eq!(report.position, Point::new(5_000, 0));
 }
+
+#[test]
+fn startup_blocks_run_after_every_reset() {
+    let serial = SimSerial::with_input(b"$N\n$N0=G20 G91 (inches, relative)\n$N1=G1 X1 F100\n$N\n");
+    let serial = paste(serial, 100_000, "\x18");
+    let serial = paste(serial, 200_000, "G1 X1 F100\n");
+    let serial = paste(paste(paste(serial, 30_000_000, "$RST=*\n"), 31_000_000, "\x18"), 32_000_000, "$N\n");
+    let report = run(serial);
+    let text = report.answers();
+    assert!(
+        text.starts_with(
+            "\r\nGrbl 1.1h ['$' for help]\r\n$N0=\r\n$N1=\r\nok\r\nok\r\nerror:3\r\n$N0=G20G91\r\n$N1=\r\nok\r\n"
+        ),
+        "{text}"
+    );
+    // The reset runs the block: the next line moves one inch, relative.
+    assert!(text.contains("\r\nGrbl 1.1h ['$' for help]\r\n>G20G91:ok\r\nok\r\n"), "{text}");
+    assert_eq!(report.position, Point::new(2_540, 0));
+    // `$RST=*` forgets them: the next reset runs nothing.
+    assert!(text.ends_with("ok\r\n\r\nGrbl 1.1h ['$' for help]\r\n$N0=\r\n$N1=\r\nok\r\n"), "{text}");
+}

@@ -42,8 +42,9 @@
 //! a required F; the line's modes apply to the jog only), `$C` check mode (at rest only, error 8
 //! otherwise: every line is parsed and every drawing built and checked against the travel and
 //! the lattice, from the position the lines before it plan, and nothing moves; `$C` again
-//! leaves it with a soft reset, as GRBL does). GRBL's `$N` (startup lines) and `$SLP` are not
-//! supported (error 3).
+//! leaves it with a soft reset, as GRBL does), `$N` / `$Nn=line` startup blocks (two, run after
+//! every reset; a block is checked when stored and refused, error 3, if it would move, dwell or
+//! stop: no one expects the pen to move at a reset). GRBL's `$SLP` is not supported (error 3).
 //!
 //! # Plotter curve commands
 //!
@@ -84,6 +85,7 @@ use super::GrblError;
 use crate::drawing::{self, Request};
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job, JobKind};
+use crate::protocol::startup::StartupLine;
 use crate::settings::Settings;
 use crate::status::RunState;
 
@@ -166,6 +168,8 @@ pub enum Report {
     Parameters,
     /// `$I`: [`crate::protocol::report::build_info`].
     BuildInfo,
+    /// `$N`: [`crate::protocol::report::startup_lines`].
+    StartupLines,
 }
 
 /// What one line asks the machine to do.
@@ -186,8 +190,11 @@ pub enum Command {
     /// `$id=value`, already checked against the settings given to `execute`: apply it with
     /// `Settings::set` (which then succeeds).
     SetSetting { id: u16, value: f32 },
-    /// `$RST=$` or `$RST=*`: every setting back to `Settings::default()`.
-    RestoreSettings,
+    /// `$RST=$` or `$RST=*`: every setting back to `Settings::default()`, and for `$RST=*` the
+    /// startup blocks cleared.
+    RestoreSettings { startup_lines: bool },
+    /// `$Nn=line`: store startup block `index` (checked: it parses and moves nothing).
+    StoreStartupLine { index: u8, line: StartupLine },
     /// Answer with a report (before the `ok`).
     Report(Report),
     /// `$X`: leave the alarm state (GRBL answers `[MSG:Caution: Unlocked]`).

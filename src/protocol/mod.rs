@@ -8,7 +8,8 @@
 //! - [`gcode`]: one line in, machine [`Command`]s out ([`GcodeState::execute`]), with GRBL's
 //!   modal state, planned position and error rules, plus the plotter's own curve commands;
 //! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...);
-//! - [`refresh`]: which status reports carry GRBL's occasional `WCO:` and `Ov:` fields.
+//! - [`refresh`]: which status reports carry GRBL's occasional `WCO:` and `Ov:` fields;
+//! - [`startup`]: the startup blocks (`$N0=`, `$N1=`) run after every reset.
 //!
 //! It owns no pins, queues or clocks: the serial task feeds it bytes, hands the resulting
 //! commands to the machine and writes the answers. Every line gets exactly one `ok` or
@@ -29,7 +30,8 @@
 //! | 5  | `SettingDisabled`         | `$H`: the plotter has no homing switches |
 //! | 8  | `NotIdle`                 | `$N=`/`$RST=` while moving; `$J=` while drawing, held or in alarm |
 //! | 9  | `Locked`                  | G-code or a curve command while in alarm (unlock with `$X`) or jogging; a move still waiting for room in the job queue when an abort (keypad D, jog cancel, a curve stopped part way) dropped what was planned |
-//! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`] |
+//! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`]; a line dropped for want of room in the receive buffer |
+//! | 14 | `LineLengthExceeded`      | a `$Nn=` startup block longer than [`startup::STARTUP_LINE_MAX_BYTES`] |
 //! | 15 | `TravelExceeded`          | any point of a move or curve outside ±max travel (`$130`, `$131`) |
 //! | 16 | `InvalidJog`              | a `$J=` line with a word or command jogging does not allow |
 //! | 20 | `Unsupported`             | a G/M code or word letter the plotter does not support (G18, G28, M8, ...) |
@@ -65,6 +67,7 @@ pub mod framing;
 pub mod gcode;
 pub mod refresh;
 pub mod report;
+pub mod startup;
 
 pub use framing::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
 pub use gcode::{Command, Commands, GcodeState, Report};
@@ -81,6 +84,7 @@ pub enum GrblError {
     NotIdle,
     Locked,
     LineOverflow,
+    LineLengthExceeded,
     TravelExceeded,
     InvalidJog,
     Unsupported,
@@ -135,6 +139,7 @@ impl GrblError {
             GrblError::NotIdle => 8,
             GrblError::Locked => 9,
             GrblError::LineOverflow => 11,
+            GrblError::LineLengthExceeded => 14,
             GrblError::TravelExceeded => 15,
             GrblError::InvalidJog => 16,
             GrblError::Unsupported => 20,

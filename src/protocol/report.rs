@@ -15,6 +15,7 @@ use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, Units};
 use crate::drawing::DrawError;
 use crate::geom::Axis;
 use crate::interp::CurveError;
+use crate::protocol::startup::StartupLines;
 use crate::settings::{SETTING_INFO, Settings};
 use crate::status::{MotionFault, RunState, Status};
 
@@ -207,7 +208,11 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
         Coolant::Flood => "M8",
         Coolant::Off => "M9",
     };
-    write!(out, "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} {coolant} T{} F{feed} S{speed}]\r\n", gcode.tool())
+    write!(
+        out,
+        "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} {coolant} T{} F{feed} S{speed}]\r\n",
+        gcode.tool()
+    )
 }
 
 /// `$#`: GRBL's coordinate offsets. Only G92 can be set; the others are always zero.
@@ -229,7 +234,24 @@ pub fn build_info(out: &mut impl Write, planner_blocks: usize, rx_buffer_bytes: 
 
 /// `$`: the commands the plotter understands.
 pub fn help(out: &mut impl Write) -> fmt::Result {
-    out.write_str("[HLP:$$ $# $G $I $x=val $J=line $RST=$ $X $E $O $S $F ~ ! ? ctrl-x]\r\n")
+    out.write_str("[HLP:$$ $# $G $I $N $x=val $Nx=line $J=line $RST=$ $C $X $E $O $S $F ~ ! ? ctrl-x]\r\n")
+}
+
+/// `$N`: every startup block, `$Nn=line` per line, empty ones included.
+pub fn startup_lines(out: &mut impl Write, lines: &StartupLines) -> fmt::Result {
+    for (n, line) in lines.all().enumerate() {
+        write!(out, "$N{n}={line}\r\n")?;
+    }
+    Ok(())
+}
+
+/// What running a startup block after a reset gave: `>line:ok` or `>line:error:N`.
+pub fn startup_result(out: &mut impl Write, line: &str, result: Result<(), GrblError>) -> fmt::Result {
+    write!(out, ">{line}:")?;
+    match result {
+        Ok(()) => ok(out),
+        Err(e) => write!(out, "error:{}\r\n", e.code()),
+    }
 }
 
 /// `x,y,0.000` in millimetres.

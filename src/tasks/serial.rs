@@ -14,7 +14,7 @@
 //! emptied the pipe it answers each of those lines `error:11` (not processed), and only then
 //! does the receiver pass bytes on again, from the start of the next line.
 
-use core::cell::Cell;
+use core::cell::{Cell, RefCell};
 use core::future::Future;
 
 use embassy_futures::join::join3;
@@ -33,6 +33,7 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::refresh::Refresh;
 use crate::protocol::report::StatusFields;
+use crate::protocol::startup::StartupLines;
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -75,6 +76,8 @@ struct Link<'m, W> {
     reset: Signal<NoopRawMutex, ()>,
     /// The line being answered left check mode: the parser starts over once it is answered.
     restart_after_answer: Cell<bool>,
+    /// The startup blocks, run after every reset.
+    startup: RefCell<StartupLines>,
 }
 
 /// Speaks GRBL on the host link forever.
@@ -88,6 +91,7 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         resets_pending: Cell::new(0),
         reset: Signal::new(),
         restart_after_answer: Cell::new(false),
+        startup: RefCell::new(StartupLines::new()),
     };
     link.send(report::welcome).await;
     join3(receive(&link, rx), lines(&link), faults(&link)).await;
@@ -364,15 +368,25 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
     }
 }
 
-/// After a soft reset, or on leaving check mode: the parser starts over from the pen, and the
-/// host gets the banner.
+/// After a soft reset, or on leaving check mode: the parser starts over from the pen, the host
+/// gets the banner, and the startup blocks run (not in an alarm, as GRBL does), each answered
+/// `>line:ok` or `>line:error:N`.
 async fn restart<W: Write>(link: &Link<'_, W>, gcode: &mut GcodeState, epoch: &mut PlanEpoch) {
     let machine = link.machine;
     machine.set_check_mode(false);
-    gcode.reset(machine.position(), &machine.settings());
-    machine.set_work_offset_mm(gcode.work_offset_mm());
+    let settings = machine.settings();
+    gcode.reset(machine.position(), &settings);
     *epoch = machine.plan_epoch();
     link.send(report::welcome).await;
+    if machine.state() != RunState::Alarm {
+        let startup = link.startup.borrow().clone();
+        for line in startup.to_run() {
+            // Checked when stored: a startup block changes modes and offsets, and moves nothing.
+            let result = gcode.execute(line, &settings, RunState::Idle).map(|_| ());
+            link.send(|a| report::startup_result(a, line, result)).await;
+        }
+    }
+    machine.set_work_offset_mm(gcode.work_offset_mm());
 }
 
 /// Carries out one command of a parsed line.
@@ -409,7 +423,13 @@ async fn carry_out<W: Write>(
                 .update_settings(|s| s.set(id, value))
                 .map_err(|_| Unfinished::Error(GrblError::InvalidStatement))?;
         }
-        Command::RestoreSettings => machine.update_settings(|s| *s = Settings::default()),
+        Command::RestoreSettings { startup_lines } => {
+            machine.update_settings(|s| *s = Settings::default());
+            if startup_lines {
+                link.startup.borrow_mut().clear();
+            }
+        }
+        Command::StoreStartupLine { index, line } => link.startup.borrow_mut().set(usize::from(index), line),
         Command::Report(kind) => {
             link.send(|a| match kind {
                 Report::Help => report::help(a),
@@ -417,6 +437,7 @@ async fn carry_out<W: Write>(
                 Report::ParserState => report::parser_state(a, gcode, settings),
                 Report::Parameters => report::parameters(a, gcode),
                 Report::BuildInfo => report::build_info(a, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES),
+                Report::StartupLines => report::startup_lines(a, &link.startup.borrow()),
             })
             .await
         }

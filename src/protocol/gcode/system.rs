@@ -6,6 +6,7 @@ use super::{Command, Commands, Distance, GcodeState, Report};
 use crate::drawing::{self, Request};
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
+use crate::protocol::startup::{STARTUP_LINES, StartupLine};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
 
@@ -34,6 +35,8 @@ impl GcodeState {
             },
             b"H" => Err(GrblError::SettingDisabled),
             b"SLP" => Err(GrblError::InvalidStatement),
+            b"N" => report(Report::StartupLines),
+            [b'N', index @ b'0'..=b'9', b'=', body @ ..] => self.startup_line(*index - b'0', body, settings, state),
             [b'R', b'S', b'T', b'=', what] => self.restore(*what, settings, state),
             [b'J', b'=', body @ ..] => self.jog(body, settings, state),
             [b'0'..=b'9', ..] => self.set_setting(&c, settings, state),
@@ -81,6 +84,38 @@ impl GcodeState {
         Ok(Commands::one(Command::SetSetting { id, value }))
     }
 
+    /// `$Nn=line`: `line` (compacted) is checked as a line run at rest, and stored if it parses
+    /// and moves nothing: a startup block runs after every reset, when no one may expect the pen
+    /// to move. An empty line clears the block.
+    fn startup_line(
+        &self,
+        index: u8,
+        body: &[u8],
+        settings: &Settings,
+        state: RunState,
+    ) -> Result<Commands, GrblError> {
+        if state != RunState::Idle {
+            return Err(GrblError::NotIdle);
+        }
+        if usize::from(index) >= STARTUP_LINES {
+            return Err(GrblError::InvalidStatement);
+        }
+        // Compacted text is ASCII.
+        let text = core::str::from_utf8(body).map_err(|_| GrblError::InvalidStatement)?;
+        let mut line = StartupLine::new();
+        line.push_str(text).map_err(|_| GrblError::LineLengthExceeded)?;
+        if !text.is_empty() {
+            if text.starts_with('$') {
+                return Err(GrblError::InvalidStatement);
+            }
+            let mut trial = self.clone();
+            if !trial.execute(text, settings, RunState::Idle)?.is_empty() {
+                return Err(GrblError::InvalidStatement);
+            }
+        }
+        Ok(Commands::one(Command::StoreStartupLine { index, line }))
+    }
+
     /// `$RST=$`, `$RST=#`, `$RST=*`.
     fn restore(&mut self, what: u8, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
         if !matches!(what, b'$' | b'#' | b'*') {
@@ -99,7 +134,7 @@ impl GcodeState {
         if defaults.steps_per_mm != settings.steps_per_mm {
             self.rescale(&defaults);
         }
-        Ok(Commands::one(Command::RestoreSettings))
+        Ok(Commands::one(Command::RestoreSettings { startup_lines: what == b'*' }))
     }
 
     /// Keeps the planned position on the same step when steps/mm change.

@@ -408,7 +408,7 @@ fn system_commands() {
     assert_eq!(run_in(&mut g, "$C", RunState::Check), Ok(std::vec![Command::CheckMode { on: false }]));
     refused_in(&mut g, "$C", RunState::Run, 8);
     refused(&mut g, "$SLP", 3);
-    refused(&mut g, "$N", 3);
+    refused(&mut g, "$N2=G20", 3);
     refused(&mut g, "$Q", 3);
     refused(&mut g, "$GX", 3);
     refused(&mut g, "$RST=x", 3);
@@ -454,7 +454,7 @@ fn restoring_defaults() {
     assert_eq!(g.execute("$RST=#", &s, RunState::Idle).map(|c| c.len()), Ok(0));
     assert_eq!(g.work_offset_mm(), [0.0, 0.0]);
     let cmds = g.execute("$RST=$", &s, RunState::Idle).unwrap();
-    assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::RestoreSettings]);
+    assert_eq!(cmds.collect::<Vec<_>>(), std::vec![Command::RestoreSettings { startup_lines: false }]);
     // Still on step 500, now 5 mm at the default 100 steps/mm.
     assert_eq!(g.position_mm, [5.0, 0.0]);
 }

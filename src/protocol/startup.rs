@@ -1,0 +1,50 @@
+//! GRBL's startup blocks (`$N0=`, `$N1=`): G-code lines the host link runs after every reset,
+//! to set the modes a user wants by default (`G20 G54`, ...). Owns the stored lines; the G-code
+//! parser checks a line before it is stored, and the serial task runs them.
+//!
+//! They are kept in RAM for now, so they last until power-off; a flash store will keep them
+//! across power cycles.
+
+use heapless::String;
+
+/// Startup blocks, as in GRBL.
+pub const STARTUP_LINES: usize = 2;
+/// Longest startup block, in bytes, as stored (compacted: no spaces or comments); GRBL's.
+pub const STARTUP_LINE_MAX_BYTES: usize = 80;
+
+/// One stored startup block.
+pub type StartupLine = String<STARTUP_LINE_MAX_BYTES>;
+
+/// The stored startup blocks, empty ones included.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StartupLines {
+    lines: [StartupLine; STARTUP_LINES],
+}
+
+impl StartupLines {
+    pub const fn new() -> Self {
+        StartupLines { lines: [String::new(), String::new()] }
+    }
+
+    /// Stores `line` as block `index` (an empty line clears it); the parser has checked both.
+    pub fn set(&mut self, index: usize, line: StartupLine) {
+        if let Some(slot) = self.lines.get_mut(index) {
+            *slot = line;
+        }
+    }
+
+    /// Every block, in order, empty ones included (`$N` lists them all).
+    pub fn all(&self) -> impl Iterator<Item = &str> {
+        self.lines.iter().map(String::as_str)
+    }
+
+    /// The blocks to run after a reset, in order.
+    pub fn to_run(&self) -> impl Iterator<Item = &str> {
+        self.all().filter(|l| !l.is_empty())
+    }
+
+    /// Forgets every block (`$RST=*`).
+    pub fn clear(&mut self) {
+        *self = StartupLines::new();
+    }
+}
