@@ -81,6 +81,8 @@ pub struct Machine {
     plan_empty: AtomicBool,
     /// The host link is in check mode (`$C`): reported as [`RunState::Check`] while idle.
     check_mode: AtomicBool,
+    /// The current hold came from the safety door.
+    door: AtomicBool,
     /// Segments the planner has room for (set by the motion task).
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
@@ -123,6 +125,7 @@ impl Machine {
             aborted: Signal::new(),
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
+            door: AtomicBool::new(false),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
@@ -148,9 +151,23 @@ impl Machine {
     }
 
     /// Asks the motion task for `control`; see [`Control::then`] for requests not yet taken.
+    /// A resume or an abort closes the safety door.
     pub fn request(&self, control: Control) {
+        if control != Control::Hold && self.door.swap(false, Ordering::Relaxed) {
+            self.changed.signal(());
+        }
         self.control.lock(|c| c.set(Some(c.get().map_or(control, |pending| pending.then(control)))));
         self.control_requested.signal(());
+    }
+
+    /// The safety door (GRBL's 0x84): a hold, reported as `Door` until a resume or an abort.
+    /// Ignored in an alarm and in check mode, where nothing moves.
+    pub fn open_door(&self) {
+        if matches!(self.state(), RunState::Alarm | RunState::Check) {
+            return;
+        }
+        self.door.store(true, Ordering::Relaxed);
+        self.request(Control::Hold);
     }
 
     /// The pending control request, if any, taking it.
@@ -325,6 +342,7 @@ impl Machine {
             position: self.position(),
             queued_jobs: self.queued_jobs() as u8,
             fault: self.fault(),
+            door: self.door.load(Ordering::Relaxed),
             underruns: self.underruns(),
         }
     }

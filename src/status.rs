@@ -43,6 +43,8 @@ pub struct Status {
     pub queued_jobs: u8,
     /// Why the last job stopped early, until the next one starts.
     pub fault: Option<MotionFault>,
+    /// The hold came from the safety door (GRBL's 0x84): reported as `Door`, resumed by `~`.
+    pub door: bool,
     /// Times the pulses had to wait for the motion task since power-on (step-queue underruns):
     /// where the machine could not keep up with the speeds it planned.
     pub underruns: u32,

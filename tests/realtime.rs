@@ -168,3 +168,18 @@ fn a_paste_ignoring_flow_control_during_a_hold_never_locks_the_link() {
     assert!(answers.contains("<Idle|"), "the status query got through: {answers}");
     assert_eq!(report.position, *report.path().last().unwrap());
 }
+
+#[test]
+fn the_safety_door_holds_reports_door_and_a_resume_finishes_the_drawing() {
+    let reference = run(&square_program(), &[]);
+    let door = run(&square_program(), &[(300_000, b"\x84"), (1_300_000, b"?"), (2_300_000, b"~"), (2_400_000, b"?")]);
+    assert_eq!(door.path(), reference.path());
+    assert!(door.last_pulse_us() > reference.last_pulse_us() + 1_500_000, "it stood still meanwhile");
+    let answers = door.answers();
+    assert!(answers.contains("<Door:0|"), "{answers}");
+    assert!(answers.contains("<Run|"), "the resume closed the door: {answers}");
+    // At rest, the door holds what comes next until `~`.
+    let idle = run("G4 P0.5\nG1 X10 F3000\n", &[(100_000, b"\x84"), (2_000_000, b"~")]);
+    assert!(idle.trace.pulses[0].t_us >= 2_000_000, "nothing moved before the resume");
+    assert_eq!(idle.position, Point::new(1_000, 0));
+}

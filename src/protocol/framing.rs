@@ -33,10 +33,12 @@ pub enum Realtime {
     CycleStart,
     /// 0x18 (Ctrl-X): soft reset.
     Reset,
+    /// 0x84: the safety door: a hold, reported as `Door` until resumed.
+    SafetyDoor,
     /// 0x85: cancel the jog in progress.
     JogCancel,
-    /// One of GRBL's other extended realtime bytes (safety door 0x84, feed, rapid and spindle
-    /// overrides 0x90–0x9E, coolant toggles 0xA0/0xA1): the plotter has no use for it and
+    /// One of GRBL's other extended realtime bytes (feed, rapid and spindle overrides
+    /// 0x90–0x9E, coolant toggles 0xA0/0xA1): the plotter has no use for it and
     /// ignores it, as GRBL would on a machine without that feature.
     Unsupported(u8),
 }
@@ -48,8 +50,9 @@ pub const fn realtime(byte: u8) -> Option<Realtime> {
         b'!' => Realtime::FeedHold,
         b'~' => Realtime::CycleStart,
         0x18 => Realtime::Reset,
+        0x84 => Realtime::SafetyDoor,
         0x85 => Realtime::JogCancel,
-        0x84 | 0x90..=0x97 | 0x99..=0x9E | 0xA0 | 0xA1 => Realtime::Unsupported(byte),
+        0x90..=0x97 | 0x99..=0x9E | 0xA0 | 0xA1 => Realtime::Unsupported(byte),
         _ => return None,
     })
 }

@@ -130,6 +130,7 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
     let state = match status.state {
         RunState::Idle => "Idle",
         RunState::Run => "Run",
+        RunState::Hold if status.door => "Door:0",
         RunState::Hold => "Hold:0",
         RunState::Jog => "Jog",
         RunState::Alarm => "Alarm",
@@ -288,7 +289,7 @@ mod tests {
     }
 
     fn st(state: RunState, x: i32, y: i32) -> Status {
-        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None, underruns: 0 }
+        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None, door: false, underruns: 0 }
     }
 
     /// The fields of a report with speed `speed` and nothing occasional.

@@ -269,6 +269,7 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
                     link.dropped.clear();
                     link.bytes.write_all(&[byte]).await;
                 }
+                Some(Realtime::SafetyDoor) => link.machine.open_door(),
                 Some(Realtime::JogCancel | Realtime::Unsupported(_)) => {}
                 None => link.line_byte(byte).await,
             }

@@ -96,7 +96,7 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
             )
         }
     };
-    let state = state_name(status.state);
+    let state = state_name(status);
     let pad = SCREEN_COLUMNS.saturating_sub(state.len());
     *title = TextLine::new(format_args!("{:<pad$}{}", title_text.as_str(), state), true);
     *l1 = position_line(status, settings);
@@ -189,10 +189,11 @@ where
     render(&view(menu, status, settings), target)
 }
 
-fn state_name(state: RunState) -> &'static str {
-    match state {
+fn state_name(status: &Status) -> &'static str {
+    match status.state {
         RunState::Idle => "IDLE",
         RunState::Run => "RUN",
+        RunState::Hold if status.door => "DOOR",
         RunState::Hold => "HOLD",
         RunState::Jog => "JOG",
         RunState::Alarm => "ALARM",
@@ -510,6 +511,7 @@ mod tests {
             queued_jobs: 255,
             position: crate::geom::Point::new(-50_000, -50_000),
             fault: None,
+            door: false,
             underruns: u32::MAX,
         };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
