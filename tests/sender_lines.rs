@@ -73,11 +73,14 @@ fn a_paste_beyond_the_receive_buffer_answers_every_line_in_order() {
 }
 
 #[test]
-fn a_paste_with_crlf_line_ends_beyond_the_buffer_answers_every_line_once() {
+fn crlf_is_answered_as_grbl_answers_it_twice_even_beyond_the_buffer() {
+    // CR ends the line and LF an empty one: two answers, as GRBL gives them.
+    let report = run(SimSerial::with_input(b"G1 X1 F600\r\n"));
+    assert_eq!(answers(&report), ["ok", "ok"], "{}", report.answers());
     let pasted = diagonal_lines(10..=209).replace('\n', "\r\n");
     let serial = paste(SimSerial::with_input(b"G1 X50 F1200\n"), 1_000, &pasted);
     let report = run(paste(serial, 900_000_000, "G1 X1 Y1\r\n"));
-    assert_eq!(answers(&report).len(), 202, "{}", report.answers());
+    assert_eq!(answers(&report).len(), 1 + 2 * 200 + 2, "{}", report.answers());
     assert_eq!(report.position, Point::new(100, 100));
 }
 

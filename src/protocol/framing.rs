@@ -1,7 +1,7 @@
 //! Serial framing: the host's bytes into text lines (one G-code block or `$` command each), and
 //! the realtime bytes that never belong to a line.
 //!
-//! GRBL senders stream lines ended by LF, CR or CRLF, and at any moment (even in the middle of a
+//! GRBL senders stream lines ended by LF or CR, and at any moment (even in the middle of a
 //! line) send single realtime bytes: `?` status, `!` hold, `~` resume, Ctrl-X reset and GRBL's
 //! extended commands in 0x80–0xFF. The serial task routes every byte through [`realtime`] first
 //! and acts on the realtime ones at once; [`LineAssembler`] skips them too, so a line is the same
@@ -83,8 +83,8 @@ impl LineEvent<'_> {
 
 /// Collects bytes into lines; see the module documentation.
 ///
-/// A line ends at LF or CR; an LF right after a CR only completes the CRLF pair and makes no
-/// second (empty) line. Every other byte that is not realtime belongs to the line: outside
+/// A line ends at LF or CR, each on its own, as in GRBL: CRLF ends a line and then an empty one,
+/// and GRBL answers both (senders send LF). Every other byte that is not realtime belongs to the line: outside
 /// comments, printable ASCII (and tab, in a `$` command) is kept; any other byte marks the whole
 /// line as refused. A line whose kept bytes grow past [`LINE_MAX_BYTES`] is dropped up to its end
 /// and reported once, as [`LineEvent::Overflow`], when that end arrives. A soft reset byte
@@ -97,8 +97,6 @@ pub struct LineAssembler {
     comment: Comment,
     overflow: bool,
     bad_byte: Option<u8>,
-    /// The previous line-ending byte was a CR: a following LF belongs to it.
-    after_cr: bool,
     /// A line was handed out by the previous `push`; the buffer starts over at the next byte.
     handed_out: bool,
 }
@@ -141,7 +139,6 @@ impl LineAssembler {
             comment: Comment::None,
             overflow: false,
             bad_byte: None,
-            after_cr: false,
             handed_out: false,
         }
     }
@@ -149,7 +146,6 @@ impl LineAssembler {
     /// Drops the partial line (after a soft reset, or when the link reconnects).
     pub fn clear(&mut self) {
         self.start_line();
-        self.after_cr = false;
         self.handed_out = false;
     }
 
@@ -175,17 +171,11 @@ impl LineAssembler {
             return None;
         }
         match byte {
-            b'\n' if self.after_cr => {
-                self.after_cr = false;
-                None
-            }
             b'\r' | b'\n' => {
-                self.after_cr = byte == b'\r';
                 self.handed_out = true;
                 Some(self.finish())
             }
             _ => {
-                self.after_cr = false;
                 self.take(byte);
                 None
             }
@@ -276,19 +266,14 @@ mod tests {
     }
 
     #[test]
-    fn lf_cr_and_crlf_each_end_one_line() {
+    fn lf_and_cr_each_end_a_line_as_in_grbl() {
         let mut a = LineAssembler::new();
-        assert_eq!(feed(&mut a, b"G0 X1\nG0 X2\rG0 X3\r\nG0 X4\n"), lines(&["G0X1", "G0X2", "G0X3", "G0X4"]));
-    }
-
-    #[test]
-    fn crlf_split_across_pushes_makes_no_empty_line_but_blank_lines_still_count() {
-        let mut a = LineAssembler::new();
+        assert_eq!(feed(&mut a, b"G0 X1\nG0 X2\rG0 X4\n"), lines(&["G0X1", "G0X2", "G0X4"]));
+        // CRLF is a line and an empty one: GRBL answers `ok` twice.
+        assert_eq!(feed(&mut a, b"G0 X3\r\n"), lines(&["G0X3", ""]));
         assert_eq!(feed(&mut a, b"$$\r"), lines(&["$$"]));
-        assert_eq!(feed(&mut a, b"\n"), lines(&[]));
+        assert_eq!(feed(&mut a, b"\n"), lines(&[""]));
         // A blank line is a line: GRBL answers it with `ok`, and senders count on that.
-        assert_eq!(feed(&mut a, b"\n\r\n"), lines(&["", ""]));
-        // LF CR is two line ends, not a pair.
         assert_eq!(feed(&mut a, b"A\n\rB\n"), lines(&["A", "", "B"]));
     }
 
@@ -316,7 +301,7 @@ mod tests {
     fn an_overlong_line_is_reported_once_and_the_next_line_is_intact() {
         let mut a = LineAssembler::new();
         let mut input = std::vec![b'X'; LINE_MAX_BYTES * 3];
-        input.extend_from_slice(b"\r\nG0 X1\n");
+        input.extend_from_slice(b"\nG0 X1\n");
         assert_eq!(feed(&mut a, &input), std::vec![Err(LineEvent::Overflow), Ok("G0X1".to_string())]);
     }
 

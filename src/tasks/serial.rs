@@ -164,26 +164,15 @@ impl<W: Write> Link<'_, W> {
     /// are still read, and its line with it; see the module documentation.
     async fn line_byte(&self, byte: u8) {
         let d = &self.dropped;
-        // An LF right after a CR completes the CRLF pair: no line end of its own.
-        let pair = byte == b'\n' && d.after_cr.get();
-        let cr_dropped = d.cr_dropped.replace(false);
-        d.after_cr.set(byte == b'\r');
-        if pair && (cr_dropped || d.active.get()) {
-            return;
-        }
         if !d.active.get() {
             let wait = Timer::after(Duration::from_millis(SERIAL_PIPE_WAIT_MS));
             if let Either::First(()) = select(self.bytes.write_all(&[byte]), wait).await {
                 return;
             }
-            if pair {
-                // Its CR ended the line already: nothing is lost.
-                return;
-            }
             d.active.set(true);
             self.send(|a| report::message(a, "Receive buffer full: lines dropped, each answered error:11")).await;
         }
-        d.cr_dropped.set(byte == b'\r');
+        // CR and LF each end a line, as they do for the line assembler.
         if byte == b'\n' || byte == b'\r' {
             d.lines.set(d.lines.get() + 1);
             d.mid_line.set(false);
@@ -204,10 +193,6 @@ struct Dropped {
     lines: Cell<u32>,
     /// The last line byte dropped was not a line end: a dropped line is still under way.
     mid_line: Cell<bool>,
-    /// The last line byte, passed on or dropped, was a CR.
-    after_cr: Cell<bool>,
-    /// The last line byte was a CR, dropped: an LF after it completes a dropped line.
-    cr_dropped: Cell<bool>,
     /// Wakes the line loop when a dropped line's end is counted.
     counted: Signal<NoopRawMutex, ()>,
 }
@@ -218,8 +203,6 @@ impl Dropped {
         self.active.set(false);
         self.lines.set(0);
         self.mid_line.set(false);
-        self.after_cr.set(false);
-        self.cr_dropped.set(false);
     }
 
     /// The dropped lines to answer now, if the line loop has taken every byte that came before
