@@ -41,6 +41,7 @@ fn a_senders_session_with_work_coordinates_and_a_reset() {
         "G0 X0 Y0", // work (0, 0) of G54: machine (10, 5)
         "G4 P0",
         "?",
+        "?",
     ];
     let report = sim::run_serial(&(session.join("\n") + "\n"));
     assert!(!report.timed_out, "{}", report.answers());
@@ -67,5 +68,44 @@ fn a_senders_session_with_work_coordinates_and_a_reset() {
         parameters("10.000,5.000,0.000", "-50.000,50.000,0.000", "-30.000,47.000,0.000", "0.000,0.000,0.000");
     expected.push("[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]".to_string());
     assert_eq!(after, expected, "{answers}");
-    assert!(answers.contains("<Idle|MPos:10.000,5.000,0.000|"), "{answers}");
+    // The first status report after the reset carries the work offset, G54's; the next does not.
+    let reports: Vec<&str> = answers.lines().filter(|l| l.starts_with('<')).collect();
+    assert_eq!(
+        reports,
+        ["<Idle|MPos:10.000,5.000,0.000|FS:0,0|WCO:10.000,5.000,0.000>", "<Idle|MPos:10.000,5.000,0.000|FS:0,0>"]
+    );
+}
+
+#[test]
+fn status_reports_carry_the_work_offset_when_it_changes() {
+    let report = sim::run_serial(
+        "?
+?
+G0 X10 Y5
+G10 L20 P1 X0 Y0
+G4 P0
+?
+G92 X-1
+?
+?
+G55
+?
+",
+    );
+    let answers = report.answers();
+    let reports: Vec<&str> = answers.lines().filter(|l| l.starts_with('<')).collect();
+    assert_eq!(
+        reports,
+        [
+            // At power-on, as GRBL does.
+            "<Idle|MPos:0.000,0.000,0.000|FS:0,0|WCO:0.000,0.000,0.000>",
+            "<Idle|MPos:0.000,0.000,0.000|FS:0,0>",
+            "<Idle|MPos:10.000,5.000,0.000|FS:0,0|WCO:10.000,5.000,0.000>",
+            "<Idle|MPos:10.000,5.000,0.000|FS:0,0|WCO:11.000,5.000,0.000>",
+            "<Idle|MPos:10.000,5.000,0.000|FS:0,0>",
+            // G55 (offset zero) with the G92 offset on top.
+            "<Idle|MPos:10.000,5.000,0.000|FS:0,0|WCO:1.000,0.000,0.000>",
+        ],
+        "{answers}"
+    );
 }

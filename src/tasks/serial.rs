@@ -7,6 +7,11 @@
 //! `error:N` once their jobs are queued (back-pressure paces a streaming sender). A third loop
 //! reports curves that stopped early. Answers are whole lines, never interleaved.
 //!
+//! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
+//! the parser has it after its last line) as GRBL's do: in the first report after power-on, a
+//! reset or a change, then once every [`REPORT_WCO_REFRESH_IDLE_COUNT`] reports
+//! ([`REPORT_WCO_REFRESH_BUSY_COUNT`] while moving), so a sender shows work positions.
+//!
 //! Every line gets exactly one answer, in order, whatever the sender does. A sender that
 //! ignores GRBL's flow control and sends more than the pipe holds while the machine is busy
 //! loses whole lines, never parts of them: from the byte that found no room up to the end of a
@@ -52,6 +57,12 @@ pub const SERIAL_CHUNK_BYTES: usize = 32;
 pub const SERIAL_ERROR_BACKOFF_MS: u64 = 1;
 /// How often waits for the machine to come to rest (G4, M0, M2) look again.
 pub const SERIAL_IDLE_POLL_MS: u64 = 5;
+/// A status report carries the work offset (`|WCO:`) once every this many reports while the
+/// machine moves or holds, GRBL's count...
+pub const REPORT_WCO_REFRESH_BUSY_COUNT: u8 = 30;
+/// ...and once every this many otherwise; always in the first report after the offset changed,
+/// after power-on and after a reset.
+pub const REPORT_WCO_REFRESH_IDLE_COUNT: u8 = 10;
 
 type Answer = String<SERIAL_ANSWER_MAX_BYTES>;
 
@@ -62,6 +73,11 @@ struct Link<'m, W> {
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
     /// Feed rate of the motion in progress, for status reports.
     feed_mm_per_min: Cell<f32>,
+    /// The parser's work offset (active work coordinate system + G92) as of its last line, for
+    /// status reports.
+    work_offset_mm: Cell<[f32; 2]>,
+    /// Status reports still to go without `|WCO:`; 0: the next one has it.
+    reports_until_wco: Cell<u8>,
     /// Lines dropped for want of room in the pipe; see the module documentation.
     dropped: Dropped,
     /// Resets received and not yet met by the line loop: bytes before them are dropped.
@@ -77,6 +93,8 @@ pub async fn run<R: Read, W: Write>(machine: &Machine, rx: R, tx: W) -> ! {
         tx: Mutex::new(tx),
         bytes: Pipe::new(),
         feed_mm_per_min: Cell::new(0.0),
+        work_offset_mm: Cell::new([0.0; 2]),
+        reports_until_wco: Cell::new(0),
         dropped: Dropped::default(),
         resets_pending: Cell::new(0),
         reset: Signal::new(),
@@ -105,7 +123,27 @@ impl<W: Write> Link<'_, W> {
         let status = self.machine.status();
         let settings = self.machine.settings();
         let feed = if status.state == RunState::Idle { 0.0 } else { self.feed_mm_per_min.get() };
-        self.send(|a| report::status(a, &status, &settings, feed, None)).await;
+        let work_offset = match self.reports_until_wco.get() {
+            0 => {
+                let busy = matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog);
+                let every = if busy { REPORT_WCO_REFRESH_BUSY_COUNT } else { REPORT_WCO_REFRESH_IDLE_COUNT };
+                self.reports_until_wco.set(every - 1);
+                Some(self.work_offset_mm.get())
+            }
+            n => {
+                self.reports_until_wco.set(n - 1);
+                None
+            }
+        };
+        self.send(|a| report::status(a, &status, &settings, feed, work_offset)).await;
+    }
+
+    /// Takes the parser's work offset after a line or a reset; the next status report carries it
+    /// if it changed.
+    fn note_work_offset(&self, offset_mm: [f32; 2]) {
+        if self.work_offset_mm.replace(offset_mm) != offset_mm {
+            self.reports_until_wco.set(0);
+        }
     }
 
     /// Runs `work` unless a reset comes first (or is already on its way).
@@ -285,6 +323,8 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                 link.machine_stopped().await;
                 link.reset.reset();
                 gcode.reset(machine.position(), &machine.settings());
+                link.note_work_offset(gcode.work_offset_mm());
+                link.reports_until_wco.set(0);
                 epoch = machine.plan_epoch();
                 link.send(report::welcome).await;
                 continue;
@@ -310,7 +350,9 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         // pen elsewhere than the parser planned.
                         gcode.sync_position(machine.position(), &settings);
                     }
-                    match gcode.execute(line, &settings, machine.run_state()) {
+                    let executed = gcode.execute(line, &settings, machine.run_state());
+                    link.note_work_offset(gcode.work_offset_mm());
+                    match executed {
                         Ok(commands) => {
                             let mut r = Ok(());
                             for command in commands {
