@@ -350,10 +350,10 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         // pen elsewhere than the parser planned.
                         gcode.sync_position(machine.position(), &settings);
                     }
-                    let executed = gcode.execute(line, &settings, machine.run_state());
-                    link.note_work_offset(gcode.work_offset_mm());
-                    match executed {
+                    match gcode.execute(line, &settings, machine.run_state()) {
                         Ok(commands) => {
+                            // A refused line changed no offset.
+                            link.note_work_offset(gcode.work_offset_mm());
                             let mut r = Ok(());
                             for command in commands {
                                 r = carry_out(link, &gcode, &settings, command, epoch).await;
