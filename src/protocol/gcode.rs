@@ -1,12 +1,13 @@
 //! One line of G-code or a `$` command in, machine [`Command`]s out, with GRBL 1.1's rules.
 //!
-//! [`GcodeState`] is GRBL's parser state: modal groups (motion, units, distance, spindle), the
-//! feed rate, the G92 work offset and the *planned* position — where the pen will be once every
-//! command handed out so far has run. [`GcodeState::execute`] parses a whole line first and
-//! changes the state only if the line is valid: an error line leaves the modal state, the planned
-//! position and the settings as they were. Positions inside are machine millimetres (as GRBL
-//! keeps them, so that relative moves never drift by rounding); every command handed out is in
-//! absolute steps, rounded from them.
+//! [`GcodeState`] is GRBL's parser state: modal groups (motion, units, distance, work coordinate
+//! system, spindle), the feed rate, the coordinate data ([`Offsets`]: G54–G59, G28, G30, G92) and
+//! the *planned* position — where the pen will be once every command handed out so far has run.
+//! [`GcodeState::execute`] parses a whole line first and changes the state only if the line is
+//! valid: an error line leaves the modal state, every offset, the planned position and the
+//! settings as they were. Positions inside are machine millimetres (as GRBL keeps them, so that
+//! relative moves never drift by rounding); every command handed out is in absolute steps,
+//! rounded from them.
 //!
 //! This module decides only; it does not move, wait or write. Settings changes are checked here
 //! and handed out as [`Command::SetSetting`], applied by the caller.
@@ -21,9 +22,9 @@
 //!   than half a circle), full circles when the end equals the start (`G91 G2 X0 Y0 I10`; as in
 //!   GRBL the end must be written, `G2 I10` alone is error 26); radii up to
 //!   [`CURVE_RADIUS_MAX_MM`];
-//! - G4 P dwell (seconds), G17 (G18/G19 refused), G20/G21, G90/G91, G91.1, G92 / G92.1 (work
-//!   offset), G53 (machine coordinates for one G0/G1 line), G80, and the header no-ops G40, G49,
-//!   G54, G61, G94;
+//! - G4 P dwell (seconds), G17 (G18/G19 refused), G20/G21, G90/G91, G91.1, G80, and the header
+//!   no-ops G40, G49, G61, G94;
+//! - work coordinates, below: G54–G59, G10 L2 / L20, G28 / G30, G28.1 / G30.1, G92 / G92.1, G53;
 //! - M0 (pause), M1 (ignored), M2/M30 (program end), M3/M4/M5 and S (accepted, no spindle),
 //!   M8/M9 (accepted, no coolant), T (kept for `$G`, as GRBL keeps them).
 //!
@@ -34,17 +35,49 @@
 //! A G1/G2/G3 before any F word uses the default feed rate (`$203`); only an explicit `F0`
 //! leaves a feed move without a feed rate (error 22).
 //!
+//! # Work coordinates
+//!
+//! As in GRBL, every absolute target — of G0–G3 and of a `$J=` jog — is in work coordinates:
+//! machine position = work position + the active system's offset + the G92 offset (`WCO`, see
+//! [`GcodeState::work_offset_mm`]). G53 takes machine coordinates for one G0/G1 line (or jog);
+//! G91 moves are relative and see no offset. The plotter curve commands draw from the pen and
+//! have no absolute target, so no offset changes them.
+//!
+//! - G54–G59 select the active system (modal group 12; G54 at power-on, after a reset and after
+//!   M2/M30). The selection in a line applies to that line's target.
+//! - `G10 L2 Pn X Y` sets system n's offset to X Y; `G10 L20 Pn X Y` sets it so that the planned
+//!   position has work coordinates X Y under it (a sender's "zero here": `G10 L20 P1 X0 Y0`).
+//!   P0 is the active system, P1–P6 are G54–G59; an axis without a word keeps its offset.
+//!   Errors, GRBL's: no axis word 26, no L or no P 28, a P other than 0 to 6 (or not whole) 29,
+//!   an L other than 2 or 20, or L2 with R, 20.
+//! - `G92 X Y` shifts every system further, so that the planned position has work coordinates
+//!   X Y; G92.1 clears that shift.
+//! - `G28` / `G30` rapid to the position `G28.1` / `G30.1` stored (machine coordinates, the
+//!   planned position when they ran). With axis words they first rapid to the point the words
+//!   give (work coordinates, G90/G91 as set), then only the axes named go on to the stored
+//!   position, as in GRBL; a Z word alone moves nothing. Axis words with G28.1 / G30.1 are an
+//!   ordinary move in the motion mode, after the position is stored.
+//! - G10, G28, G30 and G92 take the line's axis words, so none of them shares a line with a
+//!   motion command or another of them (error 24); under G80 they may have no axis word (31).
+//!
+//! The offsets of G54–G59 and the G28 and G30 positions outlive a soft reset, as GRBL's EEPROM
+//! data does; here they live in RAM, so a power cycle clears them (there is no flash store yet).
+//! A reset clears the G92 offset and selects G54; `$RST=#` (or `$RST=*`) clears them all.
+//!
 //! # `$` commands
 //!
-//! `$` help, `$$` settings, `$N=value` set one, `$G` parser state, `$#` offsets, `$I` build info,
+//! `$` help, `$$` settings, `$N=value` set one, `$G` parser state (with the active G54–G59), `$#`
+//! the coordinate data (GRBL's `[G54:…]` to `[G59:…]`, `[G28:…]`, `[G30:…]`, `[G92:…]`, then
+//! `[TLO:0.000]` and `[PRB:0.000,0.000,0.000:0]`: no tool length, no probe), `$I` build info,
 //! `$X` unlock, `$H` (no homing: error 5), `$RST=$` / `$RST=#` / `$RST=*` restore settings /
-//! clear the G92 offset / both, `$J=` jog (GRBL's rules: only G20/G21, G90/G91, G53, X Y Z, N and
-//! a required F; the line's modes apply to the jog only), `$C` check mode (at rest only, error 8
-//! otherwise: every line is parsed and every drawing built and checked against the travel and
-//! the lattice, from the position the lines before it plan, and nothing moves; `$C` again
-//! leaves it with a soft reset, as GRBL does), `$N` / `$Nn=line` startup blocks (two, run after
-//! every reset; a block is checked when stored and refused, error 3, if it would move, dwell or
-//! stop: no one expects the pen to move at a reset). GRBL's `$SLP` is not supported (error 3).
+//! clear the coordinate data / both, `$J=` jog (GRBL's rules: only G20/G21, G90/G91, G53, X Y
+//! Z, N and a required F; the line's modes apply to the jog only), `$C` check mode (at rest only,
+//! error 8 otherwise: every line is parsed and every drawing built and checked against the
+//! travel and the lattice, from the position the lines before it plan, and nothing moves; `$C`
+//! again leaves it with a soft reset, as GRBL does), `$N` / `$Nn=line` startup blocks (two, run
+//! after every reset; a block is checked when stored and refused, error 3, if it would move,
+//! dwell or stop: no one expects the pen to move at a reset). GRBL's `$SLP` is not supported
+//! (error 3).
 //!
 //! # Plotter curve commands
 //!
@@ -73,13 +106,18 @@
 // Limits are written `!(value <= limit)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod coordinates;
 mod curves;
 mod modal;
 mod motion;
+mod offsets;
 mod system;
 mod words;
 
-pub use modal::{Coolant, Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
+pub use modal::{
+    Coolant, Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units, WORK_SYSTEMS, WorkSystem,
+};
+pub use offsets::{Offsets, StoredPosition};
 
 use super::GrblError;
 use crate::drawing::{self, Request};
@@ -93,11 +131,14 @@ use words::{ProgramStop, compact, parse_block};
 
 /// What one line asks of the machine: an iterator over its [`Command`]s in execution order (a
 /// G4 dwell, then the motion or `$` command, then an M0/M2/M30 stop — GRBL's order). Empty for a
-/// line that only changes modes, or a comment: answer `ok`. It holds at most one large command,
-/// so it costs little more than one [`Command`].
+/// line that only changes modes, or a comment: answer `ok`. It holds at most two large commands
+/// (G28 or G30 through an intermediate point: two moves), so it costs little more than two
+/// [`Command`]s.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Commands {
     dwell_ms: Option<u32>,
+    /// The move to the intermediate point of G28 or G30, before `main`.
+    via: Option<Command>,
     main: Option<Command>,
     stop: Option<ProgramStop>,
 }
@@ -105,7 +146,10 @@ pub struct Commands {
 impl Commands {
     /// Commands still to come.
     pub fn len(&self) -> usize {
-        self.dwell_ms.is_some() as usize + self.main.is_some() as usize + self.stop.is_some() as usize
+        self.dwell_ms.is_some() as usize
+            + self.via.is_some() as usize
+            + self.main.is_some() as usize
+            + self.stop.is_some() as usize
     }
 
     pub fn is_empty(&self) -> bool {
@@ -123,6 +167,9 @@ impl Iterator for Commands {
     fn next(&mut self) -> Option<Command> {
         if let Some(ms) = self.dwell_ms.take() {
             return Some(Command::Dwell { ms });
+        }
+        if let Some(via) = self.via.take() {
+            return Some(via);
         }
         if let Some(main) = self.main.take() {
             return Some(main);
@@ -210,6 +257,7 @@ pub struct GcodeState {
     motion: MotionMode,
     units: Units,
     distance: Distance,
+    work_system: WorkSystem,
     spindle: Spindle,
     coolant: Coolant,
     /// `None` until an F word: the default feed rate applies.
@@ -220,8 +268,9 @@ pub struct GcodeState {
     position_mm: [f32; 2],
     /// The same, rounded to steps: where the last command handed out ends.
     position: Point,
-    /// G92 offset: machine position = work position + offset.
-    offset_mm: [f32; 2],
+    /// G54–G59, G28, G30 and G92: machine position = work position + the active system's
+    /// offset + the G92 offset.
+    offsets: Offsets,
 }
 
 impl Default for GcodeState {
@@ -237,6 +286,7 @@ impl GcodeState {
             motion: MotionMode::Rapid,
             units: Units::Mm,
             distance: Distance::Absolute,
+            work_system: WorkSystem::G54,
             spindle: Spindle::Off,
             coolant: Coolant::Off,
             feed_mm_per_min: None,
@@ -244,13 +294,16 @@ impl GcodeState {
             tool: 0,
             position_mm: [0.0; 2],
             position: Point::ORIGIN,
-            offset_mm: [0.0; 2],
+            offsets: Offsets::new(),
         }
     }
 
-    /// After a soft reset: power-on modes and no G92 offset, at the machine's real `position`.
+    /// After a soft reset: power-on modes (G54 active) and no G92 offset, at the machine's real
+    /// `position`. The offsets of G54–G59 and the G28 and G30 positions stay, as GRBL keeps them
+    /// (in EEPROM there; here in RAM, until power is lost).
     pub fn reset(&mut self, position: Point, settings: &Settings) {
-        *self = GcodeState::new();
+        let offsets = self.offsets.after_reset();
+        *self = GcodeState { offsets, ..GcodeState::new() };
         self.sync_position(position, settings);
     }
 
@@ -266,9 +319,20 @@ impl GcodeState {
         self.position
     }
 
-    /// The G92 work offset (machine = work + offset), for `WCO:` and `$#`.
+    /// The work coordinate offset (machine = work + offset): the active system's offset plus
+    /// the G92 offset, GRBL's `WCO:`.
     pub fn work_offset_mm(&self) -> [f32; 2] {
-        self.offset_mm
+        self.offsets.work_offset_mm(self.work_system)
+    }
+
+    /// G54–G59, G28, G30 and G92, for `$#`.
+    pub fn offsets(&self) -> &Offsets {
+        &self.offsets
+    }
+
+    /// The active work coordinate system (G54–G59).
+    pub fn work_system(&self) -> WorkSystem {
+        self.work_system
     }
 
     /// The feed rate G1/G2/G3 use now: the last F word, or the default feed rate.

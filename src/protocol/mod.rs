@@ -34,24 +34,25 @@
 //! | 14 | `LineLengthExceeded`      | a `$Nn=` startup block longer than [`startup::STARTUP_LINE_MAX_BYTES`] |
 //! | 15 | `TravelExceeded`          | any point of a move or curve outside ±max travel (`$130`, `$131`) |
 //! | 16 | `InvalidJog`              | a `$J=` line with a word or command jogging does not allow |
-//! | 20 | `Unsupported`             | a G/M code or word letter the plotter does not support (G18, G28, M8, ...) |
+//! | 20 | `Unsupported`             | a G/M code or word letter the plotter does not support (G18, G28.2, M8, ...); G10 with an L other than 2 or 20, or L2 with R |
 //! | 21 | `ModalGroupViolation`     | two commands of one modal group in a line (`G0 G1`, `G20 G21`) |
 //! | 22 | `UndefinedFeedRate`       | a feed move or jog with a zero or missing feed rate |
 //! | 23 | `ValueNotInteger`         | `G1.5`, `M3.1` |
-//! | 24 | `AxisCommandConflict`     | G92 and a motion command in one line |
+//! | 24 | `AxisCommandConflict`     | G10, G28, G30 or G92 with a motion command or with another of them in one line |
 //! | 25 | `RepeatedWord`            | a word letter twice in a line (`X1 X2`) |
-//! | 26 | `NoAxisWords`             | G92, an arc or a jog without axis words |
+//! | 26 | `NoAxisWords`             | G10, G92, an arc or a jog without axis words |
 //! | 27 | `InvalidLineNumber`       | N above 9 999 999 |
-//! | 28 | `ValueWordMissing`        | G4 without P; a curve command without a required word |
+//! | 28 | `ValueWordMissing`        | G4 without P; G10 without L or P; a curve command without a required word |
+//! | 29 | `UnsupportedCoordSys`     | G10 with a P other than 0 to 6 (0: the active system, 1–6: G54–G59) |
 //! | 30 | `G53InvalidMotionMode`    | G53 while G2/G3/G80 is the motion mode |
-//! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode |
+//! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode (G10's, G28's, G30's and G92's too) |
 //! | 32 | `NoAxisWordsInPlane`      | G2/G3 with only a Z word |
 //! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, sweep above 360° |
 //! | 33 | `Drawing`                 | the drawing cannot be drawn as asked: finer than the step lattice (an axis under a step, a sine of fewer than 8 steps per wave), a sine steeper than the max function jump (`$204`), a function undefined or jumping part way (an info line says which and where); as `Drawing(Travel)`: error 15 |
 //! | 33 | `FunctionUndefined`       | the `$F` function cannot be evaluated on its range (an info line gives x) |
 //! | 34 | `ArcRadius`               | R arc whose radius is shorter than half the chord |
 //! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |
-//! | 36 | `UnusedWords`             | a word no command in the line uses (`G0 X1 P2`, `I5` without an arc) |
+//! | 36 | `UnusedWords`             | a word no command in the line uses (`G0 X1 P2`, `I5` without an arc, `L2` without G10) |
 //! | 38 | `MaxValueExceeded`        | T above 255, dwell above [`gcode::DWELL_MAX_MS`] |
 //!
 //! GRBL's soft limits raise an alarm; the plotter answers `error:15` instead and moves nothing,
@@ -96,6 +97,7 @@ pub enum GrblError {
     NoAxisWords,
     InvalidLineNumber,
     ValueWordMissing,
+    UnsupportedCoordSys,
     G53InvalidMotionMode,
     AxisWordsExist,
     NoAxisWordsInPlane,
@@ -151,6 +153,7 @@ impl GrblError {
             GrblError::NoAxisWords => 26,
             GrblError::InvalidLineNumber => 27,
             GrblError::ValueWordMissing => 28,
+            GrblError::UnsupportedCoordSys => 29,
             GrblError::G53InvalidMotionMode => 30,
             GrblError::AxisWordsExist => 31,
             GrblError::NoAxisWordsInPlane => 32,

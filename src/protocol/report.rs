@@ -11,7 +11,7 @@
 use core::fmt::{self, Write};
 
 use super::GrblError;
-use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, Units};
+use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, StoredPosition, Units, WorkSystem};
 use crate::drawing::DrawError;
 use crate::geom::Axis;
 use crate::interp::CurveError;
@@ -181,7 +181,8 @@ pub fn setting(out: &mut impl Write, id: u16, settings: &Settings) -> fmt::Resul
     out.write_str("\r\n")
 }
 
-/// `$G`: `[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]`, F the feed rate G1 would use now.
+/// `$G`: `[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F3000 S0]`, F the feed rate G1 would use now,
+/// G54 the active work coordinate system.
 pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Settings) -> fmt::Result {
     let motion = match gcode.motion_mode() {
         MotionMode::Rapid => "G0",
@@ -209,22 +210,34 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
         Coolant::Flood => "M8",
         Coolant::Off => "M9",
     };
-    write!(
-        out,
-        "[GC:{motion} G54 G17 {units} {distance} G94 {spindle} {coolant} T{} F{feed} S{speed}]\r\n",
-        gcode.tool()
-    )
+    let system = gcode.work_system().gcode();
+    let tool = gcode.tool();
+    write!(out, "[GC:{motion} G{system} G17 {units} {distance} G94 {spindle} {coolant} T{tool} F{feed} S{speed}]\r\n")
 }
 
-/// `$#`: GRBL's coordinate offsets. Only G92 can be set; the others are always zero.
+/// `$#`: GRBL's coordinate data, in GRBL's order and format, millimetres: the offsets of G54 to
+/// G59, the G28 and G30 positions (machine coordinates), the G92 offset, then the tool length
+/// offset and the last probe, always zero on the plotter (no tool, no probe). G54–G59, G28 and
+/// G30 are kept in RAM, not in flash: they outlive a soft reset but not a power cycle.
 pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
-    for name in ["G54", "G55", "G56", "G57", "G58", "G59", "G28", "G30"] {
-        write!(out, "[{name}:0.000,0.000,0.000]\r\n")?;
+    let offsets = gcode.offsets();
+    for system in WorkSystem::all() {
+        write!(out, "[G{}:", system.gcode())?;
+        xyz_line_end(out, offsets.system_mm(system))?;
     }
-    let [x, y] = gcode.work_offset_mm();
+    for (name, which) in [("G28", StoredPosition::G28), ("G30", StoredPosition::G30)] {
+        write!(out, "[{name}:")?;
+        xyz_line_end(out, offsets.stored_mm(which))?;
+    }
     out.write_str("[G92:")?;
+    xyz_line_end(out, offsets.g92_mm())?;
+    out.write_str("[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
+}
+
+/// `x,y,0.000]` and the line end.
+fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
     xyz(out, x, y)?;
-    out.write_str("]\r\n[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
+    out.write_str("]\r\n")
 }
 
 /// `$I`: version and GRBL's `[OPT:codes,blocks,rx]` line. Senders size their character-counting

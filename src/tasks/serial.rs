@@ -7,6 +7,10 @@
 //! `error:N` once their jobs are queued (back-pressure paces a streaming sender). A third loop
 //! reports curves that stopped early. Answers are whole lines, never interleaved.
 //!
+//! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
+//! the parser has it after its last line) and the overrides (`|Ov:`) when
+//! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions.
+//!
 //! Every line gets exactly one answer, in order, whatever the sender does. A sender that
 //! ignores GRBL's flow control and sends more than the pipe holds while the machine is busy
 //! loses whole lines, never parts of them: from the byte that found no room up to the end of a
@@ -325,6 +329,8 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                     }
                     match gcode.execute(line, &settings, state) {
                         Ok(commands) => {
+                            // A refused line changed no offset.
+                            machine.set_work_offset_mm(gcode.work_offset_mm());
                             let mut r = Ok(());
                             for command in commands {
                                 r = carry_out(link, &gcode, &settings, command, epoch).await;
@@ -336,7 +342,6 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
                         }
                         Err(e) => Err(Unfinished::Error(e)),
                     }
-                    .inspect(|()| machine.set_work_offset_mm(gcode.work_offset_mm()))
                 }
                 Some(other) => Err(Unfinished::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
             };
@@ -358,6 +363,8 @@ async fn lines<W: Write>(link: &Link<'_, W>) -> ! {
 async fn restart<W: Write>(link: &Link<'_, W>, gcode: &mut GcodeState, epoch: &mut PlanEpoch) {
     let machine = link.machine;
     machine.set_check_mode(false);
+    // As after power-on, the next reports carry `WCO:` and `Ov:`.
+    link.refresh.set(Refresh::new());
     let settings = machine.settings();
     gcode.reset(machine.position(), &settings);
     *epoch = machine.plan_epoch();

@@ -1,12 +1,13 @@
-//! G-code blocks carried out on the parser state: modal groups, G92 offsets, and the straight
-//! moves and G2/G3 arcs a block hands out, each checked against the travel and its interpolator.
+//! G-code blocks carried out on the parser state: modal groups, non-modal commands (those on
+//! the coordinate data through [`super::coordinates`]), and the straight moves and G2/G3 arcs a
+//! block hands out, each checked against the travel and its interpolator.
 
 use core::f32::consts::TAU;
 
 use super::words::{Block, NonModal, ProgramStop};
 use super::{
     ARC_ANGLE_EPSILON_RAD, ARC_RADIUS_ERROR_MAX_MM, ARC_RADIUS_ERROR_MAX_RATIO, ARC_RADIUS_SLACK_MM, Command, Commands,
-    Coolant, DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle,
+    Coolant, DWELL_MAX_MS, Distance, GcodeState, LINE_NUMBER_MAX, MotionMode, Spindle, WorkSystem,
 };
 use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
@@ -17,7 +18,6 @@ use crate::settings::Settings;
 impl GcodeState {
     /// Executes a parsed block on `self` (a copy the caller keeps only on success).
     pub(super) fn run_block(&mut self, block: Block, settings: &Settings) -> Result<Commands, GrblError> {
-        let start_mm = self.position_mm;
         let mut words = block.words;
         if let Some(n) = words.take(b'N')
             && n > LINE_NUMBER_MAX
@@ -29,6 +29,9 @@ impl GcodeState {
         }
         if let Some(d) = block.distance {
             self.distance = d;
+        }
+        if let Some(w) = block.work_system {
+            self.work_system = w;
         }
         if let Some(s) = block.spindle {
             self.spindle = s;
@@ -64,7 +67,7 @@ impl GcodeState {
         let has_z = words.get(b'Z').is_some();
         let has_xy = axis[0].is_some() || axis[1].is_some();
         let has_axis = has_xy || has_z;
-        let axis_command = if block.non_modal == Some(NonModal::SetOffset) {
+        let axis_command = if block.non_modal.is_some_and(NonModal::uses_axis_words) {
             AxisCommand::NonModal
         } else if block.motion_word || has_axis {
             AxisCommand::Motion
@@ -73,42 +76,21 @@ impl GcodeState {
         };
 
         match block.non_modal {
-            Some(NonModal::SetOffset) => {
-                if !has_axis {
-                    return Err(GrblError::NoAxisWords);
-                }
-                for (i, v) in axis.iter().enumerate() {
-                    if let Some(v) = v {
-                        self.offset_mm[i] = start_mm[i] - v;
-                    }
-                }
-            }
-            Some(NonModal::ClearOffset) => self.offset_mm = [0.0; 2],
             Some(NonModal::MachineCoords) if !matches!(self.motion, MotionMode::Rapid | MotionMode::Linear) => {
                 return Err(GrblError::G53InvalidMotionMode);
             }
-            _ => {}
+            Some(command) => self.set_coordinates(command, &mut words, axis, has_axis)?,
+            None => {}
         }
 
         if self.motion == MotionMode::Off {
+            // Even G10, G28, G30 and G92 may not have axis words then (GRBL's rule).
             if has_axis {
                 return Err(GrblError::AxisWordsExist);
             }
         } else if axis_command == AxisCommand::Motion {
             let machine = block.non_modal == Some(NonModal::MachineCoords);
-            let mut target = start_mm;
-            for (i, v) in axis.iter().enumerate() {
-                if let Some(v) = *v {
-                    target[i] = if machine {
-                        v
-                    } else {
-                        match self.distance {
-                            Distance::Absolute => v + self.offset_mm[i],
-                            Distance::Incremental => start_mm[i] + v,
-                        }
-                    };
-                }
-            }
+            let target = self.target_mm(axis, self.distance, machine);
             let motion = match self.motion {
                 MotionMode::Rapid if has_xy => self.line(target, Feed::Rapid, settings)?,
                 MotionMode::Linear => {
@@ -142,6 +124,9 @@ impl GcodeState {
             };
             out.main = motion;
         }
+        if let Some(NonModal::GoToStored(which)) = block.non_modal {
+            (out.via, out.main) = self.go_to_stored(which, axis, has_axis, settings)?;
+        }
 
         if axis_command != AxisCommand::None {
             words.take(b'X');
@@ -154,9 +139,10 @@ impl GcodeState {
 
         if block.stop == Some(ProgramStop::End) {
             // GRBL (after LinuxCNC) resets these groups at program end; units, F, S, T and the
-            // G92 offset stay.
+            // offsets stay.
             self.motion = MotionMode::Linear;
             self.distance = Distance::Absolute;
+            self.work_system = WorkSystem::G54;
             self.spindle = Spindle::Off;
             self.coolant = Coolant::Off;
         }
@@ -171,7 +157,12 @@ impl GcodeState {
     }
 
     /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
-    fn line(&mut self, target_mm: [f32; 2], feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
+    pub(super) fn line(
+        &mut self,
+        target_mm: [f32; 2],
+        feed: Feed,
+        settings: &Settings,
+    ) -> Result<Option<Command>, GrblError> {
         let to = drawing::line_target(target_mm, settings).ok_or(GrblError::TravelExceeded)?;
         self.draw(Request::Straight { to }, feed, JobKind::Draw, Some(target_mm), settings)
     }

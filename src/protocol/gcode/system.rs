@@ -1,8 +1,9 @@
 //! The `$` commands: reports, settings, restores, unlock and `$J=` jogs; the plotter curve
 //! commands are handed on to [`super::curves`].
 
+use super::offsets::Offsets;
 use super::words::{Group, NonModal, compact, parse_block, parse_number};
-use super::{Command, Commands, Distance, GcodeState, Report};
+use super::{Command, Commands, GcodeState, Report};
 use crate::drawing::{self, Request};
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
@@ -125,7 +126,8 @@ impl GcodeState {
             return Err(GrblError::NotIdle);
         }
         if what != b'$' {
-            self.offset_mm = [0.0; 2];
+            // G54–G59, G28, G30 and G92; the active system stays selected.
+            self.offsets = Offsets::new();
         }
         if what == b'#' {
             return Ok(Commands::default());
@@ -172,20 +174,7 @@ impl GcodeState {
             return if has_z { Ok(Commands::default()) } else { Err(GrblError::NoAxisWords) };
         }
         let machine = block.non_modal == Some(NonModal::MachineCoords);
-        let mut target = self.position_mm;
-        for (i, v) in axis.iter().enumerate() {
-            if let Some(v) = *v {
-                let v = v * units.mm_per_unit();
-                target[i] = if machine {
-                    v
-                } else {
-                    match distance {
-                        Distance::Absolute => v + self.offset_mm[i],
-                        Distance::Incremental => self.position_mm[i] + v,
-                    }
-                };
-            }
-        }
+        let target = self.target_mm(axis.map(|v| v.map(|v| v * units.mm_per_unit())), distance, machine);
         let to = drawing::line_target(target, settings).ok_or(GrblError::TravelExceeded)?;
         let jog = self.draw(Request::Straight { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
         Ok(jog.map(Commands::one).unwrap_or_default())

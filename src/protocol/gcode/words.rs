@@ -1,7 +1,8 @@
 //! The words of a line and the block they make: compaction, G-code numbers, the letter values,
 //! and the G and M commands sorted into GRBL's modal groups, before any check against the state.
 
-use super::modal::{Coolant, Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units};
+use super::modal::{Coolant, Distance, MotionMode, Spindle, TOOL_NUMBER_MAX, Units, WorkSystem};
+use super::offsets::StoredPosition;
 use crate::protocol::GrblError;
 use crate::protocol::framing::LINE_MAX_BYTES;
 
@@ -143,10 +144,28 @@ impl Group {
 
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) enum NonModal {
+    /// G4.
     Dwell,
+    /// G53.
     MachineCoords,
+    /// G10 (L2 or L20): set a work coordinate system's offset.
+    SetSystem,
+    /// G28, G30: go to the stored position.
+    GoToStored(StoredPosition),
+    /// G28.1, G30.1: store the planned position.
+    Store(StoredPosition),
+    /// G92.
     SetOffset,
+    /// G92.1.
     ClearOffset,
+}
+
+impl NonModal {
+    /// G10, G28, G30 and G92 take the line's axis words for themselves, so no motion command
+    /// may share their line (GRBL's axis command conflict).
+    pub(super) const fn uses_axis_words(self) -> bool {
+        matches!(self, NonModal::SetSystem | NonModal::GoToStored(_) | NonModal::SetOffset)
+    }
 }
 
 /// A program stop: M0 pauses, M2/M30 end the program (M1, an optional stop without a switch,
@@ -167,6 +186,7 @@ pub(super) struct Block {
     pub(super) motion_word: bool,
     pub(super) units: Option<Units>,
     pub(super) distance: Option<Distance>,
+    pub(super) work_system: Option<WorkSystem>,
     pub(super) spindle: Option<Spindle>,
     pub(super) coolant: Option<Coolant>,
     pub(super) stop: Option<ProgramStop>,
@@ -184,7 +204,7 @@ impl Block {
 
     fn g(&mut self, value: f32) -> Result<(), GrblError> {
         let (int, tenths) = command_number(value)?;
-        if tenths != 0 && !matches!((int, tenths), (91, 1) | (92, 1)) {
+        if tenths != 0 && !matches!((int, tenths), (28, 1) | (30, 1) | (91, 1) | (92, 1)) {
             // GRBL's other Gxx.x commands are unsupported here; anything else is no command.
             return Err(if matches!(int, 28 | 30 | 38 | 43 | 59 | 61 | 90 | 92) {
                 GrblError::Unsupported
@@ -194,7 +214,7 @@ impl Block {
         }
         let group = match (int, tenths) {
             (0..=3, 0) => {
-                if self.non_modal == Some(NonModal::SetOffset) {
+                if self.non_modal.is_some_and(NonModal::uses_axis_words) {
                     return Err(GrblError::AxisCommandConflict);
                 }
                 self.motion =
@@ -208,12 +228,12 @@ impl Block {
             }
             (4, 0) => self.non_modal(NonModal::Dwell),
             (53, 0) => self.non_modal(NonModal::MachineCoords),
-            (92, 0) => {
-                if self.motion_word {
-                    return Err(GrblError::AxisCommandConflict);
-                }
-                self.non_modal(NonModal::SetOffset)
-            }
+            (10, 0) => self.axis_non_modal(NonModal::SetSystem)?,
+            (28, 0) => self.axis_non_modal(NonModal::GoToStored(StoredPosition::G28))?,
+            (30, 0) => self.axis_non_modal(NonModal::GoToStored(StoredPosition::G30))?,
+            (28, 1) => self.non_modal(NonModal::Store(StoredPosition::G28)),
+            (30, 1) => self.non_modal(NonModal::Store(StoredPosition::G30)),
+            (92, 0) => self.axis_non_modal(NonModal::SetOffset)?,
             (92, 1) => self.non_modal(NonModal::ClearOffset),
             (17, 0) => Group::Plane,
             (20, 0) | (21, 0) => {
@@ -228,11 +248,23 @@ impl Block {
             (94, 0) => Group::FeedMode,
             (40, 0) => Group::CutterComp,
             (49, 0) => Group::ToolLength,
-            (54, 0) => Group::CoordSystem,
+            (54..=59, 0) => {
+                self.work_system = WorkSystem::from_gcode(int);
+                Group::CoordSystem
+            }
             (61, 0) => Group::Control,
             _ => return Err(GrblError::Unsupported),
         };
         self.enter(group)
+    }
+
+    /// G10, G28, G30, G92: a non-modal command using axis words, which no motion command and no
+    /// other such command may share a line with (checked before the modal group, as GRBL does).
+    fn axis_non_modal(&mut self, command: NonModal) -> Result<Group, GrblError> {
+        if self.motion_word || self.non_modal.is_some_and(NonModal::uses_axis_words) {
+            return Err(GrblError::AxisCommandConflict);
+        }
+        Ok(self.non_modal(command))
     }
 
     fn non_modal(&mut self, command: NonModal) -> Group {
@@ -300,7 +332,7 @@ pub(super) fn parse_block(bytes: &[u8]) -> Result<Block, GrblError> {
                     return Err(GrblError::MaxValueExceeded);
                 }
             }
-            b'I' | b'J' | b'K' | b'R' | b'X' | b'Y' | b'Z' => block.words.insert(letter, value)?,
+            b'I' | b'J' | b'K' | b'L' | b'R' | b'X' | b'Y' | b'Z' => block.words.insert(letter, value)?,
             _ => return Err(GrblError::Unsupported),
         }
     }
