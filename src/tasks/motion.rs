@@ -109,8 +109,9 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             machine.set_fault(Some(MotionFault::Curve(e)));
             abort(machine, &mut planner);
         }
-        if !matches!(filled, FillEnd::QueueFull) && planner.is_idle() && !queued.resting {
-            // The motion comes to rest after the steps queued.
+        let stands = matches!(planner.state(), PlannerState::Idle | PlannerState::Held);
+        if !matches!(filled, FillEnd::QueueFull) && stands && !queued.resting {
+            // The motion comes to rest after the steps queued: at its end, or held.
             steps.rest();
             queued.resting = true;
         }
