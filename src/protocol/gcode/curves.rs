@@ -93,8 +93,10 @@ impl GcodeState {
     pub(super) fn function(&mut self, line: &str, rest: &str, settings: &Settings) -> Result<Commands, GrblError> {
         // The expression starts after the first `Y=` (spaces allowed around the `=`); a `Y` with
         // no `=` after it is a malformed value.
+        // Indices below fall on ASCII bytes, so on char boundaries; `get` says so without a
+        // panic path (and the string formatting a panic message would link).
         let equals_after = |at: usize| {
-            let after = &rest[at + 1..];
+            let after = rest.get(at + 1..).unwrap_or("");
             let spaces = after.len() - after.trim_start().len();
             (after.as_bytes().get(spaces) == Some(&b'=')).then_some(at + 1 + spaces + 1)
         };
@@ -105,8 +107,8 @@ impl GcodeState {
         });
         let (y_at, expr_at) =
             found.ok_or(if seen_y { GrblError::BadNumberFormat } else { GrblError::ValueWordMissing })?;
-        let expr_text = rest[expr_at..].split(';').next().unwrap_or("");
-        let head = compact(&rest[..y_at], true)?;
+        let expr_text = rest.get(expr_at..).unwrap_or("").split(';').next().unwrap_or("");
+        let head = compact(rest.get(..y_at).unwrap_or(""), true)?;
         let mut words = Words::default();
         // `head` starts with the command letter F.
         for word in WordIter::new(head.get(1..).unwrap_or(&[])) {
