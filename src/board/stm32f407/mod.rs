@@ -94,8 +94,8 @@ async fn keypad(machine: &'static Machine, columns: [Output<'static>; 4], rows: 
 }
 
 #[embassy_executor::task]
-async fn serial(machine: &'static Machine, rx: BufferedUartRx<'static>, tx: BufferedUartTx<'static>) -> ! {
-    tasks::serial::run(machine, rx, tx).await
+async fn serial(machine: &'static Machine, uart: (BufferedUartRx<'static>, BufferedUartTx<'static>)) -> ! {
+    tasks::serial::run(machine, uart, (NoPort, NoPort)).await
 }
 
 #[embassy_executor::task]
@@ -115,6 +115,29 @@ impl embedded_hal::digital::OutputPin for NoCs {
         Ok(())
     }
     fn set_high(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// The second host link's place while the board has none: nothing arrives, answers go nowhere.
+struct NoPort;
+
+impl embedded_io_async::ErrorType for NoPort {
+    type Error = Infallible;
+}
+
+impl embedded_io_async::Read for NoPort {
+    async fn read(&mut self, _: &mut [u8]) -> Result<usize, Infallible> {
+        core::future::pending().await
+    }
+}
+
+impl embedded_io_async::Write for NoPort {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        Ok(buf.len())
+    }
+
+    async fn flush(&mut self) -> Result<(), Infallible> {
         Ok(())
     }
 }
@@ -194,7 +217,7 @@ async fn main(spawner: Spawner) {
     // Below the pulse and motion executors: a burst of received bytes never delays a pulse.
     interrupt::USART2.set_priority(HOST_UART_PRIORITY);
     let (tx, rx) = uart.split();
-    spawner.spawn(unwrap!(serial(machine, rx, tx)));
+    spawner.spawn(unwrap!(serial(machine, (rx, tx))));
 
     let mut spi_config = spi::Config::default();
     spi_config.frequency = Hertz(LCD_SPI_HZ);
