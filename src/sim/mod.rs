@@ -2,8 +2,8 @@
 //!
 //! The pulse, motion, keypad, serial and LCD loops are the same code as on target; only their
 //! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
-//! pressed by a script, the serial link reads a transcript or standard input, and the LCD is a
-//! model of the ST7920 fed by the real driver. A run ends when every input is used up and the
+//! pressed by a script, the two host links (the board's UART and USB port) read transcripts or
+//! standard input, and the LCD is a model of the ST7920 fed by the real driver. A run ends when every input is used up and the
 //! machine has come to rest. [`cli`] is the simulator's command line: what the firmware binary
 //! runs when built for the host.
 
@@ -66,7 +66,10 @@ pub enum KeysStart {
 #[derive(Default)]
 pub struct SimConfig {
     pub settings: Settings,
+    /// The host link on the board's UART.
     pub serial: SimSerial,
+    /// The host link on the board's USB port; sends nothing unless given input.
+    pub usb: SimSerial,
     pub keys: KeyScript,
     pub keys_start: KeysStart,
     /// The board's processor: its work takes time, and the pulses may have to wait for it.
@@ -79,8 +82,10 @@ pub struct SimReport {
     pub trace: PulseTrace,
     /// Every frame sent to the LCD, with the virtual time it was sent.
     pub frames: Vec<(u64, Frame)>,
-    /// Everything the firmware answered on the serial link.
+    /// Everything the firmware answered on the UART link.
     pub serial_out: Vec<u8>,
+    /// Everything the firmware answered on the USB link.
+    pub usb_out: Vec<u8>,
     /// Position counted by the pulse task.
     pub position: Point,
     /// Settings at the end (the host may have changed them).
@@ -94,9 +99,14 @@ pub struct SimReport {
 }
 
 impl SimReport {
-    /// The serial answers as text.
+    /// The UART link's answers as text.
     pub fn answers(&self) -> std::string::String {
         std::string::String::from_utf8_lossy(&self.serial_out).into_owned()
+    }
+
+    /// The USB link's answers as text.
+    pub fn usb_answers(&self) -> std::string::String {
+        std::string::String::from_utf8_lossy(&self.usb_out).into_owned()
     }
 
     /// The pen path rebuilt from the pulses.
@@ -135,6 +145,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let columns = [0, 1, 2, 3].map(|c| matrix.column(c));
     let rows = [0, 1, 2, 3].map(|r| matrix.row(r));
     let serial = config.serial;
+    let usb = config.usb;
+    let links = [&serial, &usb];
     let cpu = config.cpu;
     let spi = SimSpi::default();
     let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
@@ -143,7 +155,7 @@ pub fn run(config: SimConfig) -> SimReport {
         step_timer::run(&machine, &mut engine, &kicks),
         tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
         tasks::keypad::run(&machine, columns, rows),
-        tasks::serial::run(&machine, serial.clone(), serial.clone()),
+        tasks::serial::run(&machine, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
         tasks::lcd::run(&machine, lcd),
     );
     let mut firmware = pin!(firmware);
@@ -165,10 +177,11 @@ pub fn run(config: SimConfig) -> SimReport {
             continue;
         }
         let now = clock::now_ticks();
-        if !matrix.started() && serial.input_done() && machine.at_rest() {
+        let input_done = links.iter().all(|l| l.input_done());
+        if !matrix.started() && input_done && machine.at_rest() {
             matrix.start();
         }
-        let at_rest = serial.input_done() && matrix.script_done() && machine.at_rest();
+        let at_rest = input_done && matrix.script_done() && machine.at_rest();
         if at_rest {
             let since = *rest_since.get_or_insert(now);
             if now >= since + SIM_SETTLE_US {
@@ -190,10 +203,11 @@ pub fn run(config: SimConfig) -> SimReport {
             break;
         }
         // A timed input byte due before the next timer deadline comes first.
-        match (serial.next_timed_us(), clock::next_deadline()) {
+        let next_timed = links.iter().filter_map(|l| l.next_timed_us()).min();
+        match (next_timed, clock::next_deadline()) {
             (Some(t), deadline) if deadline.is_none_or(|d| t < d) => {
                 clock::jump_to(t);
-                serial.deliver_due();
+                links.iter().for_each(|l| l.deliver_due());
             }
             _ => {
                 if !clock::jump_to_next_deadline() {
@@ -209,7 +223,17 @@ pub fn run(config: SimConfig) -> SimReport {
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
-    SimReport { trace, frames, serial_out: serial.output(), position, settings, end_us, timed_out, underruns }
+    SimReport {
+        trace,
+        frames,
+        serial_out: serial.output(),
+        usb_out: usb.output(),
+        position,
+        settings,
+        end_us,
+        timed_out,
+        underruns,
+    }
 }
 
 /// Runs a serial transcript (and nothing on the keypad) with default settings.

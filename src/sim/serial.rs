@@ -3,7 +3,9 @@
 //!
 //! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next
 //! line goes out once the firmware has answered the previous one with `ok` or `error:N`. Live
-//! standard input is passed on as typed.
+//! standard input is passed on as typed. A link can also be closed by its host at a given time,
+//! as a USB serial port is when the sender closes it: the read after the bytes sent before then
+//! reports the closing.
 
 use core::future::poll_fn;
 use core::task::{Poll, Waker};
@@ -21,6 +23,10 @@ struct Link {
     unsent: VecDeque<Vec<u8>>,
     /// Bytes sent at given virtual times, in order (a person pressing `!` mid-drawing).
     timed: VecDeque<(u64, u8)>,
+    /// Virtual times the host closes the port, in order.
+    closings: VecDeque<u64>,
+    /// The host closed the port after this many of the input bytes; not reported yet.
+    closed_after: Option<usize>,
     /// A reset (0x18) went out and its banner has not come back yet.
     reset_sent: bool,
     /// Answers (`ok` / `error:`) still owed for lines sent.
@@ -82,23 +88,46 @@ impl SimSerial {
         self
     }
 
-    /// When the next timed byte is due.
-    pub fn next_timed_us(&self) -> Option<u64> {
-        self.link.borrow().timed.front().map(|(t, _)| *t)
+    /// Also closes the port at virtual time `t_us`, after the bytes sent before then.
+    pub fn with_closing_at(self, t_us: u64) -> Self {
+        {
+            let mut l = self.link.borrow_mut();
+            let i = l.closings.partition_point(|t| *t <= t_us);
+            l.closings.insert(i, t_us);
+        }
+        self
     }
 
-    /// Sends the timed bytes due by now.
+    /// When the next timed byte or closing is due.
+    pub fn next_timed_us(&self) -> Option<u64> {
+        let l = self.link.borrow();
+        let byte = l.timed.front().map(|(t, _)| *t);
+        let closing = l.closings.front().copied();
+        byte.into_iter().chain(closing).min()
+    }
+
+    /// Sends the timed bytes due by now, and closes the port if that is due; in time order.
     pub fn deliver_due(&self) {
         let now = crate::sim::clock::now_ticks();
         let mut l = self.link.borrow_mut();
         let mut sent = false;
-        while let Some(&(t, b)) = l.timed.front() {
-            if t > now {
-                break;
+        loop {
+            let byte_at = l.timed.front().map(|(t, _)| *t).filter(|t| *t <= now);
+            let closing_at = l.closings.front().copied().filter(|t| *t <= now);
+            let closing_first = match (byte_at, closing_at) {
+                (None, None) => break,
+                // Bytes sent at the time of a closing go before it.
+                (Some(tb), Some(tc)) => tc < tb,
+                (Some(_), None) => false,
+                (None, Some(_)) => true,
+            };
+            if closing_first {
+                l.closings.pop_front();
+                l.closed_after = Some(l.input.len());
+            } else if let Some((_, b)) = l.timed.pop_front() {
+                l.input.push_back(b);
+                l.reset_sent |= b == 0x18;
             }
-            l.timed.pop_front();
-            l.input.push_back(b);
-            l.reset_sent |= b == 0x18;
             sent = true;
         }
         if sent && let Some(w) = l.reader.take() {
@@ -120,7 +149,12 @@ impl SimSerial {
     /// True when no input is waiting and none can come any more.
     pub fn input_done(&self) -> bool {
         let l = self.link.borrow();
-        l.input.is_empty() && l.unsent.is_empty() && l.timed.is_empty() && (l.live.is_none() || l.live_ended)
+        l.input.is_empty()
+            && l.unsent.is_empty()
+            && l.timed.is_empty()
+            && l.closings.is_empty()
+            && l.closed_after.is_none()
+            && (l.live.is_none() || l.live_ended)
     }
 
     /// Takes what standard input has sent, waiting for it up to `wait` of real time.
@@ -197,20 +231,45 @@ impl Link {
     }
 }
 
+/// The host closed the port: the one way a read of the simulated link ends without bytes.
+#[derive(Debug)]
+pub struct PortClosed;
+
+impl core::fmt::Display for PortClosed {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("port closed")
+    }
+}
+
+impl core::error::Error for PortClosed {}
+
+impl embedded_io_async::Error for PortClosed {
+    fn kind(&self) -> embedded_io_async::ErrorKind {
+        embedded_io_async::ErrorKind::NotConnected
+    }
+}
+
 impl embedded_io_async::ErrorType for SimSerial {
-    type Error = core::convert::Infallible;
+    type Error = PortClosed;
 }
 
 impl embedded_io_async::Read for SimSerial {
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
         poll_fn(|cx| {
             let mut l = self.link.borrow_mut();
+            if l.closed_after == Some(0) {
+                l.closed_after = None;
+                return Poll::Ready(Err(PortClosed));
+            }
             if l.input.is_empty() {
                 // A UART with nothing received simply waits; it never reports an end.
                 l.reader = Some(cx.waker().clone());
                 return Poll::Pending;
             }
-            let n = buf.len().min(l.input.len());
+            let n = buf.len().min(l.input.len()).min(l.closed_after.unwrap_or(usize::MAX));
+            if let Some(before) = l.closed_after.as_mut() {
+                *before -= n;
+            }
             for (dst, src) in buf.iter_mut().zip(l.input.drain(..n)) {
                 *dst = src;
             }

@@ -4,7 +4,8 @@
 //! first: the pulse engine runs in the step timer's update interrupt (TIM1, see `step_timer`);
 //! then embassy-time's timer (TIM2); the motion task on an interrupt executor (UART5's vector,
 //! unused as a UART), so the step queue stays full while a blocking LCD flush (~20 ms) runs;
-//! then the host link's UART; keypad, serial and LCD share the thread-mode executor.
+//! then the host links' UART and USB port; keypad, serial, the USB device and LCD share the
+//! thread-mode executor.
 //!
 //! | signal              | pin  | notes                                              |
 //! |---------------------|------|----------------------------------------------------|
@@ -18,8 +19,13 @@
 //! | LCD CS (RS)         | PB12 | active high, driven by the st7920 driver           |
 //! | LCD RST             | PB11 | PSB tied to GND selects serial mode                |
 //! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
+//! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port (with |
+//! |                     |      | the `usb` feature: it does not fit the flash budget yet)   |
+//! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
 
 mod step_timer;
+#[cfg(feature = "usb")]
+mod usb;
 
 use core::convert::Infallible;
 
@@ -50,13 +56,14 @@ const HSE_HZ: u32 = 8_000_000;
 const SYSCLK_HZ: u32 = 168_000_000;
 
 /// Interrupt priorities, most urgent first: the step timer (the pulse engine), embassy-time's
-/// timer, motion, then the host link's UART; keypad, LCD and serial protocol run in thread mode
-/// below them all. The step timer's hardware places every pulse edge; its interrupt only has
-/// to preload the next period before the current one ends.
+/// timer, motion, then the host links' UART and USB port; keypad, LCD, the serial protocol and
+/// the USB device's control requests run in thread mode below them all. The step timer's
+/// hardware places every pulse edge; its interrupt only has to preload the next period before
+/// the current one ends.
 const PULSE_PRIORITY: Priority = Priority::P0;
 const TIME_DRIVER_PRIORITY: Priority = Priority::P1;
 const MOTION_PRIORITY: Priority = Priority::P2;
-const HOST_UART_PRIORITY: Priority = Priority::P3;
+const HOST_LINK_PRIORITY: Priority = Priority::P3;
 
 /// Serial host link speed.
 const HOST_BAUD: u32 = 115_200;
@@ -94,8 +101,12 @@ async fn keypad(machine: &'static Machine, columns: [Output<'static>; 4], rows: 
 }
 
 #[embassy_executor::task]
-async fn serial(machine: &'static Machine, rx: BufferedUartRx<'static>, tx: BufferedUartTx<'static>) -> ! {
-    tasks::serial::run(machine, rx, tx).await
+async fn serial(
+    machine: &'static Machine,
+    uart: (BufferedUartRx<'static>, BufferedUartTx<'static>),
+    usb: UsbLink,
+) -> ! {
+    tasks::serial::run(machine, uart, usb).await
 }
 
 #[embassy_executor::task]
@@ -115,6 +126,40 @@ impl embedded_hal::digital::OutputPin for NoCs {
         Ok(())
     }
     fn set_high(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// The host link on the USB port: its receiving and sending ends.
+#[cfg(feature = "usb")]
+type UsbLink = (usb::UsbRx, usb::UsbTx);
+#[cfg(not(feature = "usb"))]
+type UsbLink = (NoPort, NoPort);
+
+/// The USB port's place as a host link in an image without it: nothing arrives, answers go
+/// nowhere.
+#[cfg(not(feature = "usb"))]
+struct NoPort;
+
+#[cfg(not(feature = "usb"))]
+impl embedded_io_async::ErrorType for NoPort {
+    type Error = Infallible;
+}
+
+#[cfg(not(feature = "usb"))]
+impl embedded_io_async::Read for NoPort {
+    async fn read(&mut self, _: &mut [u8]) -> Result<usize, Infallible> {
+        core::future::pending().await
+    }
+}
+
+#[cfg(not(feature = "usb"))]
+impl embedded_io_async::Write for NoPort {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        Ok(buf.len())
+    }
+
+    async fn flush(&mut self) -> Result<(), Infallible> {
         Ok(())
     }
 }
@@ -192,9 +237,13 @@ async fn main(spawner: Spawner) {
         uart_config,
     ));
     // Below the pulse and motion executors: a burst of received bytes never delays a pulse.
-    interrupt::USART2.set_priority(HOST_UART_PRIORITY);
+    interrupt::USART2.set_priority(HOST_LINK_PRIORITY);
     let (tx, rx) = uart.split();
-    spawner.spawn(unwrap!(serial(machine, rx, tx)));
+    #[cfg(feature = "usb")]
+    let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, HOST_LINK_PRIORITY);
+    #[cfg(not(feature = "usb"))]
+    let usb = (NoPort, NoPort);
+    spawner.spawn(unwrap!(serial(machine, (rx, tx), usb)));
 
     let mut spi_config = spi::Config::default();
     spi_config.frequency = Hertz(LCD_SPI_HZ);
