@@ -242,6 +242,8 @@ pub enum Command {
     RestoreSettings { startup_lines: bool },
     /// `$Nn=line`: store startup block `index` (checked: it parses and moves nothing).
     StoreStartupLine { index: u8, line: StartupLine },
+    /// `$I=line`: store the build info line `$I` shows.
+    StoreBuildInfo(StartupLine),
     /// Answer with a report (before the `ok`).
     Report(Report),
     /// `$X`: leave the alarm state (GRBL answers `[MSG:Caution: Unlocked]`).

@@ -242,8 +242,8 @@ fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
 
 /// `$I`: version and GRBL's `[OPT:codes,blocks,rx]` line. Senders size their character-counting
 /// window from `rx_buffer_bytes`, so it must be the serial task's real receive buffer.
-pub fn build_info(out: &mut impl Write, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
-    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:]\r\n[OPT:,{planner_blocks},{rx_buffer_bytes}]\r\n")
+pub fn build_info(out: &mut impl Write, info: &str, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
+    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:{info}]\r\n[OPT:,{planner_blocks},{rx_buffer_bytes}]\r\n")
 }
 
 /// `$`: the commands the plotter understands.
@@ -390,7 +390,7 @@ mod tests {
         assert_eq!(text(|o| error(o, GrblError::ModalGroupViolation)), "error:21\r\n");
         assert_eq!(text(welcome), "\r\nGrbl 1.1h ['$' for help]\r\n");
         assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
-        assert_eq!(text(|o| build_info(o, 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
+        assert_eq!(text(|o| build_info(o, "", 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
         assert!(text(help).starts_with("[HLP:$$ $# $G $I"));
     }
 

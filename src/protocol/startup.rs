@@ -1,6 +1,7 @@
-//! GRBL's startup blocks (`$N0=`, `$N1=`): G-code lines the host link runs after every reset,
-//! to set the modes a user wants by default (`G20 G54`, ...). Owns the stored lines; the G-code
-//! parser checks a line before it is stored, and the serial task runs them.
+//! The lines a user stores on the plotter: GRBL's startup blocks (`$N0=`, `$N1=`), G-code lines
+//! the host link runs after every reset to set the modes a user wants by default (`G20 G54`,
+//! ...), and the build info line (`$I=`) that `$I` shows. Owns the stored lines; the G-code parser
+//! checks a startup block before it is stored, and the serial task runs them.
 //!
 //! They are kept in RAM for now, so they last until power-off; a flash store will keep them
 //! across power cycles.
@@ -12,18 +13,20 @@ pub const STARTUP_LINES: usize = 2;
 /// Longest startup block, in bytes, as stored (compacted: no spaces or comments); GRBL's.
 pub const STARTUP_LINE_MAX_BYTES: usize = 80;
 
-/// One stored startup block.
+/// One stored startup block, or the build info line: as long as GRBL's.
 pub type StartupLine = String<STARTUP_LINE_MAX_BYTES>;
 
 /// The stored startup blocks, empty ones included.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StartupLines {
     lines: [StartupLine; STARTUP_LINES],
+    /// `$I=`: shown by `$I` after the version.
+    pub build_info: StartupLine,
 }
 
 impl StartupLines {
     pub const fn new() -> Self {
-        StartupLines { lines: [String::new(), String::new()] }
+        StartupLines { lines: [String::new(), String::new()], build_info: String::new() }
     }
 
     /// Stores `line` as block `index` (an empty line clears it); the parser has checked both.
@@ -43,7 +46,7 @@ impl StartupLines {
         self.all().filter(|l| !l.is_empty())
     }
 
-    /// Forgets every block (`$RST=*`).
+    /// Forgets every block and the build info line (`$RST=*`).
     pub fn clear(&mut self) {
         *self = StartupLines::new();
     }

@@ -349,6 +349,7 @@ impl Parser<'_, '_> {
                 }
             }
             Command::StoreStartupLine { index, line } => host.startup.borrow_mut().set(usize::from(index), line),
+            Command::StoreBuildInfo(line) => host.startup.borrow_mut().build_info = line,
             Command::Report(kind) => {
                 let gcode = &self.gcode;
                 link.send(|a| match kind {
@@ -356,7 +357,10 @@ impl Parser<'_, '_> {
                     Report::Settings => report::settings(a, settings),
                     Report::ParserState => report::parser_state(a, gcode, settings),
                     Report::Parameters => report::parameters(a, gcode),
-                    Report::BuildInfo => report::build_info(a, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES),
+                    Report::BuildInfo => {
+                        let info = &host.startup.borrow().build_info;
+                        report::build_info(a, info, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES)
+                    }
                     Report::StartupLines => report::startup_lines(a, &host.startup.borrow()),
                 })
                 .await

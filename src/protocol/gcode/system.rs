@@ -28,6 +28,16 @@ impl GcodeState {
             b"G" => report(Report::ParserState),
             b"#" => report(Report::Parameters),
             b"I" => report(Report::BuildInfo),
+            [b'I', b'=', body @ ..] => {
+                if state != RunState::Idle {
+                    return Err(GrblError::NotIdle);
+                }
+                let mut line = StartupLine::new();
+                // Compacted text is ASCII.
+                let text = core::str::from_utf8(body).map_err(|_| GrblError::InvalidStatement)?;
+                line.push_str(text).map_err(|_| GrblError::LineLengthExceeded)?;
+                Ok(Commands::one(Command::StoreBuildInfo(line)))
+            }
             b"X" => Ok(Commands::one(Command::Unlock)),
             b"C" => match state {
                 RunState::Check => Ok(Commands::one(Command::CheckMode { on: false })),
