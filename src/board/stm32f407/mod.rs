@@ -23,6 +23,7 @@
 //! |                     |      | the `usb` feature: it does not fit the flash budget yet)   |
 //! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
 
+mod panic;
 mod step_timer;
 #[cfg(feature = "usb")]
 mod usb;
@@ -49,7 +50,7 @@ use servoplot::settings::Settings;
 use servoplot::tasks::{self, lcd::St7920Lcd};
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
-use {defmt_rtt as _, panic_probe as _};
+use defmt_rtt as _;
 
 /// Crystal and core clock (see `clocks`).
 const HSE_HZ: u32 = 8_000_000;
