@@ -246,8 +246,10 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             && p >= cap
         {
             // Cruising: as far as the way is clear of braking to the block's exit.
+            // Counted in whole nanometres, as the distance left is: a braking distance shorter
+            // than the rounding of the steps' lengths still leaves the last step to a ramp.
             let clear_mm = block.left_mm(block.done_nm) - (cap * cap - exit * exit) / (2.0 * a);
-            let n = ((clear_mm / step_mm) as u32).min(available);
+            let n = ((clear_mm * NM_PER_MM) as u32 / chunk.step_nm.max(1)).min(available);
             if n > 0 {
                 let (ticks, frac) = split_ticks(step_mm / cap * TICK_HZ as f32, min_ticks);
                 self.speed = Some(cap);
