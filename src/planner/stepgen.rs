@@ -20,6 +20,10 @@ const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
 /// block still growing at the scan's front, move on only between runs.
 const RAMP_RUN_MAX_STEPS: u32 = 32;
 
+/// A speed up to this factor above its block's cap counts as at the cap (float noise); beyond
+/// it, the motion is above the cap because an override lowered it, and brakes down to it.
+const OVER_CAP: f32 = 1.0 + 1.0e-4;
+
 /// Half a tick in units of 2⁻³² tick: the carry from rest, so that the ticks of a run are its
 /// exact times rounded to the nearest tick.
 const HALF_TICK: u32 = 1 << 31;
@@ -90,7 +94,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let steps = self.steps.front_slice((self.run.left as usize).min(room));
             let mut carry = self.carry;
             let mut taken = 0;
-            // A ramp that reaches the cap goes on as a cruise; braking ends at the start rate.
+            // A ramp that reaches the cap goes on as a cruise; braking ends at its floor.
             let mut ends_early = false;
             match &mut self.run.pace {
                 Pace::Cruise { ticks: whole, frac } => {
@@ -119,7 +123,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         ramp.left_nm = ramp.left_nm.saturating_sub(ramp.step_nm);
                         w2 = math::min(w2, ramp.exit2 + ramp.two_a * (ramp.left_nm as f32 / NM_PER_MM));
                         if ramp.braking && v2 >= 0.0 {
-                            w2 = math::min(w2, math::max(v2 - ramp.gain, ramp.start2));
+                            w2 = math::min(w2, math::max(v2 - ramp.gain, ramp.floor2));
                         }
                         // `max` also replaces a NaN, which valid limits never produce.
                         w2 = math::max(w2, MIN_SPEED_MM_PER_S * MIN_SPEED_MM_PER_S);
@@ -133,7 +137,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         dy += i32::from(step.y);
                         taken += 1;
                         let reached_cap = w2 >= ramp.cap2;
-                        let stopped = ramp.braking && w2 <= ramp.start2;
+                        let stopped = ramp.braking && w2 <= ramp.floor2;
                         v2 = w2;
                         if stopped || (reached_cap && !ramp.braking) {
                             ends_early = true;
@@ -230,19 +234,24 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// The next run, in `block` and `chunk` (the front ones), with `start` the speed from rest:
     /// a cruise as far as the way is clear of braking when the speed is at the cap, a ramp
-    /// otherwise; see the planner's module documentation.
+    /// otherwise; see the planner's module documentation. Above the cap (an override lowered
+    /// it), the ramp brakes down to it at the acceleration limit, as a hold does to the start
+    /// rate; from the start rate or slower, the speed may drop to the cap at once, as it starts
+    /// and stops.
     fn plan_run(&mut self, block: &Block, chunk: &Chunk, start: f32) {
         let step_mm = chunk.step_mm;
         let a = block.caps.accel_mm_per_s2;
         let cap = block.caps.speed_mm_per_s;
         let exit = block.exit_mm_per_s;
         let available = chunk.left.min(block.steps - block.done_steps);
-        let braking = self.request != Request::Run;
+        let hold = self.request != Request::Run;
+        let jump = self.limits.start_speed_mm_per_s;
+        let over = self.speed.filter(|&p| p > cap * OVER_CAP && p > jump);
         let min_ticks = self.limits.min_interval_ticks;
         if self.speed.is_none() {
             self.carry = HALF_TICK;
         }
-        if let (false, Some(p)) = (braking, self.speed)
+        if let (false, None, Some(p)) = (hold, over, self.speed)
             && p >= cap
         {
             // Cruising: as far as the way is clear of braking to the block's exit.
@@ -257,16 +266,19 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 return;
             }
         }
+        let top = over.unwrap_or(cap);
+        let floor = if hold { start } else { math::max(cap, jump) };
         let ramp = Ramp {
             ticks_mm: step_mm * TICK_HZ as f32,
             gain: 2.0 * a * step_mm,
             two_a: 2.0 * a,
-            cap2: cap * cap,
+            cap2: top * top,
             exit2: exit * exit,
             start2: start * start,
+            floor2: floor * floor,
             step_nm: chunk.step_nm,
             left_nm: block.end_nm().saturating_sub(block.done_nm),
-            braking,
+            braking: hold || over.is_some(),
             min_ticks,
         };
         let n = available.min(RAMP_RUN_MAX_STEPS);
