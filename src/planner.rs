@@ -94,8 +94,10 @@
 
 mod block;
 mod limits;
+mod overriding;
 mod ring;
 mod run;
+mod scaling;
 mod scan;
 mod segment;
 mod sizes;
@@ -117,6 +119,7 @@ use crate::interp::{Interpolator, Method};
 use crate::job::Feed;
 use ring::{CopyRing, Ring, StepRing};
 use run::Run;
+use scaling::{Factors, Scale};
 use segment::{ScanPoint, Segment};
 use state::Request;
 
@@ -147,6 +150,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     pub fn new(limits: Limits) -> Self {
         Planner {
             limits,
+            factors: Factors::NONE,
             pending_limits: None,
             segments: Ring::new(),
             held: 0,
@@ -204,13 +208,28 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Queues a curve to be drawn at `feed` with `method`, which must be the interpolator's own
     /// method (it decides the distance per step). A curve without a single step is accepted and
-    /// dropped. Feeds: see [`Limits::requested_speed_mm_per_s`].
+    /// dropped. Feeds: see [`Limits::requested_speed_mm_per_s`]; the feed override scales a feed,
+    /// the rapid override a rapid (see [`Self::set_overrides`]).
     pub fn push(&mut self, curve: C, feed: Feed, method: Method) -> Result<(), PlannerFull> {
+        let scale = match feed {
+            Feed::Rapid => Scale::Rapid,
+            Feed::MmPerMin(_) => Scale::Feed,
+        };
+        self.push_scaled(curve, feed, method, scale)
+    }
+
+    /// Queues a jog, as [`Self::push`] does a drawing, at its own feed whatever the overrides.
+    pub fn push_jog(&mut self, curve: C, feed: Feed, method: Method) -> Result<(), PlannerFull> {
+        self.push_scaled(curve, feed, method, Scale::Fixed)
+    }
+
+    fn push_scaled(&mut self, curve: C, feed: Feed, method: Method, scale: Scale) -> Result<(), PlannerFull> {
         self.apply_pending_if_idle();
         if self.is_full() {
             return Err(PlannerFull);
         }
-        let segment = Segment { curve, method, requested_mm_per_s: self.limits.requested_speed_mm_per_s(feed) };
+        let requested_mm_per_s = self.limits.requested_speed_mm_per_s(feed);
+        let segment = Segment { curve, method, requested_mm_per_s, scale };
         if self.segments.push_back(segment).is_err() {
             return Err(PlannerFull);
         }

@@ -4,6 +4,7 @@
 use crate::interp::CurveError;
 use crate::math;
 use crate::planner::limits::Caps;
+use crate::planner::scaling::CapBasis;
 
 /// Distances along the path are also counted in whole nanometres, so that the scan's block
 /// lengths and the generator's progress agree exactly and the motion ends exactly at the end.
@@ -43,7 +44,9 @@ pub(crate) struct Block {
     pub ahead_nm: u32,
     pub done_steps: u32,
     pub done_nm: u32,
+    /// The caps in force, and what they are made of (to apply a change of override).
     pub caps: Caps,
+    pub basis: CapBasis,
     /// Direction (mm) at the block's start, and at its end.
     pub entry_dir_mm: [f32; 2],
     pub exit_dir_mm: [f32; 2],
@@ -55,6 +58,10 @@ pub(crate) struct Block {
     pub error: Option<CurveError>,
     /// Highest speed allowed at the end, from the backward pass.
     pub exit_mm_per_s: f32,
+    /// The least speed the motion can have slowed to by the end, at the last change of override:
+    /// the backward pass allows at least this much (0: no floor), so a lower override brakes at
+    /// the acceleration, not at once.
+    pub exit_floor_mm_per_s: f32,
     /// Changed by the scan since the last backward pass.
     pub dirty: bool,
 }
