@@ -1,15 +1,17 @@
 //! The serial task: GRBL 1.1's line protocol on the host link.
 //!
 //! Two loops share the link. The receiver reads bytes as they arrive and acts on realtime bytes
-//! (`?` `!` `~` 0x18 0x85) at once, so a status query or a feed hold is never stuck behind a line
-//! waiting for room in the job queue; every other byte goes through a small pipe to the line
-//! loop, which assembles lines, runs them through the G-code parser and answers `ok` or
-//! `error:N` once their jobs are queued (back-pressure paces a streaming sender). A third loop
-//! reports curves that stopped early. Answers are whole lines, never interleaved.
+//! (`?` `!` `~` 0x18 0x84 0x85, the overrides 0x90-0x9D) at once, so a status query, a feed hold
+//! or an override is never stuck behind a line waiting for room in the job queue; every other
+//! byte goes through a small pipe to the line loop, which assembles lines, runs them through the
+//! G-code parser and answers `ok` or `error:N` once their jobs are queued (back-pressure paces a
+//! streaming sender). A third loop reports curves that stopped early. Answers are whole lines,
+//! never interleaved.
 //!
 //! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
-//! the parser has it after its last line) and the overrides (`|Ov:`) when
-//! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions.
+//! the parser has it after its last line) and the overrides in force (`|Ov:`) when
+//! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions and
+//! overrides.
 //!
 //! Every line gets exactly one answer, in order, whatever the sender does. A sender that
 //! ignores GRBL's flow control and sends more than the pipe holds while the machine is busy
@@ -33,6 +35,7 @@ use heapless::String;
 
 use crate::job::{Control, Job};
 use crate::machine::{Machine, PlanEpoch, Stale};
+use crate::overrides::Overrides;
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::refresh::Refresh;
@@ -53,9 +56,6 @@ pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
 /// How long a byte may wait for room in the pipe before it is dropped: the line loop drains
 /// the pipe far faster unless it is waiting for the machine.
 pub const SERIAL_PIPE_WAIT_MS: u64 = 20;
-/// Feed, rapid and spindle overrides, percent, for `Ov:`: fixed, the plotter does not take
-/// GRBL's override bytes yet.
-const OVERRIDES_PERCENT: [u8; 3] = [100, 100, 100];
 /// Bytes taken from the UART, or from the pipe, at a time.
 pub const SERIAL_CHUNK_BYTES: usize = 32;
 /// After a UART read error (noise, overrun), the receiver waits this long before reading on.
@@ -124,14 +124,15 @@ impl<W: Write> Link<'_, W> {
         let work_offset_mm = machine.work_offset_mm();
         let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check);
         let mut refresh = self.refresh.get();
-        let occasional = refresh.next(work_offset_mm, OVERRIDES_PERCENT, busy);
+        let overrides = status.overrides.percents();
+        let occasional = refresh.next(work_offset_mm, overrides, busy);
         self.refresh.set(refresh);
         let rx_free = SERIAL_RX_WINDOW_BYTES.saturating_sub(self.bytes.len());
         let fields = StatusFields {
             speed_mm_per_min: machine.speed_mm_per_min(&settings),
             work_offset_mm,
             wco: occasional.wco,
-            overrides: occasional.overrides.then_some(OVERRIDES_PERCENT),
+            overrides: occasional.overrides.then_some(overrides),
             buffer: (machine.plan_free_segments(), rx_free as u16),
         };
         self.send(|a| report::status(a, &status, &settings, &fields)).await;
@@ -247,8 +248,11 @@ async fn receive<R: Read, W: Write>(link: &Link<'_, W>, mut rx: R) -> ! {
                 Some(Realtime::JogCancel) if link.machine.run_state() == RunState::Jog => {
                     link.machine.request(Control::Abort)
                 }
+                Some(Realtime::Override(command)) => link.machine.change_overrides(command),
                 Some(Realtime::Reset) => {
                     link.machine.request(Control::Abort);
+                    // As in GRBL, a reset brings every override back to 100 %.
+                    link.machine.set_overrides(Overrides::NONE);
                     // Like GRBL, everything received before the reset is dropped: the line loop
                     // discards bytes up to this marker and resets the parser when it meets it.
                     link.resets_pending.set(link.resets_pending.get() + 1);

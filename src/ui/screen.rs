@@ -311,6 +311,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::keypad::{Key, KeyEvent};
+    use crate::overrides::Overrides;
     use crate::ui::layout::SCREEN_HEIGHT_PX;
     use core::convert::Infallible;
     use embedded_graphics::Pixel;
@@ -513,6 +514,7 @@ mod tests {
             fault: None,
             door: false,
             underruns: u32::MAX,
+            overrides: Overrides::NONE,
         };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
             let mut m = Menu::new();
