@@ -66,7 +66,9 @@
 //! rule to every step, its figures (`2·a·δ`, the cap, the exit) worked out once for the run. At
 //! the cap a *cruise* run takes every step at the cap, as far as the way is clear of braking:
 //! each step's interval is the same number of whole ticks and a 32-bit fraction carried over,
-//! so long runs have no rounding drift. Motion ends only where the plan ends with `v_exit` =
+//! so long runs have no rounding drift. Above the cap (an override lowered it under the moving
+//! pen) a ramp brakes down to it, `w_k² ≥ w_{k−1}² − 2·a·δ`, as a hold does to the start rate.
+//! Motion ends only where the plan ends with `v_exit` =
 //! start rate, so the last step is never faster than the start rate. After rest the first
 //! interval is one step's time at the start rate (the pulse task may fire it at once when it
 //! has idled longer than that).
@@ -83,6 +85,14 @@
 //! starts). A backward pass over the blocks, from a stop at the end of the last one (and at
 //! every curve error and at the scan's front), gives each block `v_exit = min(junction,
 //! cap_next, √(v_exit,next² + 2·a_next·L_next))`; the runs are the forward pass.
+//!
+//! # Overrides
+//!
+//! GRBL's feed and rapid overrides ([`Planner::set_overrides`]) act on the motion already
+//! queued: each block keeps what the machine allows it apart from the feed asked for and which
+//! override scales it (see `scaling`), so a change gives every queued block its new cap, never
+//! beyond the machine's, and the backward pass runs again (see `overriding` for how the speed
+//! then changes within the acceleration limits). Jogs ([`Planner::push_jog`]) take none.
 //!
 //! # Hold and abort
 //!

@@ -66,7 +66,28 @@ pub(crate) struct Block {
     pub dirty: bool,
 }
 
+/// What lies ahead of the motion in its block, as the step generator plans a run: a copy of a
+/// few of the block's figures, not of the block.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ahead {
+    pub caps: Caps,
+    pub exit_mm_per_s: f32,
+    /// Steps not yet emitted, and the distance to brake in, nm (see [`Block::end_nm`]).
+    pub steps: u32,
+    pub left_nm: u32,
+}
+
 impl Block {
+    /// What lies ahead of the motion in the block.
+    pub fn ahead(&self) -> Ahead {
+        Ahead {
+            caps: self.caps,
+            exit_mm_per_s: self.exit_mm_per_s,
+            steps: self.steps - self.done_steps,
+            left_nm: self.end_nm().saturating_sub(self.done_nm),
+        }
+    }
+
     /// Where the motion must have braked to `exit_mm_per_s`, nm into the block: its end, or the
     /// end of its line.
     pub fn end_nm(&self) -> u32 {

@@ -238,7 +238,8 @@ impl Limits {
                 }
             }
         }
-        StepLimit { speed_mm_per_s: sanitize(speed, MIN_SPEED_MM_PER_S), dir_mm: u, curvature_per_mm }
+        // `max` also replaces a NaN, which valid limits never produce.
+        StepLimit { speed_mm_per_s: math::max(speed, MIN_SPEED_MM_PER_S), dir_mm: u, curvature_per_mm }
     }
 
     /// The tangential acceleration a step within `limit` allows at `speed_mm_per_s`: what each
@@ -250,6 +251,20 @@ impl Limits {
         // The normal (−u_y, u_x): its X share is |u_y|, its Y share |u_x|.
         let normal = [u[1].abs(), u[0].abs()];
         self.direction_accel(u, normal, speed_mm_per_s * speed_mm_per_s * limit.curvature_per_mm)
+    }
+
+    /// A tangential acceleration every step of curvature up to `curvature_per_mm` allows at
+    /// `speed_mm_per_s`, whatever its direction. [`Self::accel_at`] is the least over the axes
+    /// of `(A − c·|n_axis|) / |u_axis|`, with `A` the axis' acceleration and `c = v²κ`; as `u` and
+    /// `n` are at right angles, `(|u_axis|, |n_axis|)` is a unit vector, and the least of that
+    /// over every direction is `√(A² − c²)` (at `|n_axis| = c / A`). So `√(A² − c²)` of the
+    /// slower axis holds in every direction (or, where nothing would be left, the floor
+    /// [`Self::accel_at`] falls back to).
+    pub(crate) fn accel_floor(&self, curvature_per_mm: f32, speed_mm_per_s: f32) -> f32 {
+        let slowest_accel = math::min(self.accel_mm_per_s2[0], self.accel_mm_per_s2[1]);
+        let centripetal = speed_mm_per_s * speed_mm_per_s * curvature_per_mm;
+        let left2 = slowest_accel * slowest_accel - centripetal * centripetal;
+        sanitize(math::sqrt(math::max(left2, 0.0)), slowest_accel * (1.0 - CENTRIPETAL_SHARE))
     }
 
     /// Tangential acceleration along `u` that leaves each axis room for `centripetal_mm_per_s2`

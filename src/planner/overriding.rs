@@ -53,13 +53,20 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             self.recap(&before, true);
             self.replan();
         }
+        // The scan may add steps to the last block: they are compared with its caps in force.
+        if let Some(back) = self.blocks.back_mut()
+            && back.open
+        {
+            back.basis.rebase(back.caps);
+        }
     }
 
     /// Gives every queued block its caps at the factors in force, and its exit floor. With
     /// `keep_braking`, a block the motion may be braking through keeps its caps from `before`
     /// where the new ones would take acceleration away.
     fn recap(&mut self, before: &[Caps], keep_braking: bool) {
-        let start = self.limits.start_speed_mm_per_s;
+        let limits = self.limits;
+        let start = limits.start_speed_mm_per_s;
         let factors = self.factors;
         // The least speed², braking from the speed now, at the end of each block in turn.
         let mut least2 = self.speed.map_or(0.0, |v| v * v);
@@ -74,8 +81,10 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let braking_through = least2 > start * start;
             let carried = if braking_through { math::sqrt(least2) } else { 0.0 };
             let speed = block.basis.speed(factors);
-            block.caps =
-                Caps { speed_mm_per_s: speed, accel_mm_per_s2: block.basis.accel_at(math::max(speed, carried)) };
+            block.caps = Caps {
+                speed_mm_per_s: speed,
+                accel_mm_per_s2: block.basis.accel_at(&limits, math::max(speed, carried)),
+            };
             if let Some(&old) = before.get(i)
                 && keep_braking
                 && braking_through
