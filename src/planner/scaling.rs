@@ -19,8 +19,8 @@ use crate::math;
 use crate::overrides::Overrides;
 use crate::planner::limits::{Caps, Limits, MIN_SPEED_MM_PER_S, StepLimit};
 
-/// Percent in one.
-const PERCENT: f32 = 100.0;
+/// Percent in a whole: a factor of 1 is 100 %.
+const PERCENT_PER_UNIT: f32 = 100.0;
 
 /// Which override scales a segment's speed.
 ///
@@ -51,8 +51,8 @@ impl Factors {
 
     pub fn from_overrides(overrides: Overrides) -> Factors {
         Factors {
-            feed: f32::from(overrides.feed_percent) / PERCENT,
-            rapid: f32::from(overrides.rapid_percent) / PERCENT,
+            feed: f32::from(overrides.feed_percent) / PERCENT_PER_UNIT,
+            rapid: f32::from(overrides.rapid_percent) / PERCENT_PER_UNIT,
         }
     }
 }
@@ -112,8 +112,9 @@ pub(crate) struct CapBasis {
     pub machine_mm_per_s: f32,
     /// The largest curvature of its steps, 1/mm: what [`Limits::accel_floor`] needs.
     pub curvature_per_mm: f32,
-    /// An acceleration that holds for every step of the block up to that speed (those it was
-    /// scanned with).
+    /// The caps it was scanned with (or, for the block at the scan's front, those in force at
+    /// the last change of override): their acceleration holds for every step of the block up to
+    /// their speed.
     pub scanned: Caps,
 }
 
