@@ -24,6 +24,7 @@ pub mod keypad;
 pub mod machine;
 pub mod math;
 pub mod method;
+pub mod overrides;
 pub mod planner;
 pub mod protocol;
 pub mod pulse;

@@ -10,6 +10,10 @@
 //! planned from where the jobs before it end, and an abort drops those. Every job is handed
 //! over with the [`PlanEpoch`] it was planned in; an abort starts a new epoch, and a job from
 //! an earlier one is refused ([`Stale`]) or, if it was queued already, dropped.
+//!
+//! The overrides (GRBL's feed, rapid and spindle percentages) are one shared word: the host link
+//! sets them, the motion task hands them to its planner, reports and the LCD show them.
+//!
 //! Everything here is shared across priorities: every lock is a critical section that only
 //! copies a value in or out, and every counter has a single writer.
 
@@ -25,6 +29,7 @@ use embassy_sync::signal::Signal;
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
+use crate::overrides::{OverrideCommand, Overrides};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -67,8 +72,10 @@ pub struct Machine {
     /// Jobs handed over, each with the epoch it was planned in.
     jobs: Channel<CriticalSectionRawMutex, (PlanEpoch, Job), JOB_QUEUE_LEN>,
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
-    /// Wakes the motion task when a control is requested.
+    /// Wakes the motion task when a control is requested or an override changes.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
+    /// The overrides in force, [`Overrides::to_bits`] (written only by the host link).
+    overrides: AtomicU32,
     /// Wakes the LCD task after anything it shows may have changed.
     changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
@@ -119,6 +126,7 @@ impl Machine {
             jobs: Channel::new(),
             control: Mutex::new(Cell::new(None)),
             control_requested: Signal::new(),
+            overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
             pulses_done: Signal::new(),
             aborts: AtomicU32::new(0),
@@ -170,12 +178,32 @@ impl Machine {
         self.request(Control::Hold);
     }
 
+    /// The feed, rapid and spindle overrides in force.
+    pub fn overrides(&self) -> Overrides {
+        Overrides::from_bits(self.overrides.load(Ordering::Relaxed))
+    }
+
+    /// Changes the overrides by `command` (an override byte from the host link); the motion task
+    /// applies them to the motion in progress at its next refill. Only the host link calls this.
+    pub fn change_overrides(&self, command: OverrideCommand) {
+        self.set_overrides(self.overrides().after(command));
+    }
+
+    /// Sets the overrides: [`Overrides::NONE`] after a reset. Only the host link calls this.
+    pub fn set_overrides(&self, overrides: Overrides) {
+        let bits = overrides.to_bits();
+        if self.overrides.swap(bits, Ordering::Relaxed) != bits {
+            self.control_requested.signal(());
+            self.changed.signal(());
+        }
+    }
+
     /// The pending control request, if any, taking it.
     pub fn take_control(&self) -> Option<Control> {
         self.control.lock(|c| c.take())
     }
 
-    /// Waits until a control is requested (it may already be).
+    /// Waits until a control is requested (it may already be) or an override changes.
     pub async fn control_requested(&self) {
         if self.control.lock(|c| c.get().is_none()) {
             self.control_requested.wait().await;
@@ -344,6 +372,7 @@ impl Machine {
             fault: self.fault(),
             door: self.door.load(Ordering::Relaxed),
             underruns: self.underruns(),
+            overrides: self.overrides(),
         }
     }
 

@@ -66,7 +66,9 @@
 //! rule to every step, its figures (`2·a·δ`, the cap, the exit) worked out once for the run. At
 //! the cap a *cruise* run takes every step at the cap, as far as the way is clear of braking:
 //! each step's interval is the same number of whole ticks and a 32-bit fraction carried over,
-//! so long runs have no rounding drift. Motion ends only where the plan ends with `v_exit` =
+//! so long runs have no rounding drift. Above the cap (an override lowered it under the moving
+//! pen) a ramp brakes down to it, `w_k² ≥ w_{k−1}² − 2·a·δ`, as a hold does to the start rate.
+//! Motion ends only where the plan ends with `v_exit` =
 //! start rate, so the last step is never faster than the start rate. After rest the first
 //! interval is one step's time at the start rate (the pulse task may fire it at once when it
 //! has idled longer than that).
@@ -84,6 +86,14 @@
 //! every curve error and at the scan's front), gives each block `v_exit = min(junction,
 //! cap_next, √(v_exit,next² + 2·a_next·L_next))`; the runs are the forward pass.
 //!
+//! # Overrides
+//!
+//! GRBL's feed and rapid overrides ([`Planner::set_overrides`]) act on the motion already
+//! queued: each block keeps what the machine allows it apart from the feed asked for and which
+//! override scales it (see `scaling`), so a change gives every queued block its new cap, never
+//! beyond the machine's, and the backward pass runs again (see `overriding` for how the speed
+//! then changes within the acceleration limits). Jogs ([`Planner::push_jog`]) take none.
+//!
 //! # Hold and abort
 //!
 //! A hold decelerates at the block's acceleration on the path, down to the start rate, and
@@ -94,8 +104,10 @@
 
 mod block;
 mod limits;
+mod overriding;
 mod ring;
 mod run;
+mod scaling;
 mod scan;
 mod segment;
 mod sizes;
@@ -117,6 +129,7 @@ use crate::interp::{Interpolator, Method};
 use crate::job::Feed;
 use ring::{CopyRing, Ring, StepRing};
 use run::Run;
+use scaling::{Factors, Scale};
 use segment::{ScanPoint, Segment};
 use state::Request;
 
@@ -147,6 +160,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     pub fn new(limits: Limits) -> Self {
         Planner {
             limits,
+            factors: Factors::NONE,
             pending_limits: None,
             segments: Ring::new(),
             held: 0,
@@ -204,13 +218,28 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Queues a curve to be drawn at `feed` with `method`, which must be the interpolator's own
     /// method (it decides the distance per step). A curve without a single step is accepted and
-    /// dropped. Feeds: see [`Limits::requested_speed_mm_per_s`].
+    /// dropped. Feeds: see [`Limits::requested_speed_mm_per_s`]; the feed override scales a feed,
+    /// the rapid override a rapid (see [`Self::set_overrides`]).
     pub fn push(&mut self, curve: C, feed: Feed, method: Method) -> Result<(), PlannerFull> {
+        let scale = match feed {
+            Feed::Rapid => Scale::Rapid,
+            Feed::MmPerMin(_) => Scale::Feed,
+        };
+        self.push_scaled(curve, feed, method, scale)
+    }
+
+    /// Queues a jog, as [`Self::push`] does a drawing, at its own feed whatever the overrides.
+    pub fn push_jog(&mut self, curve: C, feed: Feed, method: Method) -> Result<(), PlannerFull> {
+        self.push_scaled(curve, feed, method, Scale::Fixed)
+    }
+
+    fn push_scaled(&mut self, curve: C, feed: Feed, method: Method, scale: Scale) -> Result<(), PlannerFull> {
         self.apply_pending_if_idle();
         if self.is_full() {
             return Err(PlannerFull);
         }
-        let segment = Segment { curve, method, requested_mm_per_s: self.limits.requested_speed_mm_per_s(feed) };
+        let requested_mm_per_s = self.limits.requested_speed_mm_per_s(feed);
+        let segment = Segment { curve, method, requested_mm_per_s, scale };
         if self.segments.push_back(segment).is_err() {
             return Err(PlannerFull);
         }

@@ -3,6 +3,7 @@
 
 use crate::geom::Point;
 use crate::interp::CurveError;
+use crate::overrides::Overrides;
 
 /// The machine's run state, named as GRBL reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -48,4 +49,6 @@ pub struct Status {
     /// Times the pulses had to wait for the motion task since power-on (step-queue underruns):
     /// where the machine could not keep up with the speeds it planned.
     pub underruns: u32,
+    /// The feed, rapid and spindle overrides in force.
+    pub overrides: Overrides,
 }

@@ -4,6 +4,7 @@
 use crate::interp::CurveError;
 use crate::math;
 use crate::planner::limits::Caps;
+use crate::planner::scaling::CapBasis;
 
 /// Distances along the path are also counted in whole nanometres, so that the scan's block
 /// lengths and the generator's progress agree exactly and the motion ends exactly at the end.
@@ -43,7 +44,9 @@ pub(crate) struct Block {
     pub ahead_nm: u32,
     pub done_steps: u32,
     pub done_nm: u32,
+    /// The caps in force, and what they are made of (to apply a change of override).
     pub caps: Caps,
+    pub basis: CapBasis,
     /// Direction (mm) at the block's start, and at its end.
     pub entry_dir_mm: [f32; 2],
     pub exit_dir_mm: [f32; 2],
@@ -55,11 +58,36 @@ pub(crate) struct Block {
     pub error: Option<CurveError>,
     /// Highest speed allowed at the end, from the backward pass.
     pub exit_mm_per_s: f32,
+    /// The least speed the motion can have slowed to by the end, at the last change of override:
+    /// the backward pass allows at least this much (0: no floor), so a lower override brakes at
+    /// the acceleration, not at once.
+    pub exit_floor_mm_per_s: f32,
     /// Changed by the scan since the last backward pass.
     pub dirty: bool,
 }
 
+/// What lies ahead of the motion in its block, as the step generator plans a run: a copy of a
+/// few of the block's figures, not of the block.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ahead {
+    pub caps: Caps,
+    pub exit_mm_per_s: f32,
+    /// Steps not yet emitted, and the distance to brake in, nm (see [`Block::end_nm`]).
+    pub steps: u32,
+    pub left_nm: u32,
+}
+
 impl Block {
+    /// What lies ahead of the motion in the block.
+    pub fn ahead(&self) -> Ahead {
+        Ahead {
+            caps: self.caps,
+            exit_mm_per_s: self.exit_mm_per_s,
+            steps: self.steps - self.done_steps,
+            left_nm: self.end_nm().saturating_sub(self.done_nm),
+        }
+    }
+
     /// Where the motion must have braked to `exit_mm_per_s`, nm into the block: its end, or the
     /// end of its line.
     pub fn end_nm(&self) -> u32 {

@@ -199,19 +199,24 @@ impl Limits {
     }
 
     /// Speed and tangential acceleration the machine allows for step `g` of a curve bending by
-    /// `bend` there, at a feed of `requested_mm_per_s`.
-    ///
-    /// Speed: the feed; each axis' share `v·|u_axis|` within its max rate; the step no shorter
-    /// than one period of the max pulse rate; where the curve bends with curvature `κ`, the
-    /// centripetal acceleration `v²·κ` within [`CENTRIPETAL_SHARE`] of the slower axis'
-    /// acceleration; at a kink, the junction speed (as between segments). Acceleration: what each
-    /// axis has left after the centripetal part at that speed, `a·|u_axis| + v²κ·|n_axis| ≤
-    /// accel_axis` (n the normal), so that no axis exceeds its acceleration on a curve either.
+    /// `bend` there, at a feed of `requested_mm_per_s`: the feed within [`Self::step_limit`], and
+    /// the acceleration [`Self::accel_at`] that speed.
     pub(crate) fn step_caps(&self, g: &StepGeometry, bend: Bend, requested_mm_per_s: f32) -> Caps {
+        let limit = self.step_limit(g, bend);
+        let speed = sanitize(math::min(requested_mm_per_s, limit.speed_mm_per_s), MIN_SPEED_MM_PER_S);
+        Caps { speed_mm_per_s: speed, accel_mm_per_s2: self.accel_at(&limit, speed) }
+    }
+
+    /// What the machine allows step `g` of a curve bending by `bend` there, whatever the feed.
+    ///
+    /// Speed: each axis' share `v·|u_axis|` within its max rate; the step no shorter than one
+    /// period of the max pulse rate; where the curve bends with curvature `κ`, the centripetal
+    /// acceleration `v²·κ` within [`CENTRIPETAL_SHARE`] of the slower axis' acceleration; at a
+    /// kink, the junction speed (as between segments). The tangential acceleration depends on the
+    /// speed on a curve: see [`Self::accel_at`].
+    pub(crate) fn step_limit(&self, g: &StepGeometry, bend: Bend) -> StepLimit {
         let u = g.dir_mm;
-        // The normal (−u_y, u_x): its X share is |u_y|, its Y share |u_x|.
-        let normal = [u[1].abs(), u[0].abs()];
-        let mut speed = math::min(requested_mm_per_s, self.max_pulse_rate_hz * g.step_mm);
+        let mut speed = self.max_pulse_rate_hz * g.step_mm;
         for (share, max) in u.iter().zip(self.max_speed_mm_per_s) {
             if share.abs() > DIR_EPSILON {
                 speed = math::min(speed, max / share.abs());
@@ -233,11 +238,33 @@ impl Limits {
                 }
             }
         }
-        let speed = sanitize(speed, MIN_SPEED_MM_PER_S);
-        Caps {
-            speed_mm_per_s: speed,
-            accel_mm_per_s2: self.direction_accel(u, normal, speed * speed * curvature_per_mm),
-        }
+        // `max` also replaces a NaN, which valid limits never produce.
+        StepLimit { speed_mm_per_s: math::max(speed, MIN_SPEED_MM_PER_S), dir_mm: u, curvature_per_mm }
+    }
+
+    /// The tangential acceleration a step within `limit` allows at `speed_mm_per_s`: what each
+    /// axis has left after the centripetal part at that speed, `a·|u_axis| + v²κ·|n_axis| ≤
+    /// accel_axis` (n the normal), so that no axis exceeds its acceleration on a curve either.
+    /// It falls as the speed rises, and does not depend on it where the path runs straight.
+    pub(crate) fn accel_at(&self, limit: &StepLimit, speed_mm_per_s: f32) -> f32 {
+        let u = limit.dir_mm;
+        // The normal (−u_y, u_x): its X share is |u_y|, its Y share |u_x|.
+        let normal = [u[1].abs(), u[0].abs()];
+        self.direction_accel(u, normal, speed_mm_per_s * speed_mm_per_s * limit.curvature_per_mm)
+    }
+
+    /// A tangential acceleration every step of curvature up to `curvature_per_mm` allows at
+    /// `speed_mm_per_s`, whatever its direction. [`Self::accel_at`] is the least over the axes
+    /// of `(A − c·|n_axis|) / |u_axis|`, with `A` the axis' acceleration and `c = v²κ`; as `u` and
+    /// `n` are at right angles, `(|u_axis|, |n_axis|)` is a unit vector, and the least of that
+    /// over every direction is `√(A² − c²)` (at `|n_axis| = c / A`). So `√(A² − c²)` of the
+    /// slower axis holds in every direction (or, where nothing would be left, the floor
+    /// [`Self::accel_at`] falls back to).
+    pub(crate) fn accel_floor(&self, curvature_per_mm: f32, speed_mm_per_s: f32) -> f32 {
+        let slowest_accel = math::min(self.accel_mm_per_s2[0], self.accel_mm_per_s2[1]);
+        let centripetal = speed_mm_per_s * speed_mm_per_s * curvature_per_mm;
+        let left2 = slowest_accel * slowest_accel - centripetal * centripetal;
+        sanitize(math::sqrt(math::max(left2, 0.0)), slowest_accel * (1.0 - CENTRIPETAL_SHARE))
     }
 
     /// Tangential acceleration along `u` that leaves each axis room for `centripetal_mm_per_s2`
@@ -331,6 +358,17 @@ pub(crate) enum Bend {
 /// Part of the slower axis' acceleration a curve's centripetal acceleration may take; the rest
 /// is left for speeding up and slowing down on the curve.
 pub const CENTRIPETAL_SHARE: f32 = 0.8;
+
+/// What the machine allows one step, whatever the feed: see [`Limits::step_limit`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StepLimit {
+    /// Highest speed, mm/s.
+    pub speed_mm_per_s: f32,
+    /// Direction of travel, mm space.
+    dir_mm: [f32; 2],
+    /// Curvature of the path, 1/mm: 0 where it runs straight (or kinks).
+    pub curvature_per_mm: f32,
+}
 
 /// Speed and acceleration allowed on a stretch of path.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

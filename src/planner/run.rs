@@ -30,12 +30,13 @@ pub(super) struct Ramp {
     pub(super) two_a: f32,
     pub(super) cap2: f32,
     pub(super) exit2: f32,
-    /// `v²` from rest, and the floor of a hold's or an abort's braking.
+    /// `v²` from rest, and where braking ends: the start rate for a hold or an abort, the cap
+    /// when braking down to a lower cap (an override lowered it; the motion is not at rest then).
     pub(super) start2: f32,
     /// The step's length, nm, and the distance left in the block before the run, nm.
     pub(super) step_nm: u32,
     pub(super) left_nm: u32,
-    /// A hold or an abort: decelerate to the start rate.
+    /// A hold or an abort, or a speed above the cap: decelerate to `start2`.
     pub(super) braking: bool,
     pub(super) min_ticks: u32,
 }

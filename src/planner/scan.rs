@@ -6,6 +6,7 @@ use crate::interp::{CurveError, Interpolator, Tangent};
 use crate::math;
 use crate::planner::block::{Block, Chunk};
 use crate::planner::limits::{Bend, Caps, StepGeometry, UnitDir};
+use crate::planner::scaling::{CapBasis, ChunkCaps, Scale};
 use crate::planner::segment::ScanPoint;
 use crate::planner::sizes::{CHUNK_STEPS, STRAIGHT_CHUNK_STEPS};
 use crate::planner::state::Planner;
@@ -88,13 +89,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         self.steps.commit(n);
         let after = segment.curve.tangent();
         let straight_left = segment.curve.straight_steps_left();
-        let (method, requested) = (segment.method, segment.requested_mm_per_s);
+        let (method, requested, scale) = (segment.method, segment.requested_mm_per_s, segment.scale);
         if n > 0 {
             // The tangent at the chunk's last point, before any kink there.
             let end_tangent = filled.kink.unwrap_or(after);
             let (sx, sy) = last_step.map_or((0, 0), |s| (s.x, s.y));
             let end = limits.step_geometry(method, UnitDir::from_tangent(end_tangent, sx, sy));
-            self.take_chunk(n as u32, end, end_tangent, requested);
+            self.take_chunk(n as u32, end, end_tangent, requested, scale);
             if let Some(left) = straight_left {
                 self.see_ahead(left);
             }
@@ -119,9 +120,10 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     }
 
     /// Files `n` scanned steps that end where a step has geometry `end` (tangent `end_tangent`)
-    /// into the chunks and blocks.
-    fn take_chunk(&mut self, n: u32, end: StepGeometry, end_tangent: Tangent, requested_mm_per_s: f32) {
+    /// into the chunks and blocks; the feed asked for is `requested_mm_per_s`, scaled by `scale`.
+    fn take_chunk(&mut self, n: u32, end: StepGeometry, end_tangent: Tangent, requested_mm_per_s: f32, scale: Scale) {
         let limits = self.limits;
+        let factors = self.factors;
         let start = self.scan.at;
         let fresh = self.scan.fresh;
         let kink_from = self.scan.kink_from_mm.take();
@@ -142,12 +144,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             None if straight => Bend::Straight,
             None => Bend::Curve { curvature_per_mm: turn_rad(start.dir_mm, end.dir_mm) / (n as f32 * step_mm) },
         };
-        let own = limits.step_caps(&g, bend, requested_mm_per_s);
+        let caps = ChunkCaps::new(&limits, &limits.step_limit(&g, bend), scale, requested_mm_per_s, factors);
         let chunk = Chunk::new(n, step_mm);
         // The open block, if any, is this segment's: the last block in the queue.
         if !fresh && let Some(back) = self.blocks.back_mut() {
             back.dirty = true;
-            if back.takes(own) {
+            if back.takes(caps.own) {
+                back.basis.join(&caps);
                 back.steps = back.steps.saturating_add(n);
                 back.len_nm = back.len_nm.saturating_add(chunk.nm(n));
                 back.exit_dir_mm = end.dir_mm;
@@ -158,27 +161,22 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             back.ahead_nm = 0;
         }
         let keep = 1.0 - if fresh { FIRST_BLOCK_MARGIN } else { BLOCK_MARGIN };
+        let basis = CapBasis::new(&caps, scale, requested_mm_per_s, factors, keep);
         let block = Block {
             steps: n,
             len_nm: chunk.nm(n),
             ahead_nm: 0,
             done_steps: 0,
             done_nm: 0,
-            caps: Caps {
-                // The margin only where the machine limits the speed: the feed itself is kept.
-                speed_mm_per_s: if own.speed_mm_per_s >= requested_mm_per_s {
-                    own.speed_mm_per_s
-                } else {
-                    own.speed_mm_per_s * keep
-                },
-                accel_mm_per_s2: own.accel_mm_per_s2 * keep,
-            },
+            caps: basis.scanned,
+            basis,
             entry_dir_mm: start.dir_mm,
             exit_dir_mm: end.dir_mm,
             open: true,
             ends_segment: false,
             error: None,
             exit_mm_per_s: limits.start_speed_mm_per_s,
+            exit_floor_mm_per_s: 0.0,
             dirty: true,
         };
         if self.blocks.push_back(block) {
@@ -265,8 +263,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         self.scan = ScanPoint::new();
     }
 
-    /// Backward pass: each block's exit speed, from a stop at the end of the plan. Stops early
-    /// where nothing changes any more (the scan only changes the last blocks).
+    /// Backward pass: each block's exit speed, from a stop at the end of the plan, and never
+    /// below its floor (see [`Block::exit_floor_mm_per_s`]). Stops early where nothing changes
+    /// any more (the scan only changes the last blocks).
     pub(crate) fn replan(&mut self) {
         let limits = self.limits;
         let start = limits.start_speed_mm_per_s;
@@ -282,7 +281,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         let a = math::min(caps.accel_mm_per_s2, block.caps.accel_mm_per_s2);
                         exit = math::min(exit, math::max(limits.junction_speed(a, block.exit_dir_mm, entry), start));
                     }
-                    exit
+                    math::max(exit, block.exit_floor_mm_per_s)
                 }
                 _ => start,
             };

@@ -3,13 +3,15 @@
 
 use crate::interp::{Method, Tangent};
 use crate::planner::limits::StepGeometry;
+use crate::planner::scaling::Scale;
 
 /// One queued curve, waiting to be scanned or being scanned.
 pub(crate) struct Segment<C> {
     pub curve: C,
     pub method: Method,
-    /// The feed, mm/s (unbounded for rapid).
+    /// The feed, mm/s (unbounded for rapid), and which override scales it.
     pub requested_mm_per_s: f32,
+    pub scale: Scale,
 }
 
 /// Where the scan stands on the front segment.

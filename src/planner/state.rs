@@ -7,6 +7,7 @@ use crate::planner::block::{Block, Chunk};
 use crate::planner::limits::Limits;
 use crate::planner::ring::{CopyRing, Ring, StepRing};
 use crate::planner::run::Run;
+use crate::planner::scaling::Factors;
 use crate::planner::segment::{ScanPoint, Segment};
 use crate::planner::sizes::{CHUNK_RING_LEN, PLANNER_BLOCKS};
 
@@ -24,6 +25,8 @@ pub(super) enum Request {
 /// look-ahead depth in segments ([`PLANNER_SEGMENTS`](crate::planner::PLANNER_SEGMENTS)).
 pub struct Planner<C: Interpolator, const N: usize> {
     pub(super) limits: Limits,
+    /// The feed and rapid overrides in force.
+    pub(super) factors: Factors,
     /// Limits to apply once the planner is idle.
     pub(super) pending_limits: Option<Limits>,
     /// Pushed segments not yet fully scanned, in order; the scan works on the front one.

@@ -7,7 +7,7 @@
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator};
 use crate::math;
-use crate::planner::block::{Block, Chunk, NM_PER_MM};
+use crate::planner::block::{Ahead, Chunk, NM_PER_MM};
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
 use crate::planner::run::{Pace, Ramp, Run};
 use crate::planner::sizes::{CHUNK_STEPS, PLANNER_BLOCKS};
@@ -19,6 +19,10 @@ const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
 /// Most steps in a ramp run. Its figures are those of its block when it starts; the scan, and a
 /// block still growing at the scan's front, move on only between runs.
 const RAMP_RUN_MAX_STEPS: u32 = 32;
+
+/// A speed up to this factor above its block's cap counts as at the cap (float noise); beyond
+/// it, the motion is above the cap because an override lowered it, and brakes down to it.
+const OVER_CAP: f32 = 1.0 + 1.0e-4;
 
 /// Half a tick in units of 2⁻³² tick: the carry from rest, so that the ticks of a run are its
 /// exact times rounded to the nearest tick.
@@ -90,7 +94,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let steps = self.steps.front_slice((self.run.left as usize).min(room));
             let mut carry = self.carry;
             let mut taken = 0;
-            // A ramp that reaches the cap goes on as a cruise; braking ends at the start rate.
+            // A ramp that reaches the cap goes on as a cruise; braking ends at `start2`.
             let mut ends_early = false;
             match &mut self.run.pace {
                 Pace::Cruise { ticks: whole, frac } => {
@@ -217,37 +221,46 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 self.rest();
                 return RunStart::Empty;
             }
-            let (Some(block), Some(chunk)) = (self.blocks.front().copied(), self.chunks.front().copied()) else {
+            let ahead = block.ahead();
+            let Some(chunk) = self.chunks.front().copied() else {
                 // Every scanned step is in a chunk; only a bug gets here.
                 self.rest();
                 return RunStart::Empty;
             };
-            self.plan_run(&block, &chunk, start);
+            self.plan_run(&ahead, &chunk, start);
             return RunStart::Ready;
         }
         RunStart::Empty
     }
 
-    /// The next run, in `block` and `chunk` (the front ones), with `start` the speed from rest:
+    /// The next run, in the front block (what lies `ahead` in it) and `chunk` (the front one),
+    /// with `start` the speed from rest:
     /// a cruise as far as the way is clear of braking when the speed is at the cap, a ramp
-    /// otherwise; see the planner's module documentation.
-    fn plan_run(&mut self, block: &Block, chunk: &Chunk, start: f32) {
+    /// otherwise; see the planner's module documentation. Above the cap (an override lowered
+    /// it), the ramp brakes down to it at the acceleration limit, as a hold does to the start
+    /// rate; from the start rate or slower, the speed may drop to the cap at once, as it starts
+    /// and stops.
+    fn plan_run(&mut self, ahead: &Ahead, chunk: &Chunk, start: f32) {
         let step_mm = chunk.step_mm;
-        let a = block.caps.accel_mm_per_s2;
-        let cap = block.caps.speed_mm_per_s;
-        let exit = block.exit_mm_per_s;
-        let available = chunk.left.min(block.steps - block.done_steps);
-        let braking = self.request != Request::Run;
+        let a = ahead.caps.accel_mm_per_s2;
+        let cap = ahead.caps.speed_mm_per_s;
+        let exit = ahead.exit_mm_per_s;
+        let available = chunk.left.min(ahead.steps);
+        let hold = self.request != Request::Run;
+        let jump = self.limits.start_speed_mm_per_s;
+        let over = self.speed.filter(|&p| p > cap * OVER_CAP && p > jump);
         let min_ticks = self.limits.min_interval_ticks;
         if self.speed.is_none() {
             self.carry = HALF_TICK;
         }
-        if let (false, Some(p)) = (braking, self.speed)
+        if let (false, None, Some(p)) = (hold, over, self.speed)
             && p >= cap
         {
             // Cruising: as far as the way is clear of braking to the block's exit.
-            let clear_mm = block.left_mm(block.done_nm) - (cap * cap - exit * exit) / (2.0 * a);
-            let n = ((clear_mm / step_mm) as u32).min(available);
+            // Counted in whole nanometres, as the distance left is: a braking distance shorter
+            // than the rounding of the steps' lengths still leaves the last step to a ramp.
+            let clear_nm = ahead.left_nm as f32 - (cap * cap - exit * exit) * (NM_PER_MM / 2.0) / a;
+            let n = (clear_nm as u32 / chunk.step_nm.max(1)).min(available);
             if n > 0 {
                 let (ticks, frac) = split_ticks(step_mm / cap * TICK_HZ as f32, min_ticks);
                 self.speed = Some(cap);
@@ -255,16 +268,20 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 return;
             }
         }
+        let top = over.unwrap_or(cap);
+        // Braking from above the cap ends at the cap (or the start rate, from which the speed may
+        // drop to the cap at once).
+        let floor = if over.is_some() && !hold { math::max(cap, jump) } else { start };
         let ramp = Ramp {
             ticks_mm: step_mm * TICK_HZ as f32,
             gain: 2.0 * a * step_mm,
             two_a: 2.0 * a,
-            cap2: cap * cap,
+            cap2: top * top,
             exit2: exit * exit,
-            start2: start * start,
+            start2: floor * floor,
             step_nm: chunk.step_nm,
-            left_nm: block.end_nm().saturating_sub(block.done_nm),
-            braking,
+            left_nm: ahead.left_nm,
+            braking: hold || over.is_some(),
             min_ticks,
         };
         let n = available.min(RAMP_RUN_MAX_STEPS);
@@ -302,10 +319,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Drops the front block, emitted to its end (or a failure block, reported).
     fn finish_block(&mut self) {
-        if let Some(block) = self.blocks.pop_front()
-            && block.ends_segment
-        {
+        if self.blocks.front().is_some_and(|b| b.ends_segment) {
             self.held = self.held.saturating_sub(1);
         }
+        self.blocks.drop_front(1);
     }
 }

@@ -13,6 +13,7 @@ use std::vec::Vec;
 
 mod control;
 mod lookahead;
+mod overrides;
 mod profile;
 mod properties;
 
@@ -201,8 +202,17 @@ impl Trace {
 
     /// Largest tangential acceleration between windows of at least `window_ticks`, mm/s².
     fn max_accel_over(&self, lengths_mm: &[f64], window_ticks: u64) -> f64 {
+        self.max_accel_above(lengths_mm, window_ticks, 0.0)
+    }
+
+    /// As [`Self::max_accel_over`], between windows both faster than `floor_mm_per_s` (the start
+    /// rate: below it the servos take a jump in speed, as when they start and stop).
+    fn max_accel_above(&self, lengths_mm: &[f64], window_ticks: u64, floor_mm_per_s: f64) -> f64 {
         let w = self.windowed_speeds(lengths_mm, window_ticks);
-        w.windows(2).map(|p| ((p[1].1 - p[0].1) / (p[1].0 - p[0].0)).abs()).fold(0.0, f64::max)
+        w.windows(2)
+            .filter(|p| p[0].1.min(p[1].1) > floor_mm_per_s)
+            .map(|p| ((p[1].1 - p[0].1) / (p[1].0 - p[0].0)).abs())
+            .fold(0.0, f64::max)
     }
 }
 

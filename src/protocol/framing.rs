@@ -16,6 +16,7 @@
 //! owns only framing (line ends, which bytes may stand in a line); the parsers read the words.
 
 use super::GrblError;
+use crate::overrides::OverrideCommand;
 
 /// Longest line kept, in bytes, after dropping what the module documentation says. GRBL keeps
 /// 80; a few more leave room for the spaces of the plotter's `$` commands.
@@ -37,9 +38,11 @@ pub enum Realtime {
     SafetyDoor,
     /// 0x85: cancel the jog in progress.
     JogCancel,
-    /// One of GRBL's other extended realtime bytes (feed, rapid and spindle overrides
-    /// 0x90–0x9E, coolant toggles 0xA0/0xA1): the plotter has no use for it and
-    /// ignores it, as GRBL would on a machine without that feature.
+    /// 0x90–0x97, 0x99–0x9D: change the feed, rapid or spindle override.
+    Override(OverrideCommand),
+    /// One of GRBL's other extended realtime bytes (spindle stop 0x9E, coolant toggles
+    /// 0xA0/0xA1): the plotter has no use for it and ignores it, as GRBL would on a machine
+    /// without that feature.
     Unsupported(u8),
 }
 
@@ -52,8 +55,11 @@ pub const fn realtime(byte: u8) -> Option<Realtime> {
         0x18 => Realtime::Reset,
         0x84 => Realtime::SafetyDoor,
         0x85 => Realtime::JogCancel,
-        0x90..=0x97 | 0x99..=0x9E | 0xA0 | 0xA1 => Realtime::Unsupported(byte),
-        _ => return None,
+        0x9E | 0xA0 | 0xA1 => Realtime::Unsupported(byte),
+        _ => match OverrideCommand::from_byte(byte) {
+            Some(command) => Realtime::Override(command),
+            None => return None,
+        },
     })
 }
 
@@ -286,7 +292,11 @@ mod tests {
         assert_eq!(realtime(b'~'), Some(Realtime::CycleStart));
         assert_eq!(realtime(0x18), Some(Realtime::Reset));
         assert_eq!(realtime(0x85), Some(Realtime::JogCancel));
-        assert_eq!(realtime(0x91), Some(Realtime::Unsupported(0x91)));
+        assert_eq!(realtime(0x91), Some(Realtime::Override(OverrideCommand::Feed(10))));
+        assert_eq!(realtime(0x97), Some(Realtime::Override(OverrideCommand::Rapid(25))));
+        assert_eq!(realtime(0x9D), Some(Realtime::Override(OverrideCommand::Spindle(-1))));
+        assert_eq!(realtime(0x9E), Some(Realtime::Unsupported(0x9E)));
+        assert_eq!(realtime(0xA0), Some(Realtime::Unsupported(0xA0)));
         assert_eq!(realtime(b'G'), None);
         assert_eq!(realtime(b'\n'), None);
     }

@@ -302,7 +302,7 @@ mod tests {
     }
 
     fn st(state: RunState, x: i32, y: i32) -> Status {
-        Status { state, position: Point::new(x, y), queued_jobs: 0, fault: None, door: false, underruns: 0 }
+        Status { state, position: Point::new(x, y), ..Status::default() }
     }
 
     /// The fields of a report with speed `speed` and nothing occasional.

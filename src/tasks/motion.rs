@@ -7,7 +7,7 @@
 //! `STEP_QUEUE_MAX_US` of motion, so a hold acts within that time even at the slowest feed —
 //! publishes what it queued, and wakes the pulse engine. Then it waits for exactly one of three
 //! things: the queue half emitted, a job when the planner has room for one, or a control
-//! request. On target it runs on its own interrupt executor, between the pulse engine and
+//! request (or a change of override, which it hands to the planner). On target it runs on its own interrupt executor, between the pulse engine and
 //! everything else.
 
 use embassy_futures::select::{Either, select};
@@ -17,6 +17,7 @@ use crate::geom::Point;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
+use crate::overrides::Overrides;
 use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner, PlannerState};
 use crate::pulse::StepProducer;
 use crate::settings::Settings;
@@ -78,9 +79,17 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
+    // The overrides the planner has.
+    let mut overrides = Overrides::NONE;
     loop {
         if let Some(control) = machine.take_control() {
             apply(machine, &mut planner, control);
+        }
+        let now = machine.overrides();
+        if now != overrides {
+            // Acts on what is planned from the next run of steps on.
+            overrides = now;
+            planner.set_overrides(now);
         }
         while !planner.is_full() {
             let Some(job) = machine.next_job() else { break };
@@ -197,7 +206,11 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
     machine.set_drawing(job.drawing.kind());
     machine.set_fault(None);
     let curve = job.drawing.into_curve().keep_within(settings.travel_steps());
-    if planner.push(curve, job.feed, settings.method).is_err() {
+    let pushed = match job.kind {
+        JobKind::Draw => planner.push(curve, job.feed, settings.method),
+        JobKind::Jog => planner.push_jog(curve, job.feed, settings.method),
+    };
+    if pushed.is_err() {
         // is_full() was false just now and nothing else pushes.
         error!("planner refused a segment it had room for");
     }

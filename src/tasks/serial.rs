@@ -2,8 +2,9 @@
 //! USB port), with one G-code parser for all of them.
 //!
 //! Each link has a receiver, which reads bytes as they arrive and acts on realtime bytes (`?` `!`
-//! `~` 0x18 0x84 0x85) at once, whatever link they come on, so a status query or a feed hold is never
-//! stuck behind a line waiting for room in the job queue; every other byte goes through the
+//! `~` 0x18 0x84 0x85, the overrides 0x90-0x9D) at once, whatever link they come on, so a status
+//! query, a feed hold or an override is never stuck behind a line waiting for room in the job
+//! queue; every other byte goes through the
 //! link's own pipe to the line loop. Each link also has a writer, which writes the link's answers
 //! one by one, each whole.
 //!
@@ -14,6 +15,11 @@
 //! either came on. A `?` is answered on the link that asked. A reset on a link drops what that
 //! link sent before it, resets the parser and greets that link with the banner; the other links
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
+//!
+//! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
+//! the parser has it after its last line) and the overrides in force (`|Ov:`) when
+//! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions and
+//! overrides.
 //!
 //! Every line gets exactly one answer, in order, on its own link, whatever the sender does. A
 //! sender that ignores GRBL's flow control and sends more than its pipe holds while the machine
@@ -38,6 +44,7 @@ use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 
 use crate::job::{Control, Job};
 use crate::machine::{Machine, PlanEpoch, Stale};
+use crate::overrides::Overrides;
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::refresh::Refresh;
@@ -58,9 +65,6 @@ pub const SERIAL_LINKS: usize = 2;
 pub const SERIAL_ERROR_BACKOFF_MS: u64 = 1;
 /// How often waits for the machine to come to rest (G4, M0, M2) look again.
 pub const SERIAL_IDLE_POLL_MS: u64 = 5;
-/// Feed, rapid and spindle overrides, percent, for `Ov:`: fixed, the plotter does not take
-/// GRBL's override bytes yet.
-const OVERRIDES_PERCENT: [u8; 3] = [100, 100, 100];
 
 /// What the loops of every link share.
 struct Host<'m> {
@@ -101,13 +105,14 @@ impl Host<'_> {
         let work_offset_mm = machine.work_offset_mm();
         let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check);
         let mut refresh = self.refresh.get();
-        let occasional = refresh.next(work_offset_mm, OVERRIDES_PERCENT, busy);
+        let overrides = status.overrides.percents();
+        let occasional = refresh.next(work_offset_mm, overrides, busy);
         self.refresh.set(refresh);
         let fields = StatusFields {
             speed_mm_per_min: machine.speed_mm_per_min(&settings),
             work_offset_mm,
             wco: occasional.wco,
-            overrides: occasional.overrides.then_some(OVERRIDES_PERCENT),
+            overrides: occasional.overrides.then_some(overrides),
             buffer: (machine.plan_free_segments(), link.rx_window_free() as u16),
         };
         link.send(|a| report::status(a, &status, &settings, &fields)).await;
@@ -125,8 +130,11 @@ impl Host<'_> {
                 Some(Realtime::SafetyDoor) => machine.open_door(),
                 Some(Realtime::CycleStart) => machine.request(Control::Resume),
                 Some(Realtime::JogCancel) if machine.run_state() == RunState::Jog => machine.request(Control::Abort),
+                Some(Realtime::Override(command)) => machine.change_overrides(command),
                 Some(Realtime::Reset) => {
                     machine.request(Control::Abort);
+                    // As in GRBL, a reset brings every override back to 100 %.
+                    machine.set_overrides(Overrides::NONE);
                     // Like GRBL, everything the link received before the reset is dropped: the
                     // line loop discards its bytes up to the reset and resets the parser there.
                     link.reset_received().await;

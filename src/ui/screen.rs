@@ -33,6 +33,7 @@ use crate::drawing::DrawError;
 use crate::geom::{Axis, Step};
 use crate::interp::{CurveError, Method};
 use crate::job::JOG_FEED_MM_PER_MIN;
+use crate::overrides::OVERRIDE_NONE_PERCENT;
 use crate::settings::Settings;
 use crate::status::{MotionFault, RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
@@ -150,9 +151,16 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
             RunState::Jog => ("Jogging", "D abort"),
             _ => ("Drawing", "C hold  D abort"),
         };
+        // A drawing at another feed than programmed says so.
+        let feed = status.overrides.feed_percent;
+        let mut what: String<SCREEN_COLUMNS> = String::new();
+        let _ = match status.state {
+            RunState::Run if feed != OVERRIDE_NONE_PERCENT => write!(Cut(&mut what), "{doing} F{feed}%"),
+            _ => Cut(&mut what).write_str(doing),
+        };
         lines[2] = match status.queued_jobs {
-            0 => TextLine::new(format_args!("{doing}"), false),
-            n => TextLine::new(format_args!("{doing}, {n} queued"), false),
+            0 => TextLine::new(format_args!("{what}"), false),
+            n => TextLine::new(format_args!("{what}, {n} queued"), false),
         };
         lines[3] = TextLine::new(format_args!("{keys}"), false);
     }
@@ -311,6 +319,7 @@ mod tests {
     extern crate std;
     use super::*;
     use crate::keypad::{Key, KeyEvent};
+    use crate::overrides::Overrides;
     use crate::ui::layout::SCREEN_HEIGHT_PX;
     use core::convert::Infallible;
     use embedded_graphics::Pixel;
@@ -430,6 +439,23 @@ mod tests {
     }
 
     #[test]
+    fn a_drawing_shows_the_feed_override_when_it_is_not_100_percent() {
+        let mut m = Menu::new();
+        press(&mut m, "2", &Status::default());
+        let slower = Overrides { feed_percent: 90, ..Overrides::NONE };
+        let status = Status { state: RunState::Run, queued_jobs: 2, overrides: slower, ..Status::default() };
+        assert_eq!(texts(&view(&m, &status, &Settings::default()))[2], "Drawing F90%, 2 queued");
+        let fastest = Overrides { feed_percent: 200, ..Overrides::NONE };
+        let status = Status { state: RunState::Run, queued_jobs: 4, overrides: fastest, ..Status::default() };
+        assert_eq!(texts(&view(&m, &status, &Settings::default()))[2], "Drawing F200%, 4 queued");
+        let rapid = Overrides { rapid_percent: 25, ..Overrides::NONE };
+        let status = Status { state: RunState::Run, overrides: rapid, ..Status::default() };
+        assert_eq!(texts(&view(&m, &status, &Settings::default()))[2], "Drawing");
+        let jogging = Status { state: RunState::Jog, overrides: slower, ..Status::default() };
+        assert_eq!(texts(&view(&m, &jogging, &Settings::default()))[2], "Jogging", "a jog takes no override");
+    }
+
+    #[test]
     fn mode_list_jog_and_settings_screens() {
         let mut m = Menu::new();
         let idle = Status::default();
@@ -513,6 +539,7 @@ mod tests {
             fault: None,
             door: false,
             underruns: u32::MAX,
+            overrides: Overrides { feed_percent: 200, ..Overrides::NONE },
         };
         for keys in ["", "1", "2 A88888888 #", "6", "7 BBBBBBBB", "4 12345678 9", "5 1# 1# # 0#"] {
             let mut m = Menu::new();
