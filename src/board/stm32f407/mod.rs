@@ -31,6 +31,7 @@ mod usb;
 use core::convert::Infallible;
 
 use defmt::{info, unwrap};
+use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
@@ -50,7 +51,6 @@ use servoplot::settings::Settings;
 use servoplot::tasks::{self, lcd::St7920Lcd};
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
-use defmt_rtt as _;
 
 /// Crystal and core clock (see `clocks`).
 const HSE_HZ: u32 = 8_000_000;
