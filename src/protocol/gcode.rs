@@ -374,7 +374,7 @@ impl GcodeState {
     /// `state`. On success the state has advanced and the commands say what to do; on error
     /// nothing has changed.
     pub fn execute(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
-        let text = line.trim_start();
+        let text = line.trim_ascii_start();
         if let Some(rest) = text.strip_prefix('$') {
             return self.system(line, rest, settings, state);
         }

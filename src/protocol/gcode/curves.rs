@@ -97,7 +97,7 @@ impl GcodeState {
         // panic path (and the string formatting a panic message would link).
         let equals_after = |at: usize| {
             let after = rest.get(at + 1..).unwrap_or("");
-            let spaces = after.len() - after.trim_start().len();
+            let spaces = after.len() - after.trim_ascii_start().len();
             (after.as_bytes().get(spaces) == Some(&b'=')).then_some(at + 1 + spaces + 1)
         };
         let mut seen_y = false;
