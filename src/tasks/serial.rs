@@ -34,7 +34,7 @@
 mod dropped;
 mod link;
 
-use core::cell::{Cell, RefCell};
+use core::cell::RefCell;
 use core::future::Future;
 
 use embassy_futures::join::{join, join3};
@@ -70,7 +70,7 @@ pub const SERIAL_IDLE_POLL_MS: u64 = 5;
 struct Host<'m> {
     machine: &'m Machine,
     /// When status reports carry `WCO:` and `Ov:`.
-    refresh: Cell<Refresh>,
+    refresh: RefCell<Refresh>,
     /// The startup blocks, run after every reset.
     startup: RefCell<StartupLines>,
     links: [Link; SERIAL_LINKS],
@@ -80,7 +80,7 @@ struct Host<'m> {
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write>(machine: &Machine, first: (R1, W1), second: (R2, W2)) -> ! {
     let host = Host {
         machine,
-        refresh: Cell::new(Refresh::new()),
+        refresh: RefCell::new(Refresh::new()),
         startup: RefCell::new(StartupLines::new()),
         links: [Link::new(), Link::new()],
     };
@@ -104,10 +104,8 @@ impl Host<'_> {
         let settings = machine.settings();
         let work_offset_mm = machine.work_offset_mm();
         let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check);
-        let mut refresh = self.refresh.get();
         let overrides = status.overrides.percents();
-        let occasional = refresh.next(work_offset_mm, overrides, busy);
-        self.refresh.set(refresh);
+        let occasional = self.refresh.borrow_mut().next(work_offset_mm, overrides, busy);
         let fields = StatusFields {
             speed_mm_per_min: machine.speed_mm_per_min(&settings),
             work_offset_mm,
@@ -279,7 +277,7 @@ impl Parser<'_, '_> {
         let machine = self.host.machine;
         machine.set_check_mode(false);
         // As after power-on, the next reports carry `WCO:` and `Ov:`.
-        self.host.refresh.set(Refresh::new());
+        *self.host.refresh.borrow_mut() = Refresh::new();
         let settings = machine.settings();
         self.gcode.reset(machine.position(), &settings);
         self.epoch = machine.plan_epoch();
