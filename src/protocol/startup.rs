@@ -41,9 +41,9 @@ impl StartupLines {
         self.lines.iter().map(String::as_str)
     }
 
-    /// The blocks to run after a reset, in order.
-    pub fn to_run(&self) -> impl Iterator<Item = &str> {
-        self.all().filter(|l| !l.is_empty())
+    /// Block `index`, empty when none is stored.
+    pub fn line(&self, index: usize) -> &str {
+        self.lines.get(index).map_or("", String::as_str)
     }
 
     /// Forgets every block and the build info line (`$RST=*`).

@@ -49,7 +49,7 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::refresh::Refresh;
 use crate::protocol::report::StatusFields;
-use crate::protocol::startup::StartupLines;
+use crate::protocol::startup::{STARTUP_LINES, StartupLines};
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -283,11 +283,20 @@ impl Parser<'_, '_> {
         self.epoch = machine.plan_epoch();
         link.send(report::welcome).await;
         if machine.state() != RunState::Alarm {
-            let startup = self.host.startup.borrow().clone();
-            for line in startup.to_run() {
-                // Checked when stored: a startup block changes modes and offsets, and moves nothing.
-                let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
-                link.send(|a| report::startup_result(a, line, result)).await;
+            for index in 0..STARTUP_LINES {
+                // The answer is written before the wait, so the blocks stay borrowed only here.
+                let sent = {
+                    let startup = self.host.startup.borrow();
+                    let line = startup.line(index);
+                    if line.is_empty() {
+                        continue;
+                    }
+                    // Checked when stored: a startup block changes modes and offsets, and moves
+                    // nothing.
+                    let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
+                    link.send(|a| report::startup_result(a, line, result))
+                };
+                sent.await;
             }
         }
         machine.set_work_offset_mm(self.gcode.work_offset_mm());
