@@ -90,6 +90,8 @@ pub struct Machine {
     check_mode: AtomicBool,
     /// The current hold came from the safety door.
     door: AtomicBool,
+    /// `$SLP`: the servos are off until a reset.
+    asleep: AtomicBool,
     /// Segments the planner has room for (set by the motion task).
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
@@ -134,6 +136,7 @@ impl Machine {
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
             door: AtomicBool::new(false),
+            asleep: AtomicBool::new(false),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
@@ -171,7 +174,7 @@ impl Machine {
     /// The safety door (GRBL's 0x84): a hold, reported as `Door` until a resume or an abort.
     /// Ignored in an alarm and in check mode, where nothing moves.
     pub fn open_door(&self) {
-        if matches!(self.state(), RunState::Alarm | RunState::Check) {
+        if matches!(self.state(), RunState::Alarm | RunState::Check | RunState::Sleep) {
             return;
         }
         self.door.store(true, Ordering::Relaxed);
@@ -336,7 +339,7 @@ impl Machine {
     /// Sets the motion's state. Check mode is not one: see [`set_check_mode`](Self::set_check_mode).
     pub fn set_run_state(&self, state: RunState) {
         let v = match state {
-            RunState::Idle | RunState::Check => 0,
+            RunState::Idle | RunState::Check | RunState::Sleep => 0,
             RunState::Run => 1,
             RunState::Hold => 2,
             RunState::Jog => 3,
@@ -354,13 +357,35 @@ impl Machine {
         }
     }
 
-    /// The state to report and to act on: the run state, or [`RunState::Check`] while the host
-    /// link checks its lines at rest.
+    /// The state to report and to act on: the run state, [`RunState::Sleep`] after `$SLP`, or
+    /// [`RunState::Check`] while the host link checks its lines at rest.
     pub fn state(&self) -> RunState {
         match self.run_state() {
+            _ if self.asleep.load(Ordering::Relaxed) => RunState::Sleep,
             RunState::Idle if self.check_mode.load(Ordering::Relaxed) => RunState::Check,
             state => state,
         }
+    }
+
+    /// `$SLP` at rest: the servos go off (the board drops SON, see [`servos_on`](Self::servos_on))
+    /// until [`wake`](Self::wake). Only the serial task calls this.
+    pub fn sleep(&self) {
+        self.asleep.store(true, Ordering::Relaxed);
+        self.changed.signal(());
+    }
+
+    /// A reset after `$SLP`: the servos come back on and the machine is in alarm, since the free
+    /// axes may have been moved. Nothing when not asleep.
+    pub fn wake(&self) {
+        if self.asleep.swap(false, Ordering::Relaxed) {
+            self.set_run_state(RunState::Alarm);
+            self.changed.signal(());
+        }
+    }
+
+    /// Whether the servo drivers are to be enabled (SON high).
+    pub fn servos_on(&self) -> bool {
+        !self.asleep.load(Ordering::Relaxed)
     }
 
     /// A snapshot for displays and reports.

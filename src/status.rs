@@ -22,6 +22,9 @@ pub enum RunState {
     /// The host link's check mode (`$C`): lines are parsed and every drawing built and checked,
     /// but nothing moves.
     Check,
+    /// `$SLP`: the servos are off (SON low) and every line is refused until a reset, after which
+    /// the machine is in alarm: the axes were free, the pen may have been moved.
+    Sleep,
 }
 
 /// Why the last job stopped early, shown on the LCD and reported to the host.

@@ -76,8 +76,9 @@
 //! travel and the lattice, from the position the lines before it plan, and nothing moves; `$C`
 //! again leaves it with a soft reset, as GRBL does), `$N` / `$Nn=line` startup blocks (two, run
 //! after every reset; a block is checked when stored and refused, error 3, if it would move,
-//! dwell or stop: no one expects the pen to move at a reset). GRBL's `$SLP` is not supported
-//! (error 3).
+//! dwell or stop: no one expects the pen to move at a reset), `$SLP` (at rest or in an alarm,
+//! error 8 otherwise: the servos go off and every line is refused, error 9, until a reset, after
+//! which the machine is in alarm, as in GRBL).
 //!
 //! # Plotter curve commands
 //!
@@ -244,6 +245,8 @@ pub enum Command {
     StoreStartupLine { index: u8, line: StartupLine },
     /// `$I=line`: store the build info line `$I` shows.
     StoreBuildInfo(StartupLine),
+    /// `$SLP`: servos off and every line refused until a reset (GRBL answers `[MSG:Sleeping]`).
+    Sleep,
     /// Answer with a report (before the `ok`).
     Report(Report),
     /// `$X`: leave the alarm state (GRBL answers `[MSG:Caution: Unlocked]`).

@@ -135,6 +135,7 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
         RunState::Jog => "Jog",
         RunState::Alarm => "Alarm",
         RunState::Check => "Check",
+        RunState::Sleep => "Sleep",
     };
     let machine = settings.status_report_mask & 1 != 0;
     write!(out, "<{state}|{}:", if machine { "MPos" } else { "WPos" })?;

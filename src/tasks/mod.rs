@@ -6,3 +6,4 @@ pub mod keypad;
 pub mod lcd;
 pub mod motion;
 pub mod serial;
+pub mod servo;

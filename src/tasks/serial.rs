@@ -103,7 +103,7 @@ impl Host<'_> {
         let status = machine.status();
         let settings = machine.settings();
         let work_offset_mm = machine.work_offset_mm();
-        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check);
+        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check | RunState::Sleep);
         let overrides = status.overrides.percents();
         let occasional = self.refresh.borrow_mut().next(work_offset_mm, overrides, busy);
         let fields = StatusFields {
@@ -123,7 +123,9 @@ impl Host<'_> {
             match realtime(byte) {
                 Some(Realtime::StatusQuery) => self.status_report(link).await,
                 // Nothing moves in check mode: a hold there would only stop the check.
-                Some(Realtime::FeedHold) if machine.state() != RunState::Check => machine.request(Control::Hold),
+                Some(Realtime::FeedHold) if !matches!(machine.state(), RunState::Check | RunState::Sleep) => {
+                    machine.request(Control::Hold)
+                }
                 Some(Realtime::FeedHold) => {}
                 Some(Realtime::SafetyDoor) => machine.open_door(),
                 Some(Realtime::CycleStart) => machine.request(Control::Resume),
@@ -276,6 +278,8 @@ impl Parser<'_, '_> {
     async fn restart(&mut self, link: &Link) {
         let machine = self.host.machine;
         machine.set_check_mode(false);
+        // After `$SLP` the servos come back on, in alarm (the free axes may have been moved).
+        machine.wake();
         // As after power-on, the next reports carry `WCO:` and `Ov:`.
         *self.host.refresh.borrow_mut() = Refresh::new();
         let settings = machine.settings();
@@ -305,6 +309,10 @@ impl Parser<'_, '_> {
     /// Parses one line of `link` and carries it out.
     async fn line(&mut self, link: &Link, line: &str) -> Result<(), Unfinished> {
         let machine = self.host.machine;
+        if machine.state() == RunState::Sleep {
+            // Asleep (`$SLP`), the servos are off: every line waits for a reset.
+            return Err(Unfinished::Error(GrblError::Locked));
+        }
         if machine.plan_epoch() != self.epoch {
             // An abort (keypad, jog cancel, a curve stopped part way, a reset on another link)
             // dropped what was planned: plan on from where the pen stops.
@@ -379,6 +387,10 @@ impl Parser<'_, '_> {
                     Report::StartupLines => report::startup_lines(a, &host.startup.borrow()),
                 })
                 .await
+            }
+            Command::Sleep => {
+                machine.sleep();
+                link.send(|a| report::message(a, "Sleeping")).await;
             }
             Command::CheckMode { on: true } => {
                 machine.set_check_mode(true);

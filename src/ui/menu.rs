@@ -144,7 +144,7 @@ impl Menu {
     /// only outside the jog screen (inside it, the jog keys steer it).
     pub fn is_busy(&self, status: &Status) -> bool {
         match status.state {
-            RunState::Run | RunState::Hold | RunState::Check => true,
+            RunState::Run | RunState::Hold | RunState::Check | RunState::Sleep => true,
             RunState::Jog => self.screen != Screen::Jog,
             RunState::Idle | RunState::Alarm => false,
         }

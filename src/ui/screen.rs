@@ -206,6 +206,7 @@ fn state_name(status: &Status) -> &'static str {
         RunState::Jog => "JOG",
         RunState::Alarm => "ALARM",
         RunState::Check => "CHECK",
+        RunState::Sleep => "SLEEP",
     }
 }
 

@@ -11,7 +11,7 @@
 //! |---------------------|------|----------------------------------------------------|
 //! | X PULS / X SIGN     | PE9 / PE10  | TIM1 CH1 / GPIO, to the X driver's PULS+/SIGN+ |
 //! | Y PULS / Y SIGN     | PE11 / PE12 | TIM1 CH2 / GPIO, to the Y driver's PULS+/SIGN+ |
-//! | servo on (SON)      | PE13 | high once the firmware runs, both drivers          |
+//! | servo on (SON)      | PE13 | high once the firmware runs, low while asleep (`$SLP`) |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
 //! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
@@ -111,6 +111,11 @@ async fn serial(
 }
 
 #[embassy_executor::task]
+async fn servo(machine: &'static Machine, son: Output<'static>) -> ! {
+    tasks::servo::run(machine, son).await
+}
+
+#[embassy_executor::task]
 async fn lcd(machine: &'static Machine, lcd: Lcd) -> ! {
     tasks::lcd::run(machine, lcd).await
 }
@@ -200,8 +205,8 @@ async fn main(spawner: Spawner) {
         PwmPin::new(p.PE11, OutputType::PushPull),
         [Output::new(p.PE10, Level::Low, Speed::VeryHigh), Output::new(p.PE12, Level::Low, Speed::VeryHigh)],
     );
-    // Servo on: the drivers hold position from here on. Kept for the program's whole life.
-    core::mem::forget(Output::new(p.PE13, Level::High, Speed::Low));
+    // Servo on: the drivers hold position from here on, off only while the machine sleeps.
+    let son = Output::new(p.PE13, Level::High, Speed::Low);
 
     interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
     let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
@@ -223,6 +228,7 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD11, Pull::Up),
     ];
     spawner.spawn(unwrap!(keypad(machine, columns, rows)));
+    spawner.spawn(unwrap!(servo(machine, son)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
     static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();

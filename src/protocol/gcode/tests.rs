@@ -407,7 +407,8 @@ fn system_commands() {
     assert_eq!(run(&mut g, "$C"), Ok(std::vec![Command::CheckMode { on: true }]));
     assert_eq!(run_in(&mut g, "$C", RunState::Check), Ok(std::vec![Command::CheckMode { on: false }]));
     refused_in(&mut g, "$C", RunState::Run, 8);
-    refused(&mut g, "$SLP", 3);
+    assert_eq!(run(&mut g, "$SLP"), Ok(std::vec![Command::Sleep]));
+    refused_in(&mut g, "$SLP", RunState::Run, 8);
     refused(&mut g, "$N2=G20", 3);
     refused(&mut g, "$Q", 3);
     refused(&mut g, "$GX", 3);
