@@ -101,6 +101,7 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
+#[inline(never)]
 pub fn message(out: &mut impl Write, text: &str) -> fmt::Result {
     write!(out, "[MSG:{text}]\r\n")
 }

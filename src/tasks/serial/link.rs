@@ -82,9 +82,7 @@ impl Link {
     pub fn send(&self, write: impl FnOnce(&mut Answer) -> fmt::Result) -> impl Future<Output = ()> + '_ {
         let mut answer = Answer::new();
         if write(&mut answer).is_err() {
-            // Every answer fits by construction; should one not, say so rather than cut it.
-            answer.clear();
-            let _ = report::message(&mut answer, "answer too long");
+            too_long(&mut answer);
         }
         self.outbox.send(answer)
     }
@@ -171,6 +169,15 @@ impl Link {
             d.mid_line.set(true);
         }
     }
+}
+
+/// Every answer fits by construction; should one not, it says so rather than being cut. Out of
+/// line: [`Link::send`] is inlined wherever an answer is written.
+#[cold]
+#[inline(never)]
+fn too_long(answer: &mut Answer) {
+    answer.clear();
+    let _ = report::message(answer, "answer too long");
 }
 
 /// Writes the link's answers to its port, each whole, in the order they were sent.
