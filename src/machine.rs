@@ -171,6 +171,13 @@ impl Machine {
         self.control_requested.signal(());
     }
 
+    /// A feed hold from the host (`!`): ignored in check mode and asleep, where nothing moves.
+    pub fn feed_hold(&self) {
+        if !matches!(self.state(), RunState::Check | RunState::Sleep) {
+            self.request(Control::Hold);
+        }
+    }
+
     /// The safety door (GRBL's 0x84): a hold, reported as `Door` until a resume or an abort.
     /// Ignored in an alarm and in check mode, where nothing moves.
     pub fn open_door(&self) {

@@ -27,6 +27,13 @@ pub enum RunState {
     Sleep,
 }
 
+impl RunState {
+    /// True while the machine moves or holds a job: drawing, held or jogging.
+    pub const fn moving(self) -> bool {
+        matches!(self, RunState::Run | RunState::Hold | RunState::Jog)
+    }
+}
+
 /// Why the last job stopped early, shown on the LCD and reported to the host.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]

@@ -157,6 +157,13 @@ impl Commands {
         self.len() == 0
     }
 
+    /// What of these commands check mode carries out: no motion, no dwell and no pause.
+    fn checked(self) -> Self {
+        let main = self.main.filter(|c| !matches!(c, Command::Job(_)));
+        let stop = self.stop.filter(|s| *s != ProgramStop::Pause);
+        Commands { dwell_ms: None, via: None, main, stop }
+    }
+
     fn one(command: Command) -> Self {
         Commands { main: Some(command), ..Commands::default() }
     }
@@ -377,6 +384,16 @@ impl GcodeState {
     /// `state`. On success the state has advanced and the commands say what to do; on error
     /// nothing has changed.
     pub fn execute(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+        if state == RunState::Sleep {
+            // Asleep (`$SLP`), the servos are off: every line waits for a reset.
+            return Err(GrblError::Locked);
+        }
+        let commands = self.parse_line(line, settings, state)?;
+        // Check mode: the line was parsed and its drawing built and checked; nothing runs.
+        Ok(if state == RunState::Check { commands.checked() } else { commands })
+    }
+
+    fn parse_line(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
         let text = line.trim_ascii_start();
         if let Some(rest) = text.strip_prefix('$') {
             return self.system(line, rest, settings, state);

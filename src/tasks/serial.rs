@@ -103,7 +103,7 @@ impl Host<'_> {
         let status = machine.status();
         let settings = machine.settings();
         let work_offset_mm = machine.work_offset_mm();
-        let busy = !matches!(status.state, RunState::Idle | RunState::Alarm | RunState::Check | RunState::Sleep);
+        let busy = status.state.moving();
         let overrides = status.overrides.percents();
         let occasional = self.refresh.borrow_mut().next(work_offset_mm, overrides, busy);
         let fields = StatusFields {
@@ -123,10 +123,7 @@ impl Host<'_> {
             match realtime(byte) {
                 Some(Realtime::StatusQuery) => self.status_report(link).await,
                 // Nothing moves in check mode: a hold there would only stop the check.
-                Some(Realtime::FeedHold) if !matches!(machine.state(), RunState::Check | RunState::Sleep) => {
-                    machine.request(Control::Hold)
-                }
-                Some(Realtime::FeedHold) => {}
+                Some(Realtime::FeedHold) => machine.feed_hold(),
                 Some(Realtime::SafetyDoor) => machine.open_door(),
                 Some(Realtime::CycleStart) => machine.request(Control::Resume),
                 Some(Realtime::JogCancel) if machine.run_state() == RunState::Jog => machine.request(Control::Abort),
@@ -309,10 +306,6 @@ impl Parser<'_, '_> {
     /// Parses one line of `link` and carries it out.
     async fn line(&mut self, link: &Link, line: &str) -> Result<(), Unfinished> {
         let machine = self.host.machine;
-        if machine.state() == RunState::Sleep {
-            // Asleep (`$SLP`), the servos are off: every line waits for a reset.
-            return Err(Unfinished::Error(GrblError::Locked));
-        }
         if machine.plan_epoch() != self.epoch {
             // An abort (keypad, jog cancel, a curve stopped part way, a reset on another link)
             // dropped what was planned: plan on from where the pen stops.
@@ -340,10 +333,7 @@ impl Parser<'_, '_> {
     /// Carries out one command of a line of `link`.
     async fn carry_out(&mut self, link: &Link, settings: &Settings, command: Command) -> Result<(), Unfinished> {
         let (host, machine) = (self.host, self.host.machine);
-        let checking = machine.state() == RunState::Check;
         match command {
-            // Check mode: the line was parsed and its drawing built and checked; nothing runs.
-            Command::Job(_) | Command::Dwell { .. } | Command::Pause if checking => {}
             Command::Job(job) => self.queue(link, job).await?,
             Command::Dwell { ms } => {
                 unless_reset(link, async {
