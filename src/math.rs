@@ -226,7 +226,9 @@ pub fn ceil(x: f32) -> f32 {
     libm::ceilf(x)
 }
 
-/// Nearest integer, halfway cases away from zero.
+/// Nearest integer, halfway cases away from zero. Out of line: it is called from many places,
+/// none of them per step.
+#[inline(never)]
 pub fn round(x: f32) -> f32 {
     libm::roundf(x)
 }

@@ -19,13 +19,11 @@
 //! | LCD CS (RS)         | PB12 | active high, driven by the st7920 driver           |
 //! | LCD RST             | PB11 | PSB tied to GND selects serial mode                |
 //! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
-//! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port (with |
-//! |                     |      | the `usb` feature: it does not fit the flash budget yet)   |
+//! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port   |
 //! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
 
 mod panic;
 mod step_timer;
-#[cfg(feature = "usb")]
 mod usb;
 
 use core::convert::Infallible;
@@ -137,38 +135,7 @@ impl embedded_hal::digital::OutputPin for NoCs {
 }
 
 /// The host link on the USB port: its receiving and sending ends.
-#[cfg(feature = "usb")]
 type UsbLink = (usb::UsbRx, usb::UsbTx);
-#[cfg(not(feature = "usb"))]
-type UsbLink = (NoPort, NoPort);
-
-/// The USB port's place as a host link in an image without it: nothing arrives, answers go
-/// nowhere.
-#[cfg(not(feature = "usb"))]
-struct NoPort;
-
-#[cfg(not(feature = "usb"))]
-impl embedded_io_async::ErrorType for NoPort {
-    type Error = Infallible;
-}
-
-#[cfg(not(feature = "usb"))]
-impl embedded_io_async::Read for NoPort {
-    async fn read(&mut self, _: &mut [u8]) -> Result<usize, Infallible> {
-        core::future::pending().await
-    }
-}
-
-#[cfg(not(feature = "usb"))]
-impl embedded_io_async::Write for NoPort {
-    async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
-        Ok(buf.len())
-    }
-
-    async fn flush(&mut self) -> Result<(), Infallible> {
-        Ok(())
-    }
-}
 
 /// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
 /// 42 MHz, APB2 84 MHz.
@@ -234,7 +201,7 @@ async fn main(spawner: Spawner) {
     static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();
     let mut uart_config = usart::Config::default();
     uart_config.baudrate = HOST_BAUD;
-    let uart = unwrap!(BufferedUart::new(
+    let uart = match BufferedUart::new(
         p.USART2,
         p.PA3,
         p.PA2,
@@ -242,14 +209,15 @@ async fn main(spawner: Spawner) {
         RX_BUF.init([0; HOST_RX_BUFFER_BYTES]),
         Irqs,
         uart_config,
-    ));
+    ) {
+        Ok(uart) => uart,
+        // Only a baud rate the clocks cannot make is refused: a fault of the build.
+        Err(_) => defmt::panic!("USART2 cannot run at {} baud", HOST_BAUD),
+    };
     // Below the pulse and motion executors: a burst of received bytes never delays a pulse.
     interrupt::USART2.set_priority(HOST_LINK_PRIORITY);
     let (tx, rx) = uart.split();
-    #[cfg(feature = "usb")]
     let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, HOST_LINK_PRIORITY);
-    #[cfg(not(feature = "usb"))]
-    let usb = (NoPort, NoPort);
     spawner.spawn(unwrap!(serial(machine, (rx, tx), usb)));
 
     let mut spi_config = spi::Config::default();
