@@ -261,7 +261,7 @@ impl Expr {
     pub fn eval(&self, x: f32) -> Result<f32, EvalError> {
         // The top of the stack is `top`, the values under it are in `below`: most operations
         // only change the top. The first push puts the initial `top` (no value) at the bottom.
-        let mut below = Stack { values: [0.0; EXPR_STACK_DEPTH], len: 0 };
+        let mut below = Stack(heapless::Vec::new());
         let mut top = 0.0;
         for op in self.ops.iter() {
             top = match *op {
@@ -281,7 +281,7 @@ impl Expr {
             };
         }
         // A program leaves one value: its result on top of the initial one.
-        if below.len == 1 { Ok(top) } else { Err(EvalError::Overflow) }
+        if below.0.len() == 1 { Ok(top) } else { Err(EvalError::Overflow) }
     }
 
     /// Number of operations in the program (at most [`EXPR_MAX_OPS`]).
@@ -379,23 +379,17 @@ fn power_int(a: f32, n: i32) -> Result<f32, EvalError> {
 
 /// The evaluation stack under its top. Parsing proved that no program exceeds it or pops an
 /// empty one, so the errors below cannot occur for an [`Expr`] made by [`parse`]; they exist so
-/// that evaluation has no panic path at all.
-struct Stack {
-    values: [f32; EXPR_STACK_DEPTH],
-    len: usize,
-}
+/// that evaluation has no panic path at all. Its storage is left uninitialised until pushed to:
+/// clearing it on every evaluation cost more than the evaluation of a short program.
+struct Stack(heapless::Vec<f32, EXPR_STACK_DEPTH>);
 
 impl Stack {
     fn push(&mut self, v: f32) -> Result<(), EvalError> {
-        let slot = self.values.get_mut(self.len).ok_or(EvalError::Overflow)?;
-        *slot = v;
-        self.len += 1;
-        Ok(())
+        self.0.push(v).map_err(|_| EvalError::Overflow)
     }
 
     fn pop(&mut self) -> Result<f32, EvalError> {
-        self.len = self.len.checked_sub(1).ok_or(EvalError::Overflow)?;
-        self.values.get(self.len).copied().ok_or(EvalError::Overflow)
+        self.0.pop().ok_or(EvalError::Overflow)
     }
 }
 
