@@ -238,6 +238,7 @@ impl Machine {
     }
 
     /// Counts the pulses of `cmd`, emitted. Only the pulse engine calls this.
+    #[inline(always)]
     pub fn emitted(&self, cmd: StepCmd) {
         // Single writer: a load and a store, no read-modify-write cycle.
         let [x, y] = &self.position;

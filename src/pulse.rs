@@ -97,11 +97,13 @@ struct Signs {
 
 impl Signs {
     /// Of the axes in `moving`, those whose level is not `high` (or not known yet).
+    #[inline(always)]
     fn changes(self, moving: u8, high: u8) -> u8 {
         moving & (!self.known | (self.high ^ high))
     }
 
     /// The levels once the axes in `moving` are set to `high`.
+    #[inline(always)]
     fn set(&mut self, moving: u8, high: u8) {
         self.high = (self.high & !moving) | high;
         self.known |= moving;
@@ -110,6 +112,7 @@ impl Signs {
 
 /// The axes `cmd` steps (bits, bit 0 X, bit 1 Y), and the SIGN levels it needs on them with
 /// the direction invert mask `invert` (`$3`).
+#[inline(always)]
 fn step_bits(cmd: StepCmd, invert: u8) -> (u8, u8) {
     let s = cmd.step;
     let moving = u8::from(s.x != 0) | (u8::from(s.y != 0) << 1);
@@ -130,6 +133,7 @@ enum Period {
 
 impl Period {
     /// Ticks, and the axes pulsed at the end (bit 0 X, bit 1 Y).
+    #[inline(always)]
     fn timer_load(self) -> (u32, u8) {
         match self {
             Period::Step { cmd, ticks } => (ticks, step_bits(cmd, 0).0),
@@ -234,6 +238,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         self.preload(next);
     }
 
+    #[inline(always)]
     fn preload(&mut self, period: Period) {
         self.preloaded = period;
         let (ticks, axes) = period.timer_load();
@@ -241,6 +246,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     }
 
     /// Drives SIGN for the axes `cmd` steps.
+    #[inline(always)]
     fn drive_signs(&mut self, cmd: StepCmd) {
         let (moving, high) = step_bits(cmd, self.timing.invert_mask);
         let changes = self.sign.changes(moving, high);
@@ -256,6 +262,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     }
 
     /// What follows the preloaded period.
+    #[inline(always)]
     fn next_period(&mut self, machine: &Machine) -> Period {
         if let Some((cmd, left)) = self.long_wait {
             return self.step_period(cmd, left);
@@ -279,6 +286,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
 
     /// The period before `cmd`'s pulse: its interval, at least one period of the max pulse
     /// rate, and where a direction changes, at least the pulse width plus the direction setup.
+    #[inline(always)]
     fn step_ticks(&mut self, cmd: StepCmd) -> u32 {
         let mut ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
         let (moving, high) = step_bits(cmd, self.timing.invert_mask);
@@ -291,6 +299,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
 
     /// `ticks` before `cmd`'s pulse: pulse-less periods first where the timer cannot count so
     /// far.
+    #[inline(always)]
     fn step_period(&mut self, cmd: StepCmd, ticks: u32) -> Period {
         if ticks > T::MAX_PERIOD_TICKS {
             let wait = T::MAX_PERIOD_TICKS / 2;

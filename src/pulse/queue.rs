@@ -117,7 +117,7 @@ pub struct StepConsumer<'q> {
 
 impl StepConsumer<'_> {
     /// The next command, if one is published.
-    #[inline]
+    #[inline(always)]
     pub fn pop(&mut self) -> Option<StepCmd> {
         let taken = self.queue.taken.load(Ordering::Relaxed);
         if taken == self.queue.published.load(Ordering::Acquire) {
