@@ -209,7 +209,9 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     }
 
     /// A period starts (the timer's update event): counts the pulses of the period that ended,
-    /// drives SIGN for this period's pulse, and preloads the next period.
+    /// drives SIGN for this period's pulse, and preloads the next period. What it calls is
+    /// `#[inline(always)]`: the image is built for size, and this is the one path where a call
+    /// costs more than it saves (`cost/` counts it per pulse).
     pub fn on_period(&mut self, machine: &Machine) {
         if !self.running {
             return;
