@@ -30,6 +30,7 @@ pub mod protocol;
 pub mod pulse;
 pub mod settings;
 pub mod status;
+pub mod store;
 pub mod tasks;
 pub mod ui;
 

@@ -141,31 +141,58 @@ impl Settings {
 
     /// Sets setting `id` to `value`; out of range, unknown or not finite changes nothing.
     pub fn set(&mut self, id: u16, value: f32) -> Result<(), SettingError> {
+        let mut next = self.clone();
+        next.assign(id, value)?;
+        next.check()?;
+        *self = next;
+        Ok(())
+    }
+
+    /// Settings from one value per setting, in [`SETTING_INFO`] order (as the flash store keeps
+    /// them): each must be in its range and all of them agree.
+    pub fn from_values(values: impl IntoIterator<Item = f32>) -> Result<Settings, SettingError> {
+        let mut settings = Settings::default();
+        let mut values = values.into_iter();
+        for info in SETTING_INFO {
+            settings.assign(info.id, values.next().ok_or(SettingError::OutOfRange)?)?;
+        }
+        if values.next().is_some() {
+            return Err(SettingError::OutOfRange);
+        }
+        settings.check()?;
+        Ok(settings)
+    }
+
+    /// Every value, in [`SETTING_INFO`] order.
+    pub fn values(&self) -> impl Iterator<Item = f32> + '_ {
+        SETTING_INFO.iter().map(|info| self.get(info.id).unwrap_or(0.0))
+    }
+
+    /// Sets one field to `value` if it is in the setting's range, without the rules that tie
+    /// settings together.
+    fn assign(&mut self, id: u16, value: f32) -> Result<(), SettingError> {
         let info = SETTING_INFO.iter().find(|i| i.id == id).ok_or(SettingError::Unknown)?;
         if !value.is_finite() || value < info.min || value > info.max {
             return Err(SettingError::OutOfRange);
         }
         let whole = value == crate::math::floor(value);
-        let mut next = self.clone();
         match id {
-            0 => next.pulse_width_us = value,
-            3 if whole => next.dir_invert_mask = value as u8,
-            10 if whole => next.status_report_mask = value as u8,
-            11 => next.junction_deviation_mm = value,
-            100 | 101 => next.steps_per_mm[(id - 100) as usize] = value,
-            110 | 111 => next.max_rate_mm_per_min[(id - 110) as usize] = value,
-            120 | 121 => next.accel_mm_per_s2[(id - 120) as usize] = value,
-            130 | 131 => next.max_travel_mm[(id - 130) as usize] = value,
-            200 => next.dir_setup_us = value,
-            201 => next.start_rate_mm_per_min = value,
-            202 if whole => next.method = if value == 0.0 { Method::Classic } else { Method::Diagonal },
-            203 => next.default_feed_mm_per_min = value,
-            204 => next.max_jump_mm = value,
-            205 => next.max_pulse_rate_hz = value,
+            0 => self.pulse_width_us = value,
+            3 if whole => self.dir_invert_mask = value as u8,
+            10 if whole => self.status_report_mask = value as u8,
+            11 => self.junction_deviation_mm = value,
+            100 | 101 => self.steps_per_mm[(id - 100) as usize] = value,
+            110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize] = value,
+            120 | 121 => self.accel_mm_per_s2[(id - 120) as usize] = value,
+            130 | 131 => self.max_travel_mm[(id - 130) as usize] = value,
+            200 => self.dir_setup_us = value,
+            201 => self.start_rate_mm_per_min = value,
+            202 if whole => self.method = if value == 0.0 { Method::Classic } else { Method::Diagonal },
+            203 => self.default_feed_mm_per_min = value,
+            204 => self.max_jump_mm = value,
+            205 => self.max_pulse_rate_hz = value,
             _ => return Err(SettingError::OutOfRange),
         }
-        next.check()?;
-        *self = next;
         Ok(())
     }
 

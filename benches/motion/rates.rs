@@ -8,6 +8,7 @@ use servoplot::settings::Settings;
 use servoplot::sim::cpu::CpuModel;
 use servoplot::sim::serial::SimSerial;
 use servoplot::sim::{self, SimConfig};
+use servoplot::store::Record;
 
 /// Rates tried, slow to fast; a curve's figure is the last one it keeps up with.
 const RATES_HZ: [f32; 13] = [10e3, 20e3, 30e3, 40e3, 50e3, 60e3, 80e3, 100e3, 120e3, 140e3, 160e3, 180e3, 200e3];
@@ -47,7 +48,7 @@ fn highest_rate(line: &str, method: Method, cpu: &CpuModel) -> Option<(f32, f32)
     let mut best = None;
     for rate in RATES_HZ {
         let report = sim::run(SimConfig {
-            settings: settings(method, rate),
+            flash: sim::flash_keeping(Record { settings: settings(method, rate), ..Record::default() }),
             serial: SimSerial::with_input(format!("{line}\n").as_bytes()),
             cpu: Some(cpu.clone()),
             ..SimConfig::default()

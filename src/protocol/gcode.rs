@@ -61,7 +61,7 @@
 //!   motion command or another of them (error 24); under G80 they may have no axis word (31).
 //!
 //! The offsets of G54–G59 and the G28 and G30 positions outlive a soft reset, as GRBL's EEPROM
-//! data does; here they live in RAM, so a power cycle clears them (there is no flash store yet).
+//! data does; the serial task keeps them in the flash store, so they outlive a power cycle too.
 //! A reset clears the G92 offset and selects G54; `$RST=#` (or `$RST=*`) clears them all.
 //!
 //! # `$` commands
@@ -118,7 +118,7 @@ mod words;
 pub use modal::{
     Coolant, Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units, WORK_SYSTEMS, WorkSystem,
 };
-pub use offsets::{Offsets, StoredPosition};
+pub use offsets::{KEPT_OFFSETS, Offsets, StoredPosition};
 
 use super::GrblError;
 use crate::drawing::{self, Request};
@@ -310,9 +310,14 @@ impl GcodeState {
         }
     }
 
+    /// Power-on: the modes of [`new`](Self::new) with the offsets a power cycle kept.
+    pub fn with_offsets(offsets: Offsets) -> Self {
+        GcodeState { offsets: offsets.after_reset(), ..GcodeState::new() }
+    }
+
     /// After a soft reset: power-on modes (G54 active) and no G92 offset, at the machine's real
     /// `position`. The offsets of G54–G59 and the G28 and G30 positions stay, as GRBL keeps them
-    /// (in EEPROM there; here in RAM, until power is lost).
+    /// (in EEPROM there, in the flash store here).
     pub fn reset(&mut self, position: Point, settings: &Settings) {
         let offsets = self.offsets.after_reset();
         *self = GcodeState { offsets, ..GcodeState::new() };

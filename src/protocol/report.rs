@@ -220,7 +220,7 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
 /// `$#`: GRBL's coordinate data, in GRBL's order and format, millimetres: the offsets of G54 to
 /// G59, the G28 and G30 positions (machine coordinates), the G92 offset, then the tool length
 /// offset and the last probe, always zero on the plotter (no tool, no probe). G54–G59, G28 and
-/// G30 are kept in RAM, not in flash: they outlive a soft reset but not a power cycle.
+/// G30 outlive a power cycle (the flash store keeps them); G92 does not.
 pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
     let offsets = gcode.offsets();
     for system in WorkSystem::all() {

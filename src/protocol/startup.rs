@@ -3,8 +3,7 @@
 //! ...), and the build info line (`$I=`) that `$I` shows. Owns the stored lines; the G-code parser
 //! checks a startup block before it is stored, and the serial task runs them.
 //!
-//! They are kept in RAM for now, so they last until power-off; a flash store will keep them
-//! across power cycles.
+//! The serial task keeps them in the flash store ([`crate::store`]), with the settings.
 
 use heapless::String;
 

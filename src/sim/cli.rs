@@ -7,7 +7,8 @@ use std::string::{String, ToString};
 use std::vec::Vec;
 use std::{eprintln, format};
 
-use crate::sim::{self, KeysStart, SimConfig, keys::KeyScript, picture, serial::SimSerial};
+use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, serial::SimSerial};
+use crate::store::STORE_SECTORS;
 
 /// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
 const DEMO_GCODE: &str = include_str!("../../demo/demo.gcode");
@@ -17,7 +18,8 @@ const DEMO_KEYS: &str = include_str!("../../demo/demo.keys");
 const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
-usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--out DIR]
+usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
+                 [--out DIR]
 
 Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
@@ -29,6 +31,10 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
   --keys-text S   the keypad script given inline
   --cpu f407      let the firmware's work take the time it takes on the STM32F407 (as counted
                   on a Cortex-M4F); the summary then tells whether the pulses ever had to wait
+  --flash FILE    the board's flash store (settings, offsets, startup blocks), kept in FILE:
+                  read at power-on, written as the firmware saves; created erased if missing.
+                  Two runs with the same FILE are a power cycle. Without it the flash starts
+                  erased and is forgotten.
   --out DIR       where the pictures go
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
@@ -69,11 +75,12 @@ struct Args {
     serial: Option<String>,
     keys: Option<String>,
     cpu: Option<sim::cpu::CpuModel>,
+    flash: Option<PathBuf>,
     out: PathBuf,
 }
 
 fn parse_args() -> Result<Args, String> {
-    let mut args = Args { serial: None, keys: None, cpu: None, out: PathBuf::from("out") };
+    let mut args = Args { serial: None, keys: None, cpu: None, flash: None, out: PathBuf::from("out") };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
@@ -88,6 +95,7 @@ fn parse_args() -> Result<Args, String> {
                 "f407" => args.cpu = Some(sim::cpu::CpuModel::f407()?),
                 other => return Err(format!("unknown processor `{other}` (there is: f407)")),
             },
+            "--flash" => args.flash = Some(PathBuf::from(value()?)),
             "--out" => args.out = PathBuf::from(value()?),
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
@@ -141,8 +149,19 @@ pub fn main() -> ExitCode {
     // person at the terminal, at once.
     let keys_start =
         if has_serial && args.serial.as_deref() != Some("-") { KeysStart::AfterSerial } else { KeysStart::AtOnce };
+    let flash = match &args.flash {
+        Some(path) => match SimFlash::in_file(path, STORE_SECTORS) {
+            Ok(flash) => flash,
+            Err(e) => {
+                eprintln!("error: --flash {}: {e}", path.display());
+                return ExitCode::from(2);
+            }
+        },
+        None => SimFlash::default(),
+    };
     let with_cpu = args.cpu.is_some();
     let report = sim::run(SimConfig {
+        flash,
         serial: serial.echo_to_stdout(),
         keys,
         keys_start,

@@ -10,6 +10,7 @@
 pub mod cli;
 pub mod clock;
 pub mod cpu;
+pub mod flash;
 pub mod keys;
 pub mod lcd;
 pub mod picture;
@@ -33,11 +34,13 @@ use crate::geom::{Axis, Point};
 use crate::machine::Machine;
 use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
+use crate::store::{Record, STORE_SECTORS, Store, StoreError};
 use crate::tasks::{self, lcd::St7920Lcd};
 use clock::FreeDelay;
 use cpu::{CpuModel, SimCpu};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
+use flash::SimFlash;
 use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SimSpi};
 use pins::{PulseTrace, TracePin};
@@ -65,7 +68,9 @@ pub enum KeysStart {
 /// What a simulation starts from.
 #[derive(Default)]
 pub struct SimConfig {
-    pub settings: Settings,
+    /// The flash store's sectors: the settings, offsets and startup blocks the board powers on
+    /// with (erased by default: the compiled-in defaults).
+    pub flash: SimFlash,
     /// The host link on the board's UART.
     pub serial: SimSerial,
     /// The host link on the board's USB port; sends nothing unless given input.
@@ -90,6 +95,10 @@ pub struct SimReport {
     pub position: Point,
     /// Settings at the end (the host may have changed them).
     pub settings: Settings,
+    /// What power-on read from the flash store.
+    pub loaded: Result<(), StoreError>,
+    /// The flash at the end: the next power-on's (see [`SimConfig::flash`]).
+    pub flash: SimFlash,
     /// Virtual time at the end, and when the last pulse went out.
     pub end_us: u64,
     /// True if the run hit `SIM_MAX_VIRTUAL_US` before coming to rest.
@@ -131,7 +140,9 @@ impl Wake for FlagWaker {
 /// Runs the firmware on the simulated board until its inputs are used up and it rests.
 pub fn run(config: SimConfig) -> SimReport {
     clock::reset();
-    let machine = Machine::new(config.settings);
+    let flash = config.flash.clone();
+    let (store, loaded) = Store::open(config.flash, STORE_RANGE);
+    let machine = Machine::new(store.kept().settings.clone());
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
     let (steps, step_consumer) = step_queue.split();
@@ -155,7 +166,7 @@ pub fn run(config: SimConfig) -> SimReport {
         step_timer::run(&machine, &mut engine, &kicks),
         tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
         tasks::keypad::run(&machine, columns, rows),
-        tasks::serial::run(&machine, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
+        tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
         tasks::lcd::run(&machine, lcd),
     );
     let mut firmware = pin!(firmware);
@@ -230,10 +241,23 @@ pub fn run(config: SimConfig) -> SimReport {
         usb_out: usb.output(),
         position,
         settings,
+        loaded,
+        flash,
         end_us,
         timed_out,
         underruns,
     }
+}
+
+/// The flash store's range of [`SimFlash`]: all of it.
+const STORE_RANGE: core::ops::Range<u32> = 0..(STORE_SECTORS * crate::store::STORE_SECTOR_BYTES) as u32;
+
+/// Flash keeping `record`, as a power cycle after saving it leaves it.
+pub fn flash_keeping(record: Record) -> SimFlash {
+    let flash = SimFlash::default();
+    let (mut store, _) = Store::open(flash.clone(), STORE_RANGE);
+    store.save(&record).expect("erased flash takes a record");
+    flash
 }
 
 /// Runs a serial transcript (and nothing on the keypad) with default settings.

@@ -28,6 +28,11 @@
 //! has emptied the pipe it answers each of those lines `error:11` (not processed), and only then
 //! does the receiver pass bytes on again, from the start of the next line.
 //!
+//! The line loop owns the flash store: once a line has changed what a power cycle keeps
+//! (settings, G54–G59, G28/G30, startup blocks, build info), it waits for the machine to stop
+//! and saves before the line's `ok`, as GRBL writes its EEPROM. At power-on the startup blocks
+//! kept there run, answered on every link.
+//!
 //! A link whose port can be closed (USB) reports each closing as a read error of kind
 //! `NotConnected`: the line the host was sending when it closed the port is dropped.
 
@@ -41,18 +46,21 @@ use embassy_futures::join::{join, join3};
 use embassy_futures::select::select_array;
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
+use embedded_storage::nor_flash::NorFlash;
 
 use crate::job::{Control, Job};
 use crate::machine::{Machine, PlanEpoch, Stale};
 use crate::overrides::Overrides;
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::protocol::gcode::Offsets;
 use crate::protocol::refresh::Refresh;
 use crate::protocol::report::StatusFields;
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
 use crate::protocol::{Command, GcodeState, GrblError, Report, report};
 use crate::settings::Settings;
 use crate::status::RunState;
+use crate::store::{Record, Store, StoreError};
 use link::{CLOSED_MARK, Intake, Link, RESET_MARK, write_answers};
 pub use link::{
     SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
@@ -76,12 +84,19 @@ struct Host<'m> {
     links: [Link; SERIAL_LINKS],
 }
 
-/// Speaks GRBL on two host links forever, each given as its receiving and its sending end.
-pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write>(machine: &Machine, first: (R1, W1), second: (R2, W2)) -> ! {
+/// Speaks GRBL on two host links forever, each given as its receiving and its sending end,
+/// keeping what a power cycle keeps in `store`; `loaded` says whether power-on read it back.
+pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
+    machine: &Machine,
+    store: Store<F>,
+    loaded: Result<(), StoreError>,
+    first: (R1, W1),
+    second: (R2, W2),
+) -> ! {
     let host = Host {
         machine,
         refresh: RefCell::new(Refresh::new()),
-        startup: RefCell::new(StartupLines::new()),
+        startup: RefCell::new(store.kept().startup.clone()),
         links: [Link::new(), Link::new()],
     };
     for link in &host.links {
@@ -90,7 +105,7 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write>(machine: &Machine, fi
     }
     let [a, b] = &host.links;
     join(
-        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host)),
+        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host, store, loaded)),
         join3(write_answers(a, first.1), write_answers(b, second.1), faults(&host)),
     )
     .await;
@@ -180,10 +195,18 @@ enum Unfinished {
     Reset,
 }
 
-/// Takes the links' bytes in turn and carries out their lines, answering each on its own link.
-async fn lines(host: &Host<'_>) -> ! {
-    let mut parser =
-        Parser { host, gcode: GcodeState::new(), epoch: host.machine.plan_epoch(), restart_after_answer: false };
+/// Says why the flash store gave the defaults, if it did, and runs the startup blocks; then
+/// takes the links' bytes in turn and carries out their lines, answering each on its own link.
+async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(), StoreError>) -> ! {
+    let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
+    let mut parser = Parser { host, gcode, store, epoch: host.machine.plan_epoch(), restart_after_answer: false };
+    let links = [&host.links[0], &host.links[1]];
+    if let Err(e) = loaded {
+        for link in links {
+            link.send(|a| report::message(a, e.message())).await;
+        }
+    }
+    parser.startup_blocks(&links).await;
     let mut assemblers = [LineAssembler::new(), LineAssembler::new()];
     let mut bufs = [[0u8; SERIAL_CHUNK_BYTES]; SERIAL_LINKS];
     // The link looked at first: the other after each turn, so a link streaming without pause
@@ -219,15 +242,16 @@ async fn lines(host: &Host<'_>) -> ! {
 
 /// The one parser every link's lines go through, and the epoch it plans in: after an abort,
 /// its planned position is stale until the machine stops.
-struct Parser<'h, 'm> {
+struct Parser<'h, 'm, F: NorFlash> {
     host: &'h Host<'m>,
     gcode: GcodeState,
+    store: Store<F>,
     epoch: PlanEpoch,
     /// The line being answered left check mode: the parser starts over once it is answered.
     restart_after_answer: bool,
 }
 
-impl Parser<'_, '_> {
+impl<F: NorFlash> Parser<'_, '_, F> {
     /// Takes one byte of `link`'s lines, assembled by `assembler`; answers the line it ends.
     async fn byte(&mut self, link: &Link, assembler: &mut LineAssembler, byte: u8) {
         match byte {
@@ -245,7 +269,10 @@ impl Parser<'_, '_> {
         }
         let result = match assembler.push(byte) {
             None => return,
-            Some(LineEvent::Line(line)) => self.line(link, line).await,
+            Some(LineEvent::Line(line)) => match self.line(link, line).await {
+                Ok(()) => self.keep(link).await,
+                refused => refused,
+            },
             Some(other) => Err(Unfinished::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
         };
         match result {
@@ -283,24 +310,46 @@ impl Parser<'_, '_> {
         self.gcode.reset(machine.position(), &settings);
         self.epoch = machine.plan_epoch();
         link.send(report::welcome).await;
+        self.startup_blocks(&[link]).await;
+    }
+
+    /// Runs the startup blocks (not in an alarm, as GRBL does), each answered on `links`
+    /// `>line:ok` or `>line:error:N`.
+    async fn startup_blocks(&mut self, links: &[&Link]) {
+        let machine = self.host.machine;
+        let settings = machine.settings();
         if machine.state() != RunState::Alarm {
+            let startup = self.host.startup.borrow().clone();
             for index in 0..STARTUP_LINES {
-                // The answer is written before the wait, so the blocks stay borrowed only here.
-                let sent = {
-                    let startup = self.host.startup.borrow();
-                    let line = startup.line(index);
-                    if line.is_empty() {
-                        continue;
-                    }
-                    // Checked when stored: a startup block changes modes and offsets, and moves
-                    // nothing.
-                    let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
-                    link.send(|a| report::startup_result(a, line, result))
-                };
-                sent.await;
+                let line = startup.line(index);
+                if line.is_empty() {
+                    continue;
+                }
+                // Checked when stored: a startup block changes modes and offsets, and moves
+                // nothing.
+                let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
+                for link in links {
+                    link.send(|a| report::startup_result(a, line, result)).await;
+                }
             }
         }
         machine.set_work_offset_mm(self.gcode.work_offset_mm());
+    }
+
+    /// After a line: if it changed what a power cycle keeps, saves it once the machine has
+    /// stopped (a flash write stalls the pulses), so the line's `ok` means it is kept. A store
+    /// that fails is reported; the line stands.
+    async fn keep(&mut self, link: &Link) -> Result<(), Unfinished> {
+        let machine = self.host.machine;
+        let record = Record::of(&machine.settings(), self.gcode.offsets(), &self.host.startup.borrow());
+        if self.store.holds(&record) {
+            return Ok(());
+        }
+        unless_reset(link, self.host.machine_stopped()).await?;
+        if let Err(e) = self.store.save(&record) {
+            link.send(|a| report::message(a, e.message())).await;
+        }
+        Ok(())
     }
 
     /// Parses one line of `link` and carries it out.

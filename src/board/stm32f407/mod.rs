@@ -31,6 +31,7 @@ use core::convert::Infallible;
 use defmt::{info, unwrap};
 use defmt_rtt as _;
 use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::flash::{Blocking as FlashBlocking, Flash};
 use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
@@ -45,7 +46,7 @@ use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
 use servoplot::machine::Machine;
 use servoplot::pulse::{StepProducer, StepQueue};
-use servoplot::settings::Settings;
+use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
 use servoplot::tasks::{self, lcd::St7920Lcd};
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
@@ -102,10 +103,12 @@ async fn keypad(machine: &'static Machine, columns: [Output<'static>; 4], rows: 
 #[embassy_executor::task]
 async fn serial(
     machine: &'static Machine,
+    store: Store<Flash<'static, FlashBlocking>>,
+    loaded: Result<(), StoreError>,
     uart: (BufferedUartRx<'static>, BufferedUartTx<'static>),
     usb: UsbLink,
 ) -> ! {
-    tasks::serial::run(machine, uart, usb).await
+    tasks::serial::run(machine, store, loaded, uart, usb).await
 }
 
 #[embassy_executor::task]
@@ -162,7 +165,10 @@ fn clocks() -> Config {
 async fn main(spawner: Spawner) {
     let p = embassy_stm32::init(clocks());
     info!("servoplot {} on STM32F407VG at {} MHz", env!("CARGO_PKG_VERSION"), SYSCLK_HZ / 1_000_000);
-    let machine: &'static Machine = MACHINE.init(Machine::new(Settings::default()));
+    // What the last power cycle kept: the settings the machine starts with, and the offsets and
+    // startup blocks the serial task starts with.
+    let (store, loaded) = Store::open(Flash::new_blocking(p.FLASH), STORE_FLASH_RANGE);
+    let machine: &'static Machine = MACHINE.init(Machine::new(store.kept().settings.clone()));
 
     // Step/direction outputs, low (no pulse) until the pulse task drives them.
     // PULS on TIM1's PWM outputs (low until a period ends with a pulse), SIGN on GPIO.
@@ -218,7 +224,7 @@ async fn main(spawner: Spawner) {
     interrupt::USART2.set_priority(HOST_LINK_PRIORITY);
     let (tx, rx) = uart.split();
     let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, HOST_LINK_PRIORITY);
-    spawner.spawn(unwrap!(serial(machine, (rx, tx), usb)));
+    spawner.spawn(unwrap!(serial(machine, store, loaded, (rx, tx), usb)));
 
     let mut spi_config = spi::Config::default();
     spi_config.frequency = Hertz(LCD_SPI_HZ);

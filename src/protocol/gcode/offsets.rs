@@ -5,9 +5,12 @@
 //! A machine position is a work position plus the active system's offset plus the G92 offset.
 //! GRBL stores G54–G59, G28 and G30 in EEPROM: they outlive a soft reset and are cleared only by
 //! `$RST=#` (or `$RST=*`), while the G92 offset is lost at every reset. The plotter keeps the
-//! same rules, but in RAM: there is no flash store yet, so a power cycle loses them all.
+//! same rules: [`crate::store`] keeps the [`kept_mm`](Offsets::kept_mm) ones in flash.
 
 use super::modal::{WORK_SYSTEMS, WorkSystem};
+
+/// The offsets a power cycle keeps: G54 to G59, then G28 and G30.
+pub const KEPT_OFFSETS: usize = WORK_SYSTEMS + 2;
 
 /// The two stored positions: G28 and G30 go to them, G28.1 and G30.1 set them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,6 +79,20 @@ impl Offsets {
     pub fn work_offset_mm(&self, active: WorkSystem) -> [f32; 2] {
         let system = self.system_mm(active);
         [system[0] + self.g92_mm[0], system[1] + self.g92_mm[1]]
+    }
+
+    /// What a power cycle keeps: G54 to G59, then G28 and G30, machine millimetres.
+    pub fn kept_mm(&self) -> [[f32; 2]; KEPT_OFFSETS] {
+        core::array::from_fn(|i| if i < WORK_SYSTEMS { self.systems_mm[i] } else { self.stored_mm[i - WORK_SYSTEMS] })
+    }
+
+    /// The offsets at power-on, from what the last power cycle kept ([`kept_mm`](Self::kept_mm)).
+    pub fn from_kept_mm(kept: [[f32; 2]; KEPT_OFFSETS]) -> Offsets {
+        Offsets {
+            systems_mm: core::array::from_fn(|i| kept[i]),
+            stored_mm: [kept[WORK_SYSTEMS], kept[WORK_SYSTEMS + 1]],
+            g92_mm: [0.0; 2],
+        }
     }
 
     /// What a soft reset keeps: all but the G92 offset.

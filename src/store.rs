@@ -1,0 +1,296 @@
+//! The flash store: what the plotter keeps across power cycles (the settings, the work
+//! coordinate systems G54–G59, the G28 and G30 positions, the startup blocks and the build info
+//! line), as one [`Record`] in two erase sectors of flash set apart for it.
+//!
+//! It is a log over the two sectors. A sector starts with a header (a magic word and a sequence
+//! number, checksummed) written after each erase; saves append the whole record after the last
+//! one, each with its length and a CRC-32. Reading takes the last record whose CRC holds, in the
+//! sector with the highest sequence number that holds one. A save appends to that sector while
+//! it has room and nothing but erased flash after its last record; otherwise it erases the
+//! other sector, gives it the next sequence number and writes the record there. So:
+//!
+//! - **wear levelling:** a sector is erased once per sector full of records, the two in turn;
+//! - **power-loss safety:** the sector holding the record kept is never erased or written over
+//!   by a save, so a cut at any byte leaves it readable, or the new record complete (a torn
+//!   record fails its CRC and is skipped). Everything kept is one record, written whole: a cut
+//!   leaves the old values or the new ones, never a mix.
+//!
+//! Flash that reads back as something else (written by a firmware with another layout, a value
+//! out of range, or sectors the store never wrote) gives the defaults and says why; erased flash
+//! gives them silently.
+//!
+//! On the F407 a write or an erase stalls every fetch from flash, interrupts included: nothing
+//! else runs meanwhile, so the store is plain blocking code, and the serial task saves only at
+//! rest (as GRBL writes its EEPROM), between the lines that change what is kept.
+
+mod record;
+#[cfg(test)]
+mod tests;
+
+use core::ops::Range;
+
+use embedded_storage::nor_flash::NorFlash;
+
+pub use record::{BadRecord, LAYOUT_TAG, RECORD_MAX_BYTES, Record};
+
+/// The flash the store uses on the F407: sectors 10 and 11, its last two, as offsets from the
+/// start of flash. `memory.x` ends the firmware's flash before them.
+pub const STORE_FLASH_RANGE: Range<u32> = 0x000C_0000..0x0010_0000;
+/// The size of those sectors.
+pub const STORE_SECTOR_BYTES: usize = 128 * 1024;
+/// How many the store uses.
+pub const STORE_SECTORS: usize = 2;
+const _: () = assert!((STORE_FLASH_RANGE.end - STORE_FLASH_RANGE.start) as usize == STORE_SECTORS * STORE_SECTOR_BYTES);
+
+/// Starts a sector header: "SPLT".
+const SECTOR_MAGIC: u32 = 0x544c_5053;
+/// Sector header: magic, sequence number, CRC-32 of the two.
+const SECTOR_HEADER_BYTES: usize = 12;
+/// Record header: length of the record's bytes (u16), then this.
+const RECORD_MAGIC: u16 = 0x5252;
+/// Record header (length and magic) and CRC-32 trailer.
+const RECORD_OVERHEAD_BYTES: usize = 4 + 4;
+/// Records and headers are laid out on this boundary: a multiple of every flash's write size
+/// the store runs on (the F407 programs 32-bit words).
+const ALIGN_BYTES: usize = 4;
+/// The store's working buffer: the longest record with its header, padding and CRC.
+pub const STORE_BUFFER_BYTES: usize = (RECORD_MAX_BYTES + RECORD_OVERHEAD_BYTES).next_multiple_of(ALIGN_BYTES);
+
+/// Why the flash did not give back a record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub enum StoreError {
+    /// The sectors hold what the store did not write.
+    Corrupt,
+    /// A record of another firmware version, with other settings.
+    OtherVersion,
+    /// A record with a value out of its range.
+    Invalid,
+    /// The flash refused a read, a write or an erase.
+    Flash,
+}
+
+impl StoreError {
+    /// What a user is told.
+    pub fn message(self) -> &'static str {
+        match self {
+            StoreError::Corrupt => "Flash store unreadable: defaults loaded",
+            StoreError::OtherVersion => "Flash store from another version: defaults loaded",
+            StoreError::Invalid => "Flash store holds invalid values: defaults loaded",
+            StoreError::Flash => "Flash store failed",
+        }
+    }
+}
+
+/// What a scan found in one sector.
+#[derive(Clone, Copy, Debug, Default)]
+struct Sector {
+    /// The header's sequence number, if the header is whole.
+    seq: Option<u32>,
+    /// The last record whose CRC holds: its offset in the sector and length.
+    last: Option<(usize, usize)>,
+    /// Where the next record goes, if everything from there on is erased.
+    append_at: Option<usize>,
+}
+
+/// The flash store over `F`, in a range of it, and the record it keeps.
+pub struct Store<F: NorFlash> {
+    flash: F,
+    /// The first byte of the store in `flash`.
+    start: u32,
+    sectors: [Sector; STORE_SECTORS],
+    buf: [u8; STORE_BUFFER_BYTES],
+    kept: Record,
+    /// The flash holds `kept` (false after a failed save).
+    in_flash: bool,
+}
+
+impl<F: NorFlash> Store<F> {
+    /// Power-on: the store in `range` of `flash` ([`STORE_SECTORS`] erase sectors), keeping
+    /// the record read back, or the defaults and why none was read. Erased flash gives the
+    /// defaults and no error.
+    pub fn open(flash: F, range: Range<u32>) -> (Self, Result<(), StoreError>) {
+        assert!(range.len() == STORE_SECTORS * F::ERASE_SIZE && F::ERASE_SIZE.is_multiple_of(ALIGN_BYTES));
+        let mut store = Store {
+            flash,
+            start: range.start,
+            sectors: [Sector::default(); STORE_SECTORS],
+            buf: [0; STORE_BUFFER_BYTES],
+            kept: Record::default(),
+            in_flash: true,
+        };
+        let loaded = store.load();
+        if let Err(e) = loaded {
+            warn!("flash store: {}", e.message());
+        }
+        (store, loaded)
+    }
+
+    /// What the flash keeps (as read at power-on or last saved).
+    pub fn kept(&self) -> &Record {
+        &self.kept
+    }
+
+    /// Whether the flash holds `record` already: saving it would change nothing.
+    pub fn holds(&self, record: &Record) -> bool {
+        self.in_flash && *record == self.kept
+    }
+
+    /// Keeps `record` in place of the one kept so far. If the flash fails, what it keeps is
+    /// unknown: the next save writes again.
+    pub fn save(&mut self, record: &Record) -> Result<(), StoreError> {
+        let len = record.encode(&mut self.buf[4..]);
+        let saved = self.append(len);
+        if saved.is_err() {
+            warn!("flash store: {}", StoreError::Flash.message());
+            // What the flash holds now, so the next save still spares the record kept.
+            for s in 0..STORE_SECTORS {
+                self.sectors[s] = self.scan(s).map(|(sector, _)| sector).unwrap_or_default();
+            }
+        }
+        self.in_flash = saved.is_ok();
+        self.kept.clone_from(record);
+        saved.map_err(|_| StoreError::Flash)
+    }
+
+    /// The flash, given back.
+    pub fn into_flash(self) -> F {
+        self.flash
+    }
+
+    /// The sector holding the record kept: the highest sequence number with a record.
+    fn newest(&self) -> Option<usize> {
+        (0..STORE_SECTORS).filter(|&s| self.sectors[s].last.is_some()).max_by_key(|&s| self.sectors[s].seq)
+    }
+
+    fn load(&mut self) -> Result<(), StoreError> {
+        let mut foreign = false;
+        for s in 0..STORE_SECTORS {
+            let (sector, empty) = self.scan(s).map_err(|_| StoreError::Flash)?;
+            self.sectors[s] = sector;
+            foreign |= sector.seq.is_none() && !empty;
+        }
+        let Some(s) = self.newest() else {
+            return if foreign { Err(StoreError::Corrupt) } else { Ok(()) };
+        };
+        let (at, len) = self.sectors[s].last.unwrap_or_default();
+        let from = self.sector_start(s) + at as u32 + 4;
+        let bytes = &mut self.buf[..len];
+        self.flash.read(from, bytes).map_err(|_| StoreError::Flash)?;
+        self.kept = Record::decode(bytes).map_err(|bad| match bad {
+            BadRecord::OtherLayout => StoreError::OtherVersion,
+            BadRecord::Invalid => StoreError::Invalid,
+        })?;
+        Ok(())
+    }
+
+    fn sector_start(&self, s: usize) -> u32 {
+        self.start + (s * F::ERASE_SIZE) as u32
+    }
+
+    /// Reads sector `s`: its header, its last good record and where a record may go next; and
+    /// whether it holds nothing past a bad header (erased, or a header write cut short).
+    fn scan(&mut self, s: usize) -> Result<(Sector, bool), F::Error> {
+        let base = self.sector_start(s);
+        let mut header = [0u8; SECTOR_HEADER_BYTES];
+        self.flash.read(base, &mut header)?;
+        let mut sector = Sector::default();
+        let [magic, seq, crc] = [0, 4, 8].map(|i| u32::from_le_bytes([0, 1, 2, 3].map(|k| header[i + k])));
+        if magic != SECTOR_MAGIC || crc != crc32(&header[..8]) {
+            // Erased, or a header cut short (erased after it): nothing the store wrote is lost.
+            // Anything else is not the store's.
+            return Ok((sector, self.erased_from(base, SECTOR_HEADER_BYTES)?));
+        }
+        sector.seq = Some(seq);
+        let mut at = SECTOR_HEADER_BYTES;
+        // Records one after another up to the first that is not whole: a torn write, or the
+        // erased end of the log.
+        while at + RECORD_OVERHEAD_BYTES <= F::ERASE_SIZE {
+            let mut head = [0u8; 4];
+            self.flash.read(base + at as u32, &mut head)?;
+            let len = usize::from(u16::from_le_bytes([head[0], head[1]]));
+            let size = (len + RECORD_OVERHEAD_BYTES).next_multiple_of(ALIGN_BYTES);
+            if u16::from_le_bytes([head[2], head[3]]) != RECORD_MAGIC
+                || size > STORE_BUFFER_BYTES
+                || at + size > F::ERASE_SIZE
+            {
+                break;
+            }
+            let bytes = &mut self.buf[..size];
+            self.flash.read(base + at as u32, bytes)?;
+            let crc = u32::from_le_bytes([0, 1, 2, 3].map(|k| bytes[size - 4 + k]));
+            if crc != crc32(&bytes[..size - 4]) {
+                break;
+            }
+            sector.last = Some((at, len));
+            at += size;
+        }
+        if sector.seq.is_some() && self.erased_from(base, at)? {
+            sector.append_at = Some(at);
+        }
+        Ok((sector, false))
+    }
+
+    /// Whether every byte of the sector at `base` from `at` on is erased.
+    fn erased_from(&mut self, base: u32, mut at: usize) -> Result<bool, F::Error> {
+        let mut chunk = [0u8; 64];
+        while at < F::ERASE_SIZE {
+            let n = chunk.len().min(F::ERASE_SIZE - at);
+            self.flash.read(base + at as u32, &mut chunk[..n])?;
+            if chunk[..n].iter().any(|&b| b != 0xFF) {
+                return Ok(false);
+            }
+            at += n;
+        }
+        Ok(true)
+    }
+
+    /// Writes the record of `len` bytes at `buf[4..]`: after the record kept if its sector has
+    /// room, else in the other sector, erased and numbered next.
+    fn append(&mut self, len: usize) -> Result<(), F::Error> {
+        let size = (len + RECORD_OVERHEAD_BYTES).next_multiple_of(ALIGN_BYTES);
+        self.buf[..2].copy_from_slice(&(len as u16).to_le_bytes());
+        self.buf[2..4].copy_from_slice(&RECORD_MAGIC.to_le_bytes());
+        self.buf[4 + len..size - 4].fill(0xFF);
+        let crc = crc32(&self.buf[..size - 4]);
+        self.buf[size - 4..size].copy_from_slice(&crc.to_le_bytes());
+
+        let newest = self.newest();
+        let fits = |sector: &Sector| sector.append_at.is_some_and(|at| at + size <= F::ERASE_SIZE);
+        let (s, at) = match newest.filter(|&s| fits(&self.sectors[s])) {
+            Some(s) => (s, self.sectors[s].append_at.unwrap_or_default()),
+            None => {
+                // Never the sector holding the record kept.
+                let s = newest.map_or(0, |n| (n + 1) % STORE_SECTORS);
+                let seq = newest.and_then(|n| self.sectors[n].seq).map_or(1, |q| q.wrapping_add(1));
+                self.sectors[s] = Sector::default();
+                let base = self.sector_start(s);
+                self.flash.erase(base, base + F::ERASE_SIZE as u32)?;
+                let mut header = [0u8; SECTOR_HEADER_BYTES];
+                header[..4].copy_from_slice(&SECTOR_MAGIC.to_le_bytes());
+                header[4..8].copy_from_slice(&seq.to_le_bytes());
+                let crc = crc32(&header[..8]);
+                header[8..].copy_from_slice(&crc.to_le_bytes());
+                self.flash.write(base, &header)?;
+                self.sectors[s].seq = Some(seq);
+                (s, SECTOR_HEADER_BYTES)
+            }
+        };
+        self.flash.write(self.sector_start(s) + at as u32, &self.buf[..size])?;
+        self.sectors[s].last = Some((at, len));
+        self.sectors[s].append_at = Some(at + size);
+        Ok(())
+    }
+}
+
+/// CRC-32 (IEEE 802.3, reflected), bit by bit: a few hundred bytes per save or record read.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &byte in bytes {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
+}
