@@ -1,5 +1,6 @@
-//! The servo-on task: drives the drivers' SON input from the machine's state. The servos hold
-//! position from power-on, and go off while the machine sleeps (`$SLP`) until a reset.
+//! The servo-on task: drives the drivers' SON input from the machine's state. SON stays low
+//! from power-on until this task runs (the board starts it with the pulse engine running); the
+//! servos then hold position, and go off while the machine sleeps (`$SLP`) until a reset.
 
 use embassy_time::{Duration, Timer};
 use embedded_hal::digital::{OutputPin, PinState};

@@ -11,7 +11,7 @@
 //! |---------------------|------|----------------------------------------------------|
 //! | X PULS / X SIGN     | PE9 / PE10  | TIM1 CH1 / GPIO, to the X driver's PULS+/SIGN+ |
 //! | Y PULS / Y SIGN     | PE11 / PE12 | TIM1 CH2 / GPIO, to the Y driver's PULS+/SIGN+ |
-//! | servo on (SON)      | PE13 | high once the firmware runs, low while asleep (`$SLP`) |
+//! | servo on (SON)      | PE13 | high once the tasks run, low while asleep (`$SLP`) or after a fault |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
 //! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
@@ -178,8 +178,8 @@ async fn main(spawner: Spawner) {
         PwmPin::new(p.PE11, OutputType::PushPull),
         [Output::new(p.PE10, Level::Low, Speed::VeryHigh), Output::new(p.PE12, Level::Low, Speed::VeryHigh)],
     );
-    // Servo on: the drivers hold position from here on, off only while the machine sleeps.
-    let son = Output::new(p.PE13, Level::High, Speed::Low);
+    // Servo on: low until the servo task, started with the pulse engine running, turns it on.
+    let son = Output::new(p.PE13, Level::Low, Speed::Low);
 
     interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
     let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
