@@ -153,11 +153,6 @@ impl<F: NorFlash> Store<F> {
         saved.map_err(|_| StoreError::Flash)
     }
 
-    /// The flash, given back.
-    pub fn into_flash(self) -> F {
-        self.flash
-    }
-
     /// The sector holding the record kept: the highest sequence number with a record.
     fn newest(&self) -> Option<usize> {
         (0..STORE_SECTORS).filter(|&s| self.sectors[s].last.is_some()).max_by_key(|&s| self.sectors[s].seq)
@@ -195,7 +190,7 @@ impl<F: NorFlash> Store<F> {
         let mut header = [0u8; SECTOR_HEADER_BYTES];
         self.flash.read(base, &mut header)?;
         let mut sector = Sector::default();
-        let [magic, seq, crc] = [0, 4, 8].map(|i| u32::from_le_bytes([0, 1, 2, 3].map(|k| header[i + k])));
+        let [magic, seq, crc] = [0, 4, 8].map(|at| le_u32(&header, at));
         if magic != SECTOR_MAGIC || crc != crc32(&header[..8]) {
             // Erased, or a header cut short (erased after it): nothing the store wrote is lost.
             // Anything else is not the store's.
@@ -218,8 +213,7 @@ impl<F: NorFlash> Store<F> {
             }
             let bytes = &mut self.buf[..size];
             self.flash.read(base + at as u32, bytes)?;
-            let crc = u32::from_le_bytes([0, 1, 2, 3].map(|k| bytes[size - 4 + k]));
-            if crc != crc32(&bytes[..size - 4]) {
+            if le_u32(bytes, size - 4) != crc32(&bytes[..size - 4]) {
                 break;
             }
             sector.last = Some((at, len));
@@ -281,6 +275,11 @@ impl<F: NorFlash> Store<F> {
         self.sectors[s].append_at = Some(at + size);
         Ok(())
     }
+}
+
+/// The little-endian word at `at` in `bytes`.
+fn le_u32(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([0, 1, 2, 3].map(|k| bytes[at + k]))
 }
 
 /// CRC-32 (IEEE 802.3, reflected), bit by bit: a few hundred bytes per save or record read.

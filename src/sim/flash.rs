@@ -112,11 +112,6 @@ impl<const SECTOR_BYTES: usize> SimFlash<SECTOR_BYTES> {
         self.erases.borrow().clone()
     }
 
-    /// Whether the power was cut.
-    pub fn power_cut(&self) -> bool {
-        self.power_bytes.get() == Some(0)
-    }
-
     /// Sets the bytes from `offset` on by `change`, one byte at a time while the power lasts,
     /// writing them through to the file.
     fn change(&self, offset: usize, len: usize, change: impl Fn(usize, u8) -> u8) -> Result<(), SimFlashError> {
