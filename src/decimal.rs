@@ -250,11 +250,62 @@ pub fn write_fixed(out: &mut impl core::fmt::Write, value: f32, decimals: u8) ->
         });
     };
     let decimals = decimals.min(WRITE_MAX_DECIMALS);
-    let sign = if negative && (whole != 0 || fraction != 0) { "-" } else { "" };
-    if decimals == 0 {
-        write!(out, "{sign}{whole}")
-    } else {
-        write!(out, "{sign}{whole}.{fraction:0width$}", width = usize::from(decimals))
+    if negative && (whole != 0 || fraction != 0) {
+        out.write_char('-')?;
+    }
+    write_digits(out, whole, 1)?;
+    if decimals > 0 {
+        out.write_char('.')?;
+        write_digits(out, u64::from(fraction), usize::from(decimals))?;
+    }
+    Ok(())
+}
+
+/// Digits of the largest `u64`.
+const U64_MAX_DIGITS: usize = 20;
+
+/// Writes `value` in decimal, with leading zeros up to `min_digits` digits (at most
+/// [`U64_MAX_DIGITS`]). The firmware writes every integer through here: core's integer
+/// formatting and padding would cost flash for widths it never uses.
+pub fn write_digits(out: &mut impl core::fmt::Write, mut value: u64, min_digits: usize) -> core::fmt::Result {
+    let mut digits = [0u8; U64_MAX_DIGITS];
+    let mut start = U64_MAX_DIGITS;
+    let min_start = U64_MAX_DIGITS - min_digits.clamp(1, U64_MAX_DIGITS);
+    while value > 0 || start > min_start {
+        start -= 1;
+        digits[start] = (value % 10) as u8;
+        value /= 10;
+    }
+    digits[start..].iter().try_for_each(|&d| out.write_char(char::from(b'0' + d)))
+}
+
+/// An integer, for format strings: `write!(out, "error:{}", Int(code))`. See [`write_digits`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Int(pub i64);
+
+impl core::fmt::Display for Int {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        if self.0 < 0 {
+            core::fmt::Write::write_char(f, '-')?;
+        }
+        write_digits(f, self.0.unsigned_abs(), 1)
+    }
+}
+
+macro_rules! int_from {
+    ($($t:ty),*) => {$(
+        impl From<$t> for Int {
+            fn from(value: $t) -> Int {
+                Int(i64::from(value))
+            }
+        }
+    )*};
+}
+int_from!(u8, u16, u32, i8, i16, i32);
+
+impl From<usize> for Int {
+    fn from(value: usize) -> Int {
+        Int(i64::try_from(value).unwrap_or(i64::MAX))
     }
 }
 
@@ -480,6 +531,19 @@ mod tests {
             prop_assert_eq!(read(&format!("-{text}"), SIGNED), Ok((-v, n + 1)));
             prop_assert_eq!(read(&format!("+{text}"), SIGNED), Ok((v, n + 1)));
         }
+    }
+
+    #[test]
+    fn integers_are_written_like_core_writes_them() {
+        for v in [0i64, 7, -7, 10, 255, 65_535, -1_000_000, i64::MAX, i64::MIN] {
+            assert_eq!(format!("{}", Int(v)), format!("{v}"));
+        }
+        assert_eq!(format!("{}", Int::from(usize::MAX)), format!("{}", i64::MAX));
+        let mut s = String::new();
+        write_digits(&mut s, 42, 5).unwrap();
+        write_digits(&mut s, 0, 0).unwrap();
+        write_digits(&mut s, u64::MAX, 30).unwrap();
+        assert_eq!(s, "00042018446744073709551615");
     }
 
     fn fixed(value: f32, decimals: u8) -> std::string::String {

@@ -12,6 +12,7 @@ use core::fmt::{self, Write};
 
 use super::GrblError;
 use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, StoredPosition, Units, WorkSystem};
+use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::Axis;
 use crate::interp::CurveError;
@@ -41,7 +42,7 @@ pub fn ok(out: &mut impl Write) -> fmt::Result {
 pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
     match error {
         GrblError::Expression { column, kind } => {
-            write!(out, "[MSG:Expression error at column {column}: {}]\r\n", kind.message())?;
+            write!(out, "[MSG:Expression error at column {}: {}]\r\n", Int::from(column), kind.message())?;
         }
         GrblError::FunctionUndefined { x_mm, error } => {
             out.write_str("[MSG:Function undefined at x=")?;
@@ -51,7 +52,7 @@ pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
         GrblError::Drawing(e) => drawing_refused(out, e)?,
         _ => {}
     }
-    write!(out, "error:{}\r\n", error.code())
+    write!(out, "error:{}\r\n", Int::from(error.code()))
 }
 
 /// Why the drawing builder refused a drawing, as an info line.
@@ -97,7 +98,7 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
         CurveError::Jump => "jump over $204",
         CurveError::Travel => "travel limit",
     };
-    write!(out, "ALARM:{code}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n")
+    write!(out, "ALARM:{}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n", Int::from(code))
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
@@ -145,20 +146,20 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
     let y = settings.steps_to_mm(Axis::Y, status.position.y) - oy;
     xyz(out, x, y)?;
     if settings.status_report_mask & 2 != 0 {
-        write!(out, "|Bf:{},{}", fields.buffer.0, fields.buffer.1)?;
+        write!(out, "|Bf:{},{}", Int::from(fields.buffer.0), Int::from(fields.buffer.1))?;
     }
     let speed = fields.speed_mm_per_min;
     let feed = if speed.is_finite() { crate::math::round(speed.abs()) as u32 } else { 0 };
-    write!(out, "|FS:{feed},0")?;
+    write!(out, "|FS:{},0", Int::from(feed))?;
     if fields.wco {
         out.write_str("|WCO:")?;
         xyz(out, fields.work_offset_mm[0], fields.work_offset_mm[1])?;
     }
     if let Some([feed, rapid, spindle]) = fields.overrides {
-        write!(out, "|Ov:{feed},{rapid},{spindle}")?;
+        write!(out, "|Ov:{},{},{}", Int::from(feed), Int::from(rapid), Int::from(spindle))?;
     }
     if status.underruns > 0 {
-        write!(out, "|Un:{}", status.underruns)?;
+        write!(out, "|Un:{}", Int::from(status.underruns))?;
     }
     out.write_str(">\r\n")
 }
@@ -174,9 +175,9 @@ pub fn settings(out: &mut impl Write, settings: &Settings) -> fmt::Result {
 /// One `$N=value` line; nothing for an unknown id.
 pub fn setting(out: &mut impl Write, id: u16, settings: &Settings) -> fmt::Result {
     let Ok(value) = settings.get(id) else { return Ok(()) };
-    write!(out, "${id}=")?;
+    write!(out, "${}=", Int::from(id))?;
     if INTEGER_SETTINGS.contains(&id) {
-        write!(out, "{}", value as i64)?;
+        write!(out, "{}", Int(value as i64))?;
     } else {
         decimal(out, value)?;
     }
@@ -214,6 +215,7 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
     };
     let system = gcode.work_system().gcode();
     let tool = gcode.tool();
+    let (system, tool, feed, speed) = (Int::from(system), Int::from(tool), Int::from(feed), Int::from(speed));
     write!(out, "[GC:{motion} G{system} G17 {units} {distance} G94 {spindle} {coolant} T{tool} F{feed} S{speed}]\r\n")
 }
 
@@ -224,7 +226,7 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
 pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
     let offsets = gcode.offsets();
     for system in WorkSystem::all() {
-        write!(out, "[G{}:", system.gcode())?;
+        write!(out, "[G{}:", Int::from(system.gcode()))?;
         xyz_line_end(out, offsets.system_mm(system))?;
     }
     for (name, which) in [("G28", StoredPosition::G28), ("G30", StoredPosition::G30)] {
@@ -245,7 +247,8 @@ fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
 /// `$I`: version and GRBL's `[OPT:codes,blocks,rx]` line. Senders size their character-counting
 /// window from `rx_buffer_bytes`, so it must be the serial task's real receive buffer.
 pub fn build_info(out: &mut impl Write, info: &str, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
-    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:{info}]\r\n[OPT:,{planner_blocks},{rx_buffer_bytes}]\r\n")
+    let (blocks, rx) = (Int::from(planner_blocks), Int::from(rx_buffer_bytes));
+    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:{info}]\r\n[OPT:,{blocks},{rx}]\r\n")
 }
 
 /// `$`: the commands the plotter understands.
@@ -256,7 +259,7 @@ pub fn help(out: &mut impl Write) -> fmt::Result {
 /// `$N`: every startup block, `$Nn=line` per line, empty ones included.
 pub fn startup_lines(out: &mut impl Write, lines: &StartupLines) -> fmt::Result {
     for (n, line) in lines.all().enumerate() {
-        write!(out, "$N{n}={line}\r\n")?;
+        write!(out, "$N{}={line}\r\n", Int::from(n))?;
     }
     Ok(())
 }
@@ -266,7 +269,7 @@ pub fn startup_result(out: &mut impl Write, line: &str, result: Result<(), GrblE
     write!(out, ">{line}:")?;
     match result {
         Ok(()) => ok(out),
-        Err(e) => write!(out, "error:{}\r\n", e.code()),
+        Err(e) => write!(out, "error:{}\r\n", Int::from(e.code())),
     }
 }
 

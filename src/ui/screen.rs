@@ -29,6 +29,7 @@ use embedded_graphics::primitives::Rectangle;
 use embedded_graphics::text::{Baseline, Text};
 use heapless::String;
 
+use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::{Axis, Step};
 use crate::interp::{CurveError, Method};
@@ -92,8 +93,8 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
                 Cut(&mut title_text),
                 "{} {}/{}",
                 form.mode().title(),
-                form.field_index() + 1,
-                form.mode().fields().len()
+                Int::from(form.field_index() + 1),
+                Int::from(form.mode().fields().len())
             )
         }
     };
@@ -107,8 +108,8 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
             let first = menu.selected().index().min(Mode::ALL.len() - 2);
             for (line, i) in [l2, l3].into_iter().zip(first..) {
                 let mode = Mode::ALL[i];
-                let marker = if mode == menu.selected() { '>' } else { ' ' };
-                *line = TextLine::new(format_args!("{marker}{} {}", i + 1, mode.label()), false);
+                let marker = if mode == menu.selected() { ">" } else { " " };
+                *line = TextLine::new(format_args!("{marker}{} {}", Int::from(i + 1), mode.label()), false);
             }
         }
         Screen::Jog => match menu.jog() {
@@ -133,7 +134,7 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
             }
             Some(Field::Preset) => {
                 let p = form.preset();
-                *l2 = TextLine::new(format_args!("f{} y={}", p.index() + 1, p.expression()), false);
+                *l2 = TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), p.expression()), false);
                 *l3 = TextLine::new(format_args!("1-5 or A/B pick, # ok"), false);
             }
             None => {}
@@ -155,12 +156,12 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
         let feed = status.overrides.feed_percent;
         let mut what: String<SCREEN_COLUMNS> = String::new();
         let _ = match status.state {
-            RunState::Run if feed != OVERRIDE_NONE_PERCENT => write!(Cut(&mut what), "{doing} F{feed}%"),
+            RunState::Run if feed != OVERRIDE_NONE_PERCENT => write!(Cut(&mut what), "{doing} F{}%", Int::from(feed)),
             _ => Cut(&mut what).write_str(doing),
         };
         lines[2] = match status.queued_jobs {
             0 => TextLine::new(format_args!("{what}"), false),
-            n => TextLine::new(format_args!("{what}, {n} queued"), false),
+            n => TextLine::new(format_args!("{what}, {} queued", Int::from(n)), false),
         };
         lines[3] = TextLine::new(format_args!("{keys}"), false);
     }
@@ -264,7 +265,7 @@ struct Direction(Step);
 
 impl fmt::Display for Direction {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (v, axis) in [(self.0.x, 'X'), (self.0.y, 'Y')] {
+        for (v, axis) in [(self.0.x, "X"), (self.0.y, "Y")] {
             match v {
                 1.. => write!(f, "+{axis}")?,
                 ..0 => write!(f, "-{axis}")?,
@@ -280,7 +281,7 @@ struct ErrorText(UiError);
 impl fmt::Display for ErrorText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.0 {
-            UiError::Entry(EntryError::TooLong) => write!(f, "Max {ENTRY_MAX_CHARS} characters"),
+            UiError::Entry(EntryError::TooLong) => write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
             UiError::Entry(EntryError::NotANumber) => f.write_str("Not a number"),
             UiError::Empty => f.write_str("Type a value"),
             UiError::OutOfRange { min, max, unit } => write!(f, "Range {}..{} {}", Num(min), Num(max), unit.symbol()),
