@@ -20,6 +20,14 @@ impl Axis {
             Axis::Y => 1,
         }
     }
+
+    /// `X` or `Y`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Axis::X => "X",
+            Axis::Y => "Y",
+        }
+    }
 }
 
 /// A lattice point, in steps.

@@ -27,6 +27,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
+use crate::inputs::{InputLevels, Trip};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
 use crate::overrides::{OverrideCommand, Overrides};
@@ -120,6 +121,15 @@ pub struct Machine {
     drawing: AtomicU8,
     settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
     fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
+    /// An input tripped: the pulse engine stops at once and starts nothing until the alarm is
+    /// cleared. Set by [`trip`](Self::trip), cleared by [`unlock`](Self::unlock).
+    halted: AtomicBool,
+    /// The trip the motion task has not yet handled.
+    trip: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
+    /// The step timer runs (written only by the pulse engine).
+    pulsing: AtomicBool,
+    /// The input levels last read at rest (written only by the servo task).
+    input_levels: AtomicU8,
 }
 
 impl Machine {
@@ -153,6 +163,10 @@ impl Machine {
             drawing: AtomicU8::new(0),
             settings: Mutex::new(RefCell::new(settings)),
             fault: Mutex::new(Cell::new(None)),
+            halted: AtomicBool::new(false),
+            trip: Mutex::new(Cell::new(None)),
+            pulsing: AtomicBool::new(false),
+            input_levels: AtomicU8::new(0),
         }
     }
 
@@ -391,9 +405,70 @@ impl Machine {
         }
     }
 
-    /// Whether the servo drivers are to be enabled (SON high).
+    /// Whether the servo drivers are to be enabled (SON high): not asleep, and not after a
+    /// driver alarm until it is cleared.
     pub fn servos_on(&self) -> bool {
-        !self.asleep.load(Ordering::Relaxed)
+        let driver_alarm = matches!(self.fault(), Some(MotionFault::Tripped(Trip::DriverAlarm(_))));
+        let off_for_alarm = driver_alarm && self.halted();
+        !self.asleep.load(Ordering::Relaxed) && !off_for_alarm
+    }
+
+    /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it
+    /// has not stopped itself already, and starts nothing until [`unlock`](Self::unlock); the
+    /// motion task drops what was planned and raises the alarm. A trip while halted is no news.
+    pub fn trip(&self, trip: Trip) {
+        if self.halted.swap(true, Ordering::AcqRel) {
+            return;
+        }
+        self.trip.lock(|t| t.set(Some(trip)));
+        self.control_requested.signal(());
+        self.changed.signal(());
+    }
+
+    /// True from a trip until the alarm is cleared: no pulse goes out.
+    #[inline(always)]
+    pub fn halted(&self) -> bool {
+        self.halted.load(Ordering::Relaxed)
+    }
+
+    /// The trip the motion task has yet to handle, taking it. Only the motion task calls this.
+    pub fn take_trip(&self) -> Option<Trip> {
+        self.trip.lock(|t| t.take())
+    }
+
+    /// The step timer starts or stops. Only the pulse engine calls this.
+    pub fn set_pulsing(&self, on: bool) {
+        self.pulsing.store(on, Ordering::Release);
+    }
+
+    /// True while the step timer runs.
+    pub fn pulsing(&self) -> bool {
+        self.pulsing.load(Ordering::Acquire)
+    }
+
+    /// Steps emitted so far and the sum of their intervals (both wrap): after a trip, all there
+    /// will be of what was queued.
+    pub fn emitted_totals(&self) -> (u32, u32) {
+        (self.emitted_steps.load(Ordering::Acquire), self.emitted_ticks.load(Ordering::Acquire))
+    }
+
+    /// The input levels read at rest. Only the servo task calls this.
+    pub fn set_input_levels(&self, levels: InputLevels) {
+        self.input_levels.store(levels, Ordering::Relaxed);
+    }
+
+    /// The input levels last read.
+    pub fn input_levels(&self) -> InputLevels {
+        self.input_levels.load(Ordering::Relaxed)
+    }
+
+    /// `$X`: leaves the alarm, and lets pulses out again after a trip (handled by the motion
+    /// task by now: the machine has stopped). Only the serial task calls this.
+    pub fn unlock(&self) {
+        if self.run_state() == RunState::Alarm {
+            self.set_run_state(RunState::Idle);
+        }
+        self.halted.store(false, Ordering::Release);
     }
 
     /// A snapshot for displays and reports.

@@ -275,6 +275,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         }
     }
 
+    /// Drops everything at once, without braking: the pulses were cut by a trip, and the machine
+    /// stands where they stopped.
+    pub fn drop_all(&mut self) {
+        self.request = Request::Abort;
+        self.rest();
+    }
+
     /// The machine is at rest: finishes an abort, applies pending limits.
     fn rest(&mut self) {
         self.speed = None;

@@ -24,11 +24,18 @@
 //! * When the queue runs dry at a rest, the engine stops the timer once the last pulse is out,
 //!   and signals the motion task.
 //!
+//! At the start of each period the engine also samples the machine's inputs ([`crate::inputs`]):
+//! the limit switches the step now starting runs towards, the drivers' alarms and the emergency
+//! stop. Once one has tripped, or anything else has tripped the machine ([`Machine::trip`]), it
+//! halts the timer before that period's pulse, so the pulses stop within one period, and starts
+//! nothing until the alarm is cleared.
+//!
 //! Nothing here decides anything about motion. On the board [`PulseEngine::on_period`] runs in
 //! the step timer's interrupt, the highest priority; in the simulator a model of the timer
 //! calls it at the virtual times the hardware would.
 
 use crate::geom::{Axis, StepCmd, TICK_HZ};
+use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, limits_toward};
 use crate::machine::Machine;
 use crate::math;
 use crate::settings::Settings;
@@ -43,8 +50,9 @@ pub const UNDERRUN_WAIT_TICKS: u32 = 20 * (TICK_HZ / 1_000_000);
 /// Length of the pulse-less period after the last pulse, at whose start the timer stops.
 const TAIL_TICKS: u32 = 10 * (TICK_HZ / 1_000_000);
 
-/// The hardware the engine drives: a timer that counts one period at a time and ends each with
-/// a pulse on the axes chosen for it, and the two SIGN outputs.
+/// The hardware the engine drives and watches: a timer that counts one period at a time and ends
+/// each with a pulse on the axes chosen for it, the two SIGN outputs, and the machine's input
+/// pins.
 pub trait StepTimer {
     /// Longest period the timer counts, ticks.
     const MAX_PERIOD_TICKS: u32;
@@ -62,6 +70,12 @@ pub trait StepTimer {
 
     /// Stops counting: no period follows the current one.
     fn stop(&mut self);
+
+    /// Stops counting at once, PULS low, whatever the period was to end with.
+    fn halt(&mut self);
+
+    /// The levels of the machine's input pins, read at once.
+    fn input_levels(&mut self) -> InputLevels;
 }
 
 /// Pulse timing, taken from the settings whenever the timer starts.
@@ -159,6 +173,13 @@ pub struct PulseEngine<'q, T: StepTimer> {
     long_wait: Option<(StepCmd, u32)>,
     /// The queue ran dry before a rest: an underrun is under way (counted once).
     starving: bool,
+    /// The inputs as the settings were when the timer started, and their debounce.
+    inputs: InputSetup,
+    debounce: Debounce,
+    /// Ticks counted (wrapping), up to the end of the preloaded period: the debounce's clock.
+    clock_ticks: u32,
+    /// The limit switches the step of the active period runs towards.
+    toward: u8,
 }
 
 impl<'q, T: StepTimer> PulseEngine<'q, T> {
@@ -174,6 +195,10 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             sign_preloaded: Signs::default(),
             long_wait: None,
             starving: false,
+            inputs: InputSetup::from_settings(&Settings::default()),
+            debounce: Debounce::default(),
+            clock_ticks: 0,
+            toward: 0,
         }
     }
 
@@ -193,18 +218,22 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
 
     /// The motion task queued commands: starts the timer if it is stopped and a step is queued.
     pub fn kick(&mut self, machine: &Machine) {
-        if self.running {
+        if self.running || machine.halted() {
             return;
         }
         if !self.queue.ready() {
             return;
         }
-        self.timing = Timing::from_settings(&machine.settings());
+        let settings = machine.settings();
+        self.timing = Timing::from_settings(&settings);
+        self.inputs = InputSetup::from_settings(&settings);
+        self.debounce.clear();
         self.sign_preloaded = self.sign;
         let first = self.next_period(machine);
         self.active = Period::Tail;
         self.preload(first);
         self.running = true;
+        machine.set_pulsing(true);
         self.timer.start(self.timing.width_ticks);
     }
 
@@ -220,16 +249,26 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             machine.emitted(cmd);
         }
         self.active = self.preloaded;
+        // The axes this period's pulse steps, and those it steps forward.
+        let mut directions = (0, 0);
+        if let Period::Step { cmd, .. } = self.active {
+            directions = step_bits(cmd, 0);
+            self.toward = limits_toward(directions.0, directions.1);
+        }
+        if self.tripped(machine) {
+            self.timer.halt();
+            self.stopped(machine);
+            return;
+        }
         match self.active {
-            Period::Step { cmd, .. } => self.drive_signs(cmd),
+            Period::Step { .. } => self.drive_signs(directions.0, directions.1),
             Period::Wait { .. } => {}
             Period::Tail => {
                 // The last pulse is out. Go on from rest if more came in behind the rest.
                 let next = self.next_period(machine);
                 if next == Period::Tail {
                     self.timer.stop();
-                    self.running = false;
-                    machine.pulses_stopped();
+                    self.stopped(machine);
                     return;
                 }
                 self.preload(next);
@@ -240,17 +279,44 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         self.preload(next);
     }
 
+    /// Samples the inputs the active period watches; true once the machine has tripped, by them
+    /// or otherwise.
+    #[inline(always)]
+    fn tripped(&mut self, machine: &Machine) -> bool {
+        let levels = self.timer.input_levels();
+        let active = self.inputs.active(levels) & (self.toward | ALWAYS_WATCHED);
+        if (active != 0 || self.debounce.holding())
+            && let Some(trip) = self.debounce.sample(active, self.clock_ticks, self.inputs.debounce_ticks)
+        {
+            machine.trip(trip);
+        }
+        machine.halted()
+    }
+
+    /// The timer has stopped: the engine is ready for the next kick.
+    fn stopped(&mut self, machine: &Machine) {
+        self.running = false;
+        self.active = Period::Tail;
+        self.preloaded = Period::Tail;
+        self.long_wait = None;
+        self.starving = false;
+        machine.set_pulsing(false);
+        machine.pulses_stopped();
+    }
+
     #[inline(always)]
     fn preload(&mut self, period: Period) {
         self.preloaded = period;
         let (ticks, axes) = period.timer_load();
+        // The debounce's clock runs one period ahead: only its differences count.
+        self.clock_ticks = self.clock_ticks.wrapping_add(ticks);
         self.timer.preload(ticks, axes);
     }
 
-    /// Drives SIGN for the axes `cmd` steps.
+    /// Drives SIGN for the axes in `moving`, those in `forward` forward.
     #[inline(always)]
-    fn drive_signs(&mut self, cmd: StepCmd) {
-        let (moving, high) = step_bits(cmd, self.timing.invert_mask);
+    fn drive_signs(&mut self, moving: u8, forward: u8) {
+        let high = (forward ^ self.timing.invert_mask) & moving;
         let changes = self.sign.changes(moving, high);
         if changes != 0 {
             for axis in Axis::ALL {
@@ -330,6 +396,9 @@ mod tests {
         sign: [bool; 2],
         /// (ticks, axes pulsed at the end, SIGN levels).
         periods: Vec<(u32, u8, [bool; 2])>,
+        /// The input levels read; halts seen.
+        levels: InputLevels,
+        halts: usize,
     }
 
     impl StepTimer for MockTimer {
@@ -346,6 +415,13 @@ mod tests {
         }
         fn stop(&mut self) {
             self.running = false;
+        }
+        fn halt(&mut self) {
+            self.running = false;
+            self.halts += 1;
+        }
+        fn input_levels(&mut self) -> InputLevels {
+            self.levels
         }
     }
 

@@ -30,10 +30,20 @@ pub struct SettingInfo {
 /// 200 kpps, a period of at least 5 µs).
 pub const MAX_PULSE_RATE_HZ: f32 = 200_000.0;
 
+/// Longest input debounce (`$206`): a switch held this long is no bounce.
+pub const INPUT_DEBOUNCE_MAX_MS: u32 = 100;
+
 /// Every setting, in `$$` listing order.
 pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, name: "pulse width", unit: "us", min: 2.5, max: 100.0 },
     SettingInfo { id: 3, name: "direction invert mask", unit: "mask", min: 0.0, max: 3.0 },
+    SettingInfo {
+        id: 5,
+        name: "limit pins invert (0 normally open, 1 normally closed)",
+        unit: "bool",
+        min: 0.0,
+        max: 1.0,
+    },
     SettingInfo {
         id: 10,
         name: "status report (1 machine position, +2 buffer state)",
@@ -42,6 +52,7 @@ pub const SETTING_INFO: &[SettingInfo] = &[
         max: 3.0,
     },
     SettingInfo { id: 11, name: "junction deviation", unit: "mm", min: 0.0, max: 5.0 },
+    SettingInfo { id: 21, name: "hard limits", unit: "bool", min: 0.0, max: 1.0 },
     SettingInfo { id: 100, name: "x steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
     SettingInfo { id: 101, name: "y steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
     SettingInfo { id: 110, name: "x max rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
@@ -56,6 +67,9 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 203, name: "default feed rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
     SettingInfo { id: 204, name: "max function jump", unit: "mm", min: 0.01, max: 500.0 },
     SettingInfo { id: 205, name: "max pulse rate", unit: "Hz", min: 100.0, max: MAX_PULSE_RATE_HZ },
+    SettingInfo { id: 206, name: "input debounce", unit: "ms", min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
+    SettingInfo { id: 207, name: "driver alarm inputs", unit: "bool", min: 0.0, max: 1.0 },
+    SettingInfo { id: 208, name: "emergency stop input", unit: "bool", min: 0.0, max: 1.0 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -66,11 +80,15 @@ pub struct Settings {
     pub pulse_width_us: f32,
     /// Bit 0 inverts X's SIGN output, bit 1 Y's ($3).
     pub dir_invert_mask: u8,
+    /// The limit switches are normally closed: pressed reads high ($5).
+    pub limit_pins_invert: bool,
     /// What status reports show ($10): bit 0 set, the machine position (`MPos:`), clear, the
     /// work position (`WPos:`); bit 1, the buffer state (`Bf:`).
     pub status_report_mask: u8,
     /// GRBL's junction deviation for look-ahead at corners ($11).
     pub junction_deviation_mm: f32,
+    /// A limit switch pressed while moving towards it stops the machine in an alarm ($21).
+    pub hard_limits: bool,
     /// Steps per millimetre, X and Y ($100, $101).
     pub steps_per_mm: [f32; 2],
     /// Fastest travel per axis ($110, $111).
@@ -91,6 +109,14 @@ pub struct Settings {
     pub max_jump_mm: f32,
     /// Highest pulse frequency the drivers (and their optocouplers) take, per axis ($205).
     pub max_pulse_rate_hz: f32,
+    /// How long a limit switch, driver alarm or emergency stop input must stay active to count
+    /// ($206).
+    pub input_debounce_ms: u32,
+    /// The drivers' alarm outputs are wired: an alarm stops the machine and turns the servos
+    /// off ($207).
+    pub driver_alarm_input: bool,
+    /// The emergency stop input is wired ($208).
+    pub estop_input: bool,
 }
 
 impl Default for Settings {
@@ -98,8 +124,10 @@ impl Default for Settings {
         Settings {
             pulse_width_us: 5.0,
             dir_invert_mask: 0,
+            limit_pins_invert: false,
             status_report_mask: 1,
             junction_deviation_mm: 0.02,
+            hard_limits: false,
             steps_per_mm: [100.0, 100.0],
             max_rate_mm_per_min: [6_000.0, 6_000.0],
             accel_mm_per_s2: [500.0, 500.0],
@@ -110,6 +138,9 @@ impl Default for Settings {
             default_feed_mm_per_min: 3_000.0,
             max_jump_mm: 5.0,
             max_pulse_rate_hz: 20_000.0,
+            input_debounce_ms: 2,
+            driver_alarm_input: false,
+            estop_input: false,
         }
     }
 }
@@ -120,8 +151,10 @@ impl Settings {
         Ok(match id {
             0 => self.pulse_width_us,
             3 => self.dir_invert_mask as f32,
+            5 => f32::from(u8::from(self.limit_pins_invert)),
             10 => self.status_report_mask as f32,
             11 => self.junction_deviation_mm,
+            21 => f32::from(u8::from(self.hard_limits)),
             100 | 101 => self.steps_per_mm[(id - 100) as usize],
             110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize],
             120 | 121 => self.accel_mm_per_s2[(id - 120) as usize],
@@ -135,6 +168,9 @@ impl Settings {
             203 => self.default_feed_mm_per_min,
             204 => self.max_jump_mm,
             205 => self.max_pulse_rate_hz,
+            206 => self.input_debounce_ms as f32,
+            207 => f32::from(u8::from(self.driver_alarm_input)),
+            208 => f32::from(u8::from(self.estop_input)),
             _ => return Err(SettingError::Unknown),
         })
     }
@@ -179,8 +215,10 @@ impl Settings {
         match id {
             0 => self.pulse_width_us = value,
             3 if whole => self.dir_invert_mask = value as u8,
+            5 if whole => self.limit_pins_invert = value != 0.0,
             10 if whole => self.status_report_mask = value as u8,
             11 => self.junction_deviation_mm = value,
+            21 if whole => self.hard_limits = value != 0.0,
             100 | 101 => self.steps_per_mm[(id - 100) as usize] = value,
             110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize] = value,
             120 | 121 => self.accel_mm_per_s2[(id - 120) as usize] = value,
@@ -191,6 +229,9 @@ impl Settings {
             203 => self.default_feed_mm_per_min = value,
             204 => self.max_jump_mm = value,
             205 => self.max_pulse_rate_hz = value,
+            206 if whole => self.input_debounce_ms = value as u32,
+            207 if whole => self.driver_alarm_input = value != 0.0,
+            208 if whole => self.estop_input = value != 0.0,
             _ => return Err(SettingError::OutOfRange),
         }
         Ok(())

@@ -2,6 +2,7 @@
 //! reports and the menu see it.
 
 use crate::geom::Point;
+use crate::inputs::Trip;
 use crate::interp::CurveError;
 use crate::overrides::Overrides;
 
@@ -41,6 +42,8 @@ pub enum MotionFault {
     /// The curve ended part way: the travel guard stopped it at the edge (see
     /// [`crate::interp::Curve`]).
     Curve(CurveError),
+    /// An input stopped the machine at once: a limit switch, a driver alarm, the emergency stop.
+    Tripped(Trip),
 }
 
 /// A snapshot of the machine for displays and reports.

@@ -207,9 +207,16 @@ fn halt() -> ! {
 /// between them.
 const PULSE_RUN_STEPS: [usize; 2] = [50, 250];
 
-/// The pulse path on a circle's steps (both axes, every direction), 100 µs apart.
+/// The pulse path on a circle's steps (both axes, every direction), 100 µs apart, watching every
+/// input.
 fn pulse_path_runs() {
-    let settings = Settings { method: Method::Diagonal, ..Settings::default() };
+    let settings = Settings {
+        method: Method::Diagonal,
+        hard_limits: true,
+        driver_alarm_input: true,
+        estop_input: true,
+        ..Settings::default()
+    };
     let circle = cases()[3].1.clone();
     let mut c = curve(&circle, &settings);
     let mut buf = [servoplot::geom::Step::NONE; PULSE_RUN_STEPS[1]];

@@ -7,11 +7,12 @@
 //! the timer's interrupt entry to its return, and the sleep loop around it.
 
 use core::cell::RefCell;
-use core::ptr::{addr_of_mut, write_volatile};
+use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 use core::sync::atomic::{AtomicBool, Ordering};
 
 use critical_section::Mutex;
 use servoplot::geom::{Axis, StepCmd};
+use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
 use servoplot::pulse::{PulseEngine, StepQueue, StepTimer};
 use servoplot::settings::Settings;
@@ -31,6 +32,9 @@ const TIMER_CLOCKS_PER_TICK: u32 = 25;
 /// Where the board writes its two compare registers and a SIGN output (one store each).
 static mut COMPARE: [u32; 2] = [0; 2];
 static mut SIGN_OUT: u32 = 0;
+/// Where the board reads its input port (one load, then as many shifts and masks): every input
+/// idle, the switches open (high), the drivers' alarms and the e-stop low.
+static mut INPUT_PORT: u32 = !(1 << 8 | 1 << 14 | 1 << 15);
 
 /// The model's timer standing in for TIM1.
 pub struct ModelStepTimer {
@@ -68,6 +72,16 @@ impl StepTimer for ModelStepTimer {
     fn stop(&mut self) {
         // SAFETY: the model's timer register.
         unsafe { write_volatile(TIMER0_CTRL, 0) };
+    }
+
+    fn halt(&mut self) {
+        self.stop();
+    }
+
+    fn input_levels(&mut self) -> InputLevels {
+        // SAFETY: INPUT_PORT is only read.
+        let port = unsafe { read_volatile(addr_of!(INPUT_PORT)) };
+        (((port >> 4) & 0x1F) | ((port >> 9) & 0x60)) as InputLevels
     }
 }
 

@@ -15,6 +15,7 @@ use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, StoredPos
 use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::Axis;
+use crate::inputs::Trip;
 use crate::interp::CurveError;
 use crate::protocol::startup::StartupLines;
 use crate::settings::{SETTING_INFO, Settings};
@@ -30,7 +31,7 @@ pub const BUILD_NAME: &str = "servoplot";
 pub const REPORT_LINE_MAX_BYTES: usize = 128;
 
 /// Settings whose values are whole numbers (a bit mask, a choice), listed without decimals.
-const INTEGER_SETTINGS: &[u16] = &[3, 10, 202];
+const INTEGER_SETTINGS: &[u16] = &[3, 5, 10, 21, 202, 206, 207, 208];
 
 /// `ok`: the line was executed.
 pub fn ok(out: &mut impl Write) -> fmt::Result {
@@ -82,14 +83,23 @@ pub fn welcome(out: &mut impl Write) -> fmt::Result {
     write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")
 }
 
+/// GRBL's alarm code for a hard limit: a limit switch stopped the machine.
+pub const ALARM_HARD_LIMIT: u8 = 1;
 /// GRBL's alarm code for the soft limit: a motion would leave the travel.
 pub const ALARM_SOFT_LIMIT: u8 = 2;
+/// grblHAL's alarm code for the emergency stop.
+pub const ALARM_ESTOP: u8 = 10;
+/// grblHAL's alarm code for a motor fault: a driver raised its alarm output.
+pub const ALARM_DRIVER: u8 = 17;
 /// The alarm code for a curve that stopped part way for another reason (not a GRBL code).
 pub const ALARM_CURVE_STOPPED: u8 = 20;
 
 /// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened.
 pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
-    let MotionFault::Curve(e) = fault;
+    let e = match fault {
+        MotionFault::Curve(e) => e,
+        MotionFault::Tripped(trip) => return tripped(out, trip),
+    };
     let code = if e == CurveError::Travel { ALARM_SOFT_LIMIT } else { ALARM_CURVE_STOPPED };
     let why = match e {
         CurveError::Domain => "function undefined",
@@ -99,6 +109,22 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
         CurveError::Travel => "travel limit",
     };
     write!(out, "ALARM:{}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n", Int::from(code))
+}
+
+/// The alarm of a trip: `ALARM:N`, what tripped, and what clears it.
+fn tripped(out: &mut impl Write, trip: Trip) -> fmt::Result {
+    let (code, what, then) = match trip {
+        Trip::Limit { .. } => (ALARM_HARD_LIMIT, "Hard limit", "position lost; move off the switch after '$X'"),
+        Trip::DriverAlarm(_) => (ALARM_DRIVER, "Driver alarm", "servos off; clear the driver's fault, then '$X'"),
+        Trip::EStop => (ALARM_ESTOP, "Emergency stop", "release it, then '$X'"),
+    };
+    write!(out, "ALARM:{}\r\n[MSG:{what}", Int::from(code))?;
+    match trip {
+        Trip::Limit { axis, max } => write!(out, " {}{}", axis.name(), if max { "+" } else { "-" })?,
+        Trip::DriverAlarm(axis) => write!(out, " {}", axis.name())?,
+        Trip::EStop => {}
+    }
+    write!(out, ": {then}]\r\n")
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).

@@ -108,6 +108,14 @@ impl StepProducer<'_> {
         let published = self.queue.published.load(Ordering::Relaxed);
         self.queue.rest_at.store(published, Ordering::Release);
     }
+
+    /// Takes back every command published and not yet taken, and rests there. Only while the
+    /// consumer takes nothing: the pulse engine halted by a trip (see [`crate::machine::Machine::trip`]).
+    pub fn retract(&mut self) {
+        let taken = self.queue.taken.load(Ordering::Acquire);
+        self.queue.published.store(taken, Ordering::Release);
+        self.rest();
+    }
 }
 
 /// The pulse engine's end of the [`StepQueue`].

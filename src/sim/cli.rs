@@ -7,6 +7,7 @@ use std::string::{String, ToString};
 use std::vec::Vec;
 use std::{eprintln, format};
 
+use crate::sim::inputs::{InputScript, Switches};
 use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, serial::SimSerial};
 use crate::store::STORE_SECTORS;
 
@@ -19,7 +20,7 @@ const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
 usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
-                 [--out DIR]
+                 [--switches MM] [--events FILE] [--out DIR]
 
 Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
@@ -35,6 +36,12 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
                   read at power-on, written as the firmware saves; created erased if missing.
                   Two runs with the same FILE are a power cycle. Without it the flash starts
                   erased and is forgotten.
+  --switches MM   limit switches MM beyond each end of the travel ($130, $131 either way of
+                  where the pen starts; negative: inside it), normally open ($5=0); they stop
+                  the pen when hard limits are on ($21=1)
+  --events FILE   input events at set times, one per line: `<ms> on|off <input>`, the input
+                  one of x- x+ y- y+ (a switch stuck pressed, or let go), alarm-x alarm-y (a
+                  driver's alarm output, watched with $207=1) or estop (watched with $208=1)
   --out DIR       where the pictures go
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
@@ -76,11 +83,21 @@ struct Args {
     keys: Option<String>,
     cpu: Option<sim::cpu::CpuModel>,
     flash: Option<PathBuf>,
+    switches: Option<Switches>,
+    events: InputScript,
     out: PathBuf,
 }
 
 fn parse_args() -> Result<Args, String> {
-    let mut args = Args { serial: None, keys: None, cpu: None, flash: None, out: PathBuf::from("out") };
+    let mut args = Args {
+        serial: None,
+        keys: None,
+        cpu: None,
+        flash: None,
+        switches: None,
+        events: InputScript::default(),
+        out: PathBuf::from("out"),
+    };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
@@ -96,6 +113,18 @@ fn parse_args() -> Result<Args, String> {
                 other => return Err(format!("unknown processor `{other}` (there is: f407)")),
             },
             "--flash" => args.flash = Some(PathBuf::from(value()?)),
+            "--switches" => {
+                let mm = value()?;
+                let beyond_travel_mm = mm.parse::<f32>().ok().filter(|v| v.is_finite());
+                let beyond_travel_mm =
+                    beyond_travel_mm.ok_or_else(|| format!("--switches: `{mm}` is no distance in mm"))?;
+                args.switches = Some(Switches { beyond_travel_mm });
+            }
+            "--events" => {
+                let path = value()?;
+                let text = std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?;
+                args.events = InputScript::parse(&text).map_err(|e| format!("{path}: {e}"))?;
+            }
             "--out" => args.out = PathBuf::from(value()?),
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
@@ -166,6 +195,8 @@ pub fn main() -> ExitCode {
         keys,
         keys_start,
         cpu: args.cpu,
+        switches: args.switches,
+        events: args.events,
         ..SimConfig::default()
     });
     if with_cpu {

@@ -11,6 +11,7 @@ pub mod cli;
 pub mod clock;
 pub mod cpu;
 pub mod flash;
+pub mod inputs;
 pub mod keys;
 pub mod lcd;
 pub mod picture;
@@ -28,7 +29,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::task::Wake;
 use std::vec::Vec;
 
-use embassy_futures::join::join5;
+use embassy_futures::join::{join, join5};
 
 use crate::geom::{Axis, Point};
 use crate::machine::Machine;
@@ -41,9 +42,10 @@ use cpu::{CpuModel, SimCpu};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 use flash::SimFlash;
+use inputs::{InputScript, SimInputs, Switches};
 use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SimSpi};
-use pins::{PulseTrace, TracePin};
+use pins::{LevelPin, PulseTrace, TracePin};
 use serial::SimSerial;
 use step_timer::SimStepTimer;
 
@@ -80,6 +82,10 @@ pub struct SimConfig {
     /// The board's processor: its work takes time, and the pulses may have to wait for it.
     /// `None`: the firmware's work takes no time.
     pub cpu: Option<CpuModel>,
+    /// Limit switches at the ends of the travel; none if `None`.
+    pub switches: Option<Switches>,
+    /// Driver alarms, e-stops and stuck switches at set virtual times.
+    pub events: InputScript,
 }
 
 /// What a simulation produced.
@@ -105,6 +111,8 @@ pub struct SimReport {
     pub timed_out: bool,
     /// Times the pulses had to wait for the motion task.
     pub underruns: u32,
+    /// Every change of the servo-on output, with its virtual time.
+    pub son: Vec<(u64, bool)>,
 }
 
 impl SimReport {
@@ -146,8 +154,10 @@ pub fn run(config: SimConfig) -> SimReport {
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
     let (steps, step_consumer) = step_queue.split();
-    let mut engine =
-        PulseEngine::new(SimStepTimer::new(Axis::ALL.map(|axis| TracePin::pair(&trace, axis))), step_consumer);
+    let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
+    let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
+    let mut engine = PulseEngine::new(SimStepTimer::new(pins, inputs.clone()), step_consumer);
+    let son = LevelPin::default();
     let kicks = Signal::<NoopRawMutex, ()>::new();
     let matrix = match config.keys_start {
         KeysStart::AtOnce => KeyMatrix::new(config.keys),
@@ -162,12 +172,15 @@ pub fn run(config: SimConfig) -> SimReport {
     let spi = SimSpi::default();
     let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
 
-    let firmware = join5(
-        step_timer::run(&machine, &mut engine, &kicks),
-        tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
-        tasks::keypad::run(&machine, columns, rows),
-        tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
-        tasks::lcd::run(&machine, lcd),
+    let firmware = join(
+        join5(
+            step_timer::run(&machine, &mut engine, &kicks),
+            tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
+            tasks::keypad::run(&machine, columns, rows),
+            tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
+            tasks::lcd::run(&machine, lcd),
+        ),
+        tasks::servo::run(&machine, son.clone(), || inputs.levels()),
     );
     let mut firmware = pin!(firmware);
     let flag = Arc::new(FlagWaker(AtomicBool::new(true)));
@@ -246,6 +259,7 @@ pub fn run(config: SimConfig) -> SimReport {
         end_us,
         timed_out,
         underruns,
+        son: son.changes(),
     }
 }
 

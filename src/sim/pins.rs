@@ -29,6 +29,8 @@ pub struct PulseTrace {
     /// Shortest PULS high time.
     pub min_pulse_width_us: Option<u64>,
     sign_high: [bool; 2],
+    /// Per axis, pulses with SIGN high less those with SIGN low.
+    driven: [i64; 2],
     sign_changed_at: [Option<u64>; 2],
     puls_high_since: [Option<u64>; 2],
 }
@@ -48,6 +50,7 @@ impl PulseTrace {
                 (None, true) => {
                     self.puls_high_since[i] = Some(t);
                     self.pulses.push(Pulse { t_us: t, axis, sign_high: self.sign_high[i] });
+                    self.driven[i] += if self.sign_high[i] { 1 } else { -1 };
                     if let Some(changed) = self.sign_changed_at[i].take() {
                         let setup = t - changed;
                         self.min_dir_setup_us = Some(self.min_dir_setup_us.map_or(setup, |m| m.min(setup)));
@@ -61,6 +64,12 @@ impl PulseTrace {
                 _ => {}
             },
         }
+    }
+
+    /// Per axis, where the pulses so far have driven it: pulses with SIGN high less those with
+    /// SIGN low.
+    pub fn driven_steps(&self) -> [i64; 2] {
+        self.driven
     }
 
     /// Pulses per axis, counted by direction: `[x_forward, x_backward, y_forward, y_backward]`,
@@ -140,6 +149,41 @@ impl embedded_hal::digital::OutputPin for TracePin {
 
     fn set_high(&mut self) -> Result<(), Self::Error> {
         self.trace.borrow_mut().edge(self.axis, self.role, true);
+        Ok(())
+    }
+}
+
+/// An output whose every change of level is recorded with its virtual time (the servo-on
+/// output); it starts low.
+#[derive(Clone, Default)]
+pub struct LevelPin(Rc<RefCell<Vec<(u64, bool)>>>);
+
+impl LevelPin {
+    /// Every change, in order.
+    pub fn changes(&self) -> Vec<(u64, bool)> {
+        self.0.borrow().clone()
+    }
+
+    fn set(&self, high: bool) {
+        let mut changes = self.0.borrow_mut();
+        if changes.last().map_or(high, |c| c.1 != high) {
+            changes.push((clock::now_ticks(), high));
+        }
+    }
+}
+
+impl embedded_hal::digital::ErrorType for LevelPin {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::digital::OutputPin for LevelPin {
+    fn set_low(&mut self) -> Result<(), Self::Error> {
+        self.set(false);
+        Ok(())
+    }
+
+    fn set_high(&mut self) -> Result<(), Self::Error> {
+        self.set(true);
         Ok(())
     }
 }

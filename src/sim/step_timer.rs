@@ -12,8 +12,10 @@ use embassy_time::{Instant, Timer};
 use embedded_hal::digital::OutputPin;
 
 use crate::geom::Axis;
+use crate::inputs::InputLevels;
 use crate::machine::Machine;
 use crate::pulse::{PulseEngine, StepTimer};
+use crate::sim::inputs::SimInputs;
 use crate::sim::pins::TracePin;
 
 /// Longest period of the board's 16-bit timer at one tick per count.
@@ -23,6 +25,7 @@ pub const SIM_MAX_PERIOD_TICKS: u32 = 65_535;
 pub struct SimStepTimer {
     puls: [TracePin; 2],
     sign: [TracePin; 2],
+    inputs: SimInputs,
     /// The preloaded period: ticks and the axes pulsed at its end.
     preload: (u32, u8),
     width_ticks: u32,
@@ -32,12 +35,13 @@ pub struct SimStepTimer {
 }
 
 impl SimStepTimer {
-    /// A stopped timer with PULS and SIGN pins per axis.
-    pub fn new(pins: [(TracePin, TracePin); 2]) -> Self {
+    /// A stopped timer with PULS and SIGN pins per axis, watching `inputs`.
+    pub fn new(pins: [(TracePin, TracePin); 2], inputs: SimInputs) -> Self {
         let [(puls_x, sign_x), (puls_y, sign_y)] = pins;
         SimStepTimer {
             puls: [puls_x, puls_y],
             sign: [sign_x, sign_y],
+            inputs,
             preload: (0, 0),
             width_ticks: 0,
             running: false,
@@ -75,6 +79,15 @@ impl StepTimer for SimStepTimer {
 
     fn stop(&mut self) {
         self.running = false;
+    }
+
+    fn halt(&mut self) {
+        // The engine halts at an update event, when PULS is low in PWM mode 2.
+        self.running = false;
+    }
+
+    fn input_levels(&mut self) -> InputLevels {
+        self.inputs.levels()
     }
 }
 

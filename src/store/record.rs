@@ -181,9 +181,10 @@ mod tests {
         let mut other = buf;
         other[0] ^= 1;
         assert_eq!(Record::decode(&other[..n]), Err(BadRecord::OtherLayout));
-        // $100 (steps/mm) is the fifth setting: 0 is out of its range.
+        // 0 steps/mm ($100) is out of its range.
+        let at = SETTING_INFO.iter().position(|i| i.id == 100).unwrap();
         let mut bad = buf;
-        bad[2 + 4 * 4..2 + 4 * 5].copy_from_slice(&0.0f32.to_le_bytes());
+        bad[2 + 4 * at..2 + 4 * (at + 1)].copy_from_slice(&0.0f32.to_le_bytes());
         assert_eq!(Record::decode(&bad[..n]), Err(BadRecord::Invalid));
         let mut nan = buf;
         nan[2 + 4 * SETTING_INFO.len()..][..4].copy_from_slice(&f32::NAN.to_le_bytes());

@@ -14,6 +14,7 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 
 use crate::geom::Point;
+use crate::inputs::Trip;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
@@ -82,6 +83,9 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
     // The overrides the planner has.
     let mut overrides = Overrides::NONE;
     loop {
+        if let Some(trip) = machine.take_trip() {
+            halted(machine, &mut planner, &mut steps, &mut queued, trip).await;
+        }
         if let Some(control) = machine.take_control() {
             apply(machine, &mut planner, control);
         }
@@ -140,7 +144,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                 match planner.state() {
                     PlannerState::Idle => {
                         // Everything planned is queued: rest once it has been emitted.
-                        while !machine.pulses_idle() {
+                        while !machine.pulses_idle() && !machine.halted() {
                             machine.until_pulses_stopped().await;
                         }
                         if machine.run_state() != RunState::Idle {
@@ -163,6 +167,32 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             }
         }
     }
+}
+
+/// An input tripped the machine (see [`crate::inputs`]): once the pulse engine has halted,
+/// drops everything planned and queued without braking (the pulses already stopped), takes the
+/// position from the pulses emitted, and raises the alarm. Motion is refused until `$X`.
+async fn halted(
+    machine: &Machine,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    steps: &mut StepProducer<'_>,
+    queued: &mut Queued,
+    trip: Trip,
+) {
+    while machine.pulsing() {
+        machine.until_pulses_stopped().await;
+    }
+    error!("tripped: {:?}", trip);
+    planner.drop_all();
+    steps.retract();
+    let (emitted_steps, emitted_ticks) = machine.emitted_totals();
+    *queued = Queued { steps: emitted_steps, ticks: emitted_ticks, end: machine.position(), resting: true };
+    machine.set_queued(emitted_steps, emitted_ticks);
+    machine.set_plan_empty(true);
+    machine.set_plan_free_segments(planner.free_segments());
+    machine.set_run_state(RunState::Alarm);
+    machine.set_fault(Some(MotionFault::Tripped(trip)));
+    machine.abort_plan();
 }
 
 /// Moves step commands from the planner into the step queue: as many as fit, up to

@@ -48,8 +48,9 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
+use crate::inputs::{ALWAYS_WATCHED, InputSetup, Trip};
 use crate::job::{Control, Job};
-use crate::machine::{Machine, PlanEpoch, Stale};
+use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::overrides::Overrides;
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
@@ -291,7 +292,8 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         self.host.machine_stopped().await;
         link.reset_met();
         self.restart(link).await;
-        for other in self.host.links.iter().filter(|l| !core::ptr::eq(*l, link)) {
+        // A link resetting too (after an e-stop, all are) hears of its own reset.
+        for other in self.host.links.iter().filter(|l| !core::ptr::eq(*l, link) && !l.resetting()) {
             other.send(|a| report::message(a, "Reset from another host link")).await;
         }
     }
@@ -440,9 +442,16 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 self.restart_after_answer = true;
             }
             Command::Unlock => {
-                if machine.run_state() == RunState::Alarm {
-                    machine.set_run_state(RunState::Idle);
+                // A driver alarm or the e-stop still raised would trip again at once.
+                if InputSetup::from_settings(settings).active(machine.input_levels()) & ALWAYS_WATCHED != 0 {
+                    link.send(|a| report::message(a, "Driver alarm or e-stop still active")).await;
+                    return Err(Unfinished::Error(GrblError::Locked));
                 }
+                if machine.halted() {
+                    // The motion task drops what a trip cut short before the pulses may go on.
+                    unless_reset(link, host.machine_stopped()).await?;
+                }
+                machine.unlock();
                 link.send(|a| report::message(a, "Caution: Unlocked")).await;
             }
         }
@@ -465,12 +474,19 @@ async fn unless_reset<T>(link: &Link, work: impl Future<Output = T>) -> Result<T
     link.unless_reset(work).await.ok_or(Unfinished::Reset)
 }
 
-/// Pushes an alarm to every link when a curve stops part way.
+/// Pushes an alarm to every link when a curve stops part way or an input trips the machine. The
+/// emergency stop also resets every link, as Ctrl-X does: what they sent before it is dropped.
 async fn faults(host: &Host<'_>) -> ! {
     loop {
         let fault = host.machine.next_fault().await;
         for link in &host.links {
             link.send(|a| report::alarm(a, fault)).await;
+        }
+        if fault == MotionFault::Tripped(Trip::EStop) {
+            host.machine.set_overrides(Overrides::NONE);
+            for link in &host.links {
+                link.reset_received().await;
+            }
         }
     }
 }

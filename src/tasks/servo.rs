@@ -1,19 +1,34 @@
-//! The servo-on task: drives the drivers' SON input from the machine's state. SON stays low
-//! from power-on until this task runs (the board starts it with the pulse engine running); the
-//! servos then hold position, and go off while the machine sleeps (`$SLP`) until a reset.
+//! The servo task: drives the drivers' SON input from the machine's state, and watches the
+//! drivers' alarms and the emergency stop whether the axes move or not (the pulse engine watches
+//! them too while they move, at every period). SON stays low from power-on until this task runs
+//! (the board starts it with the pulse engine running); the servos then hold position, and go
+//! off while the machine sleeps (`$SLP`) until a reset, and after a driver alarm until `$X`.
 
-use embassy_time::{Duration, Timer};
+use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 
+use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
 
-/// How often the servo-on output follows the machine's state: well within a person's reach of
-/// the axes after `$SLP`.
+/// How often the task reads the inputs and sets SON: well within a person's reach of the axes
+/// after `$SLP`, and an e-stop pressed at rest is an alarm within this (plus the debounce).
 pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 
-/// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on.
-pub async fn run<P: OutputPin>(machine: &Machine, mut son: P) -> ! {
+/// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on, and
+/// trips the machine when a driver alarm or the e-stop read through `levels` stays active.
+pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl FnMut() -> InputLevels) -> ! {
+    let mut debounce = Debounce::default();
     loop {
+        let now = levels();
+        machine.set_input_levels(now);
+        let setup = InputSetup::from_settings(&machine.settings());
+        let active = setup.active(now) & ALWAYS_WATCHED;
+        // The debounce clock in ticks, wrapping as it allows.
+        let ticks = Instant::now().as_ticks() as u32;
+        if let Some(trip) = debounce.sample(active, ticks, setup.debounce_ticks) {
+            machine.trip(trip);
+            debounce.clear();
+        }
         if son.set_state(PinState::from(machine.servos_on())).is_err() {
             warn!("servo-on output failed");
         }
@@ -56,7 +71,7 @@ mod tests {
         crate::sim::clock::reset();
         let machine = Machine::new(Settings::default());
         let son = Cell::new(false);
-        let mut task = pin!(run(&machine, Pin(&son)));
+        let mut task = pin!(run(&machine, Pin(&son), || 0));
         let mut cx = Context::from_waker(Waker::noop());
         let mut step = || {
             let _ = task.as_mut().poll(&mut cx);

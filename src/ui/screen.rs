@@ -32,6 +32,7 @@ use heapless::String;
 use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::{Axis, Step};
+use crate::inputs::Trip;
 use crate::interp::{CurveError, Method};
 use crate::job::JOG_FEED_MM_PER_MIN;
 use crate::overrides::OVERRIDE_NONE_PERCENT;
@@ -167,7 +168,7 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
     }
     if let Some(error) = menu.message() {
         lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error)), true);
-    } else if let (RunState::Idle, Some(fault)) = (status.state, status.fault) {
+    } else if let (RunState::Idle | RunState::Alarm, Some(fault)) = (status.state, status.fault) {
         lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault)), true);
     }
     ScreenView { lines }
@@ -306,6 +307,11 @@ struct FaultText(MotionFault);
 impl fmt::Display for FaultText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let why = match self.0 {
+            MotionFault::Tripped(Trip::Limit { axis, max }) => {
+                return write!(f, "Limit {}{}: $X", axis.name(), if max { "+" } else { "-" });
+            }
+            MotionFault::Tripped(Trip::DriverAlarm(axis)) => return write!(f, "{} driver alarm", axis.name()),
+            MotionFault::Tripped(Trip::EStop) => "E-stop",
             MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
             MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
             MotionFault::Curve(CurveError::Overflow) => "value too large",

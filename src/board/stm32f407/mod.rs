@@ -11,7 +11,11 @@
 //! |---------------------|------|----------------------------------------------------|
 //! | X PULS / X SIGN     | PE9 / PE10  | TIM1 CH1 / GPIO, to the X driver's PULS+/SIGN+ |
 //! | Y PULS / Y SIGN     | PE11 / PE12 | TIM1 CH2 / GPIO, to the Y driver's PULS+/SIGN+ |
-//! | servo on (SON)      | PE13 | high once the tasks run, low while asleep (`$SLP`) or after a fault |
+//! | servo on (SON)      | PE13 | high once the tasks run, low while asleep (`$SLP`), after a driver alarm or a fault |
+//! | X / Y limit min     | PE4 / PE5 | inputs with pull-ups, switch to GND (normally open; `$5=1` normally closed) |
+//! | X / Y limit max     | PE6 / PE7 | as the min switches                        |
+//! | X / Y driver ALM    | PE8 / PE14 | inputs with pull-ups, from the drivers' ALM+ (ALM- to GND): open = alarm (`$207`) |
+//! | e-stop              | PE15 | input with pull-up, normally closed button to GND: open = stop (`$208`) |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
 //! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
@@ -22,6 +26,7 @@
 //! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port   |
 //! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
 
+mod inputs;
 mod panic;
 mod step_timer;
 mod usb;
@@ -113,7 +118,7 @@ async fn serial(
 
 #[embassy_executor::task]
 async fn servo(machine: &'static Machine, son: Output<'static>) -> ! {
-    tasks::servo::run(machine, son).await
+    tasks::servo::run(machine, son, inputs::read).await
 }
 
 #[embassy_executor::task]
@@ -177,6 +182,7 @@ async fn main(spawner: Spawner) {
         PwmPin::new(p.PE9, OutputType::PushPull),
         PwmPin::new(p.PE11, OutputType::PushPull),
         [Output::new(p.PE10, Level::Low, Speed::VeryHigh), Output::new(p.PE12, Level::Low, Speed::VeryHigh)],
+        inputs::InputPins::new(p.PE4, p.PE5, p.PE6, p.PE7, p.PE8, p.PE14, p.PE15),
     );
     // Servo on: low until the servo task, started with the pulse engine running, turns it on.
     let son = Output::new(p.PE13, Level::Low, Speed::Low);

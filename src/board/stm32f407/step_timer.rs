@@ -17,17 +17,24 @@ use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Channel};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+
+use super::inputs::InputPins;
 use servoplot::geom::{Axis, TICK_HZ};
+use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
 use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
+
+/// The channels driving X and Y PULS.
+const PULS_CHANNELS: [Channel; 2] = [Channel::Ch1, Channel::Ch2];
 
 /// A compare value the 16-bit counter never reaches (its periods end at 65_534): no pulse.
 const NO_PULSE: u16 = u16::MAX;
 
-/// TIM1 driving PULS, and the SIGN outputs.
+/// TIM1 driving PULS, the SIGN outputs, and the input pins the engine watches.
 pub struct Tim1StepTimer {
     timer: Timer<'static, TIM1>,
     sign: [Output<'static>; 2],
+    inputs: InputPins,
     width_ticks: u32,
     _puls: (PwmPin<'static, TIM1, Ch1>, PwmPin<'static, TIM1, Ch2>),
 }
@@ -39,11 +46,12 @@ impl Tim1StepTimer {
         puls_x: PwmPin<'static, TIM1, Ch1>,
         puls_y: PwmPin<'static, TIM1, Ch2>,
         sign: [Output<'static>; 2],
+        inputs: InputPins,
     ) -> Self {
         let mut timer = Timer::new(tim);
         timer.set_tick_freq(Hertz(TICK_HZ));
         timer.set_autoreload_preload(true);
-        for channel in [Channel::Ch1, Channel::Ch2] {
+        for channel in PULS_CHANNELS {
             timer.set_output_compare_mode(channel, OutputCompareMode::PwmMode2);
             timer.set_output_compare_preload(channel, true);
             timer.set_output_polarity(channel, OutputPolarity::ActiveHigh);
@@ -54,7 +62,7 @@ impl Tim1StepTimer {
         // Setting the tick rate made an update event: its flag is no period of ours.
         timer.regs_core().sr().write_value(embassy_stm32::pac::timer::regs::SrCore(!1));
         timer.enable_update_interrupt(true);
-        Tim1StepTimer { timer, sign, width_ticks: 0, _puls: (puls_x, puls_y) }
+        Tim1StepTimer { timer, sign, inputs, width_ticks: 0, _puls: (puls_x, puls_y) }
     }
 }
 
@@ -76,6 +84,10 @@ impl StepTimer for Tim1StepTimer {
 
     fn start(&mut self, width_ticks: u32) {
         self.width_ticks = width_ticks;
+        // After a halt the outputs were forced low.
+        for channel in PULS_CHANNELS {
+            self.timer.set_output_compare_mode(channel, OutputCompareMode::PwmMode2);
+        }
         let regs = self.timer.regs_core();
         // The update event loads the preloaded period and raises the update interrupt.
         regs.egr().write(|w| w.set_ug(true));
@@ -84,6 +96,18 @@ impl StepTimer for Tim1StepTimer {
 
     fn stop(&mut self) {
         self.timer.stop();
+    }
+
+    fn halt(&mut self) {
+        self.timer.stop();
+        for channel in PULS_CHANNELS {
+            self.timer.set_output_compare_mode(channel, OutputCompareMode::ForceInactive);
+        }
+    }
+
+    #[inline(always)]
+    fn input_levels(&mut self) -> InputLevels {
+        self.inputs.levels()
     }
 }
 
