@@ -396,8 +396,10 @@ mod tests {
         sign: [bool; 2],
         /// (ticks, axes pulsed at the end, SIGN levels).
         periods: Vec<(u32, u8, [bool; 2])>,
-        /// The input levels read; halts seen.
+        /// The input levels read, and from which read on (counting from 1) they change to what.
         levels: InputLevels,
+        then: Option<(usize, InputLevels)>,
+        reads: usize,
         halts: usize,
     }
 
@@ -421,7 +423,11 @@ mod tests {
             self.halts += 1;
         }
         fn input_levels(&mut self) -> InputLevels {
-            self.levels
+            self.reads += 1;
+            match self.then {
+                Some((from, levels)) if self.reads >= from => levels,
+                _ => self.levels,
+            }
         }
     }
 
@@ -555,6 +561,35 @@ mod tests {
         }
         assert!(gaps.iter().all(|&g| g >= 100), "{gaps:?}");
         assert!(periods.iter().any(|p| p.1 == 0 && p.0 == UNDERRUN_WAIT_TICKS));
+    }
+
+    #[test]
+    fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts_until_unlocked() {
+        use crate::inputs::{LIMIT_X_MAX, LIMIT_X_MIN, LIMITS, Trip};
+        // Hard limits, no debounce; normally open switches read low when pressed.
+        let settings = Settings { hard_limits: true, input_debounce_ms: 0, ..Settings::default() };
+        let machine = Machine::new(settings);
+        let mut q = StepQueue::new();
+        let (mut p, c) = q.split();
+        queue(&mut p, &[step(1, 0, 100); 10], true);
+        // The X min switch, behind the pen, is pressed from the start and never stops it; the X
+        // max switch closes at the fifth period.
+        let timer = MockTimer {
+            levels: LIMITS & !LIMIT_X_MIN,
+            then: Some((5, LIMITS & !LIMIT_X_MIN & !LIMIT_X_MAX)),
+            ..MockTimer::default()
+        };
+        let mut engine = PulseEngine::new(timer, c);
+        run(&mut engine, &machine, 100, |_| {});
+        assert_eq!(engine.timer().halts, 1);
+        assert!(machine.halted());
+        assert_eq!(machine.position(), Point::new(4, 0), "the pulses of the periods before");
+        assert_eq!(machine.take_trip(), Some(Trip::Limit { axis: Axis::X, max: true }));
+        engine.kick(&machine);
+        assert!(!engine.is_running(), "halted: no kick starts the timer");
+        machine.unlock();
+        engine.kick(&machine);
+        assert!(engine.is_running(), "unlocked, the queued steps go on");
     }
 
     #[test]
