@@ -62,19 +62,6 @@ impl Trip {
             _ => Trip::EStop,
         }
     }
-
-    /// The input bit that raised this trip.
-    pub fn bit(self) -> u8 {
-        match self {
-            Trip::Limit { axis: Axis::X, max: false } => LIMIT_X_MIN,
-            Trip::Limit { axis: Axis::Y, max: false } => LIMIT_Y_MIN,
-            Trip::Limit { axis: Axis::X, max: true } => LIMIT_X_MAX,
-            Trip::Limit { axis: Axis::Y, max: true } => LIMIT_Y_MAX,
-            Trip::DriverAlarm(Axis::X) => DRIVER_ALARM_X,
-            Trip::DriverAlarm(Axis::Y) => DRIVER_ALARM_Y,
-            Trip::EStop => ESTOP,
-        }
-    }
 }
 
 /// The limit switches a step runs towards: the one at the end each of its axes moves to, from the
@@ -119,6 +106,12 @@ impl InputSetup {
     #[inline(always)]
     pub fn active(&self, levels: InputLevels) -> u8 {
         (levels ^ self.active_low) & self.watched
+    }
+
+    /// The watched driver alarms and e-stop active at `levels`: what trips the machine whether
+    /// it moves or not, and what `$X` must not unlock over.
+    pub fn stops_active(&self, levels: InputLevels) -> u8 {
+        self.active(levels) & ALWAYS_WATCHED
     }
 }
 
@@ -225,9 +218,9 @@ mod tests {
         let mut d = Debounce::default();
         assert_eq!(d.sample(ESTOP, u32::MAX - 10, 50), None);
         assert_eq!(d.sample(ESTOP, 39, 50), Some(Trip::EStop));
-        for trip in [Trip::Limit { axis: Axis::Y, max: false }, Trip::DriverAlarm(Axis::X), Trip::EStop] {
-            assert_eq!(Trip::of(trip.bit()), trip);
-        }
+        assert_eq!(Trip::of(LIMIT_Y_MIN), Trip::Limit { axis: Axis::Y, max: false });
+        assert_eq!(Trip::of(DRIVER_ALARM_X), Trip::DriverAlarm(Axis::X));
+        assert_eq!(Trip::of(ESTOP), Trip::EStop);
     }
 
     #[test]

@@ -128,7 +128,7 @@ pub struct Machine {
     trip: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
     /// The step timer runs (written only by the pulse engine).
     pulsing: AtomicBool,
-    /// The input levels last read at rest (written only by the servo task).
+    /// The input levels the servo task read last (written only by it).
     input_levels: AtomicU8,
 }
 
@@ -452,7 +452,7 @@ impl Machine {
         (self.emitted_steps.load(Ordering::Acquire), self.emitted_ticks.load(Ordering::Acquire))
     }
 
-    /// The input levels read at rest. Only the servo task calls this.
+    /// The input levels just read. Only the servo task calls this.
     pub fn set_input_levels(&self, levels: InputLevels) {
         self.input_levels.store(levels, Ordering::Relaxed);
     }

@@ -48,7 +48,7 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
-use crate::inputs::{ALWAYS_WATCHED, InputSetup, Trip};
+use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::overrides::Overrides;
@@ -443,7 +443,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             }
             Command::Unlock => {
                 // A driver alarm or the e-stop still raised would trip again at once.
-                if InputSetup::from_settings(settings).active(machine.input_levels()) & ALWAYS_WATCHED != 0 {
+                if InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0 {
                     link.send(|a| report::message(a, "Driver alarm or e-stop still active")).await;
                     return Err(Unfinished::Error(GrblError::Locked));
                 }

@@ -7,7 +7,7 @@
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 
-use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup};
+use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
 
 /// How often the task reads the inputs and sets SON: well within a person's reach of the axes
@@ -22,7 +22,7 @@ pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl F
         let now = levels();
         machine.set_input_levels(now);
         let setup = InputSetup::from_settings(&machine.settings());
-        let active = setup.active(now) & ALWAYS_WATCHED;
+        let active = setup.stops_active(now);
         // The debounce clock in ticks, wrapping as it allows.
         let ticks = Instant::now().as_ticks() as u32;
         if let Some(trip) = debounce.sample(active, ticks, setup.debounce_ticks) {
