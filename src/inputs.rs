@@ -108,6 +108,15 @@ impl InputSetup {
         (levels ^ self.active_low) & self.watched
     }
 
+    /// True when the limit switch of `trip` reads pressed at `levels`, watched or not.
+    pub fn pressed(&self, levels: InputLevels, trip: Trip) -> bool {
+        let bit = match trip {
+            Trip::Limit { axis, max } => (1 << axis.index()) << if max { 2 } else { 0 },
+            Trip::DriverAlarm(_) | Trip::EStop => return false,
+        };
+        (levels ^ self.active_low) & bit != 0
+    }
+
     /// The watched driver alarms and e-stop active at `levels`: what trips the machine whether
     /// it moves or not, and what `$X` must not unlock over.
     pub fn stops_active(&self, levels: InputLevels) -> u8 {

@@ -21,12 +21,15 @@ pub enum Feed {
     MmPerMin(f32),
 }
 
-/// Whether a job draws or jogs. A jog is reported as such and only a jog cancel stops it.
+/// Whether a job draws, jogs or homes. A jog is reported as such and only a jog cancel stops
+/// it. A homing move goes where the travel does not reach: it is planned like a drawing, but
+/// neither built nor guarded against the travel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum JobKind {
     Draw,
     Jog,
+    Home,
 }
 
 /// One job for the motion task: a drawing, checked and built, and how fast to draw it.
@@ -72,6 +75,15 @@ impl Job {
     pub fn jog_to(from: Point, to: Point, feed: Feed, settings: &Settings) -> Result<Option<Job>, DrawError> {
         let drawing = drawing::build(&Request::Straight { to }, from, settings)?;
         Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog }))
+    }
+
+    /// A move of the homing cycle: a straight line from `from` to `to` at `feed_mm_per_min`,
+    /// wherever the pen and the travel are (the position is unknown until homed). `None` when
+    /// it goes nowhere, or beyond what any plotter reaches.
+    pub fn homing_move(from: Point, to: Point, feed_mm_per_min: f32, settings: &Settings) -> Option<Job> {
+        let unchecked = Settings { soft_limits: false, ..settings.clone() };
+        let drawing = drawing::build(&Request::Straight { to }, from, &unchecked).ok()??;
+        Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home })
     }
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a

@@ -11,6 +11,10 @@
 //! over with the [`PlanEpoch`] it was planned in; an abort starts a new epoch, and a job from
 //! an earlier one is refused ([`Stale`]) or, if it was queued already, dropped.
 //!
+//! The machine also owns where machine zero is: the position is the pulses emitted less the
+//! origin homing found ([`set_origin`](Machine::set_origin)), and whether it can be trusted
+//! ([`position_lost`](Machine::position_lost)).
+//!
 //! The overrides (GRBL's feed, rapid and spindle percentages) are one shared word: the host link
 //! sets them, the motion task hands them to its planner, reports and the LCD show them.
 //!
@@ -67,6 +71,13 @@ pub enum Refused {
     /// See [`Stale`].
     Stale,
 }
+
+/// The run states as [`Machine`] stores them.
+const STATE_IDLE: u8 = 0;
+const STATE_RUN: u8 = 1;
+const STATE_HOLD: u8 = 2;
+const STATE_JOG: u8 = 3;
+const STATE_ALARM: u8 = 4;
 
 /// Everything the tasks share.
 pub struct Machine {
@@ -130,10 +141,26 @@ pub struct Machine {
     pulsing: AtomicBool,
     /// The input levels the servo task read last (written only by it).
     input_levels: AtomicU8,
+    /// A homing cycle runs: limit switches ahead are watched, and one found is no alarm.
+    homing: AtomicBool,
+    /// Wakes the homing task.
+    homing_requested: Signal<CriticalSectionRawMutex, ()>,
+    /// The switch a homing approach stopped at, until the homing task takes it.
+    switch_found: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
+    /// SON has been high for the drivers' enable delay (written only by the servo task).
+    servos_ready: AtomicBool,
+    /// Pulses emitted at machine zero (written only by the homing task, at rest).
+    origin: [AtomicI32; 2],
+    /// The pulses stopped without braking, or the axes were free: the position may be wrong
+    /// until the next homing.
+    position_lost: AtomicBool,
 }
 
 impl Machine {
+    /// The machine at power-on: locked in an alarm when homing is enabled (`$22`), until it is
+    /// homed or unlocked, and its position unknown until homed.
     pub fn new(settings: Settings) -> Self {
+        let locked = settings.homing;
         Machine {
             jobs: Channel::new(),
             control: Mutex::new(Cell::new(None)),
@@ -151,7 +178,7 @@ impl Machine {
             faults: Signal::new(),
             menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
-            state: AtomicU8::new(0),
+            state: AtomicU8::new(if locked { STATE_ALARM } else { STATE_IDLE }),
             queued_steps: AtomicU32::new(0),
             queued_ticks: AtomicU32::new(0),
             emitted_steps: AtomicU32::new(0),
@@ -167,12 +194,84 @@ impl Machine {
             trip: Mutex::new(Cell::new(None)),
             pulsing: AtomicBool::new(false),
             input_levels: AtomicU8::new(0),
+            homing: AtomicBool::new(false),
+            servos_ready: AtomicBool::new(false),
+            homing_requested: Signal::new(),
+            switch_found: Mutex::new(Cell::new(None)),
+            origin: [AtomicI32::new(0), AtomicI32::new(0)],
+            position_lost: AtomicBool::new(locked),
         }
     }
 
-    /// Pulses emitted so far: the position, always.
+    /// The machine position: the pulses emitted so far, from machine zero.
     pub fn position(&self) -> Point {
-        Point::new(self.position[0].load(Ordering::Relaxed), self.position[1].load(Ordering::Relaxed))
+        let at = |axis: usize| {
+            let emitted = self.position[axis].load(Ordering::Relaxed);
+            emitted.wrapping_sub(self.origin[axis].load(Ordering::Relaxed))
+        };
+        Point::new(at(0), at(1))
+    }
+
+    /// Homing found machine zero: the pen, at rest, is at `position`. Only the homing task
+    /// calls this.
+    pub fn set_origin(&self, position: Point) {
+        for (axis, at) in [position.x, position.y].into_iter().enumerate() {
+            let emitted = self.position[axis].load(Ordering::Relaxed);
+            self.origin[axis].store(emitted.wrapping_sub(at), Ordering::Relaxed);
+        }
+        self.position_lost.store(false, Ordering::Relaxed);
+        self.changed.signal(());
+    }
+
+    /// True when the position may be wrong: from power-on with homing enabled, and after a
+    /// trip stopped the pulses without braking, until the next homing.
+    pub fn position_lost(&self) -> bool {
+        self.position_lost.load(Ordering::Relaxed)
+    }
+
+    /// Asks the homing task for a cycle; false if one runs already. The state is
+    /// [`RunState::Home`] from now until it ends.
+    pub fn request_homing(&self) -> bool {
+        if self.homing.swap(true, Ordering::AcqRel) {
+            return false;
+        }
+        self.homing_requested.signal(());
+        self.changed.signal(());
+        true
+    }
+
+    /// Waits for a homing request. For the homing task.
+    pub async fn homing_requested(&self) {
+        self.homing_requested.wait().await
+    }
+
+    /// True while a homing cycle runs.
+    pub fn homing(&self) -> bool {
+        self.homing.load(Ordering::Acquire)
+    }
+
+    /// The homing cycle ended: at rest, in an alarm if it failed. Only the homing task calls
+    /// this.
+    pub fn end_homing(&self) {
+        self.homing.store(false, Ordering::Release);
+        self.changed.signal(());
+    }
+
+    /// A homing approach stopped at `trip`'s switch: the pulse engine stays halted until the
+    /// homing task has seen it ([`take_switch_found`](Self::take_switch_found)). Only the
+    /// motion task calls this.
+    pub fn found_switch(&self, trip: Trip) {
+        self.switch_found.lock(|f| f.set(Some(trip)));
+    }
+
+    /// The switch the last homing approach stopped at, if it did, and lets pulses out again.
+    /// Only the homing task calls this.
+    pub fn take_switch_found(&self) -> Option<Trip> {
+        let found = self.switch_found.lock(|f| f.take());
+        if found.is_some() {
+            self.halted.store(false, Ordering::Release);
+        }
+        found
     }
 
     /// Asks the motion task for `control`; see [`Control::then`] for requests not yet taken.
@@ -350,10 +449,10 @@ impl Machine {
 
     pub fn run_state(&self) -> RunState {
         match self.state.load(Ordering::Relaxed) {
-            1 => RunState::Run,
-            2 => RunState::Hold,
-            3 => RunState::Jog,
-            4 => RunState::Alarm,
+            STATE_RUN => RunState::Run,
+            STATE_HOLD => RunState::Hold,
+            STATE_JOG => RunState::Jog,
+            STATE_ALARM => RunState::Alarm,
             _ => RunState::Idle,
         }
     }
@@ -361,11 +460,11 @@ impl Machine {
     /// Sets the motion's state. Check mode is not one: see [`set_check_mode`](Self::set_check_mode).
     pub fn set_run_state(&self, state: RunState) {
         let v = match state {
-            RunState::Idle | RunState::Check | RunState::Sleep => 0,
-            RunState::Run => 1,
-            RunState::Hold => 2,
-            RunState::Jog => 3,
-            RunState::Alarm => 4,
+            RunState::Idle | RunState::Check | RunState::Sleep | RunState::Home => STATE_IDLE,
+            RunState::Run => STATE_RUN,
+            RunState::Hold => STATE_HOLD,
+            RunState::Jog => STATE_JOG,
+            RunState::Alarm => STATE_ALARM,
         };
         if self.state.swap(v, Ordering::Relaxed) != v {
             self.changed.signal(());
@@ -379,11 +478,14 @@ impl Machine {
         }
     }
 
-    /// The state to report and to act on: the run state, [`RunState::Sleep`] after `$SLP`, or
-    /// [`RunState::Check`] while the host link checks its lines at rest.
+    /// The state to report and to act on: the run state, [`RunState::Sleep`] after `$SLP`,
+    /// [`RunState::Home`] during a homing cycle, or [`RunState::Check`] while the host link
+    /// checks its lines at rest.
     pub fn state(&self) -> RunState {
         match self.run_state() {
             _ if self.asleep.load(Ordering::Relaxed) => RunState::Sleep,
+            RunState::Alarm => RunState::Alarm,
+            _ if self.homing() => RunState::Home,
             RunState::Idle if self.check_mode.load(Ordering::Relaxed) => RunState::Check,
             state => state,
         }
@@ -413,6 +515,17 @@ impl Machine {
         !self.asleep.load(Ordering::Relaxed) && !off_for_alarm
     }
 
+    /// Whether the drivers hold their axes: SON high for the enable delay (`$209`). Only the
+    /// servo task calls this.
+    pub fn set_servos_ready(&self, ready: bool) {
+        self.servos_ready.store(ready, Ordering::Release);
+    }
+
+    /// True once the drivers hold their axes; no pulse may go out before.
+    pub fn servos_ready(&self) -> bool {
+        self.servos_ready.load(Ordering::Acquire)
+    }
+
     /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it
     /// has not stopped itself already, and starts nothing until [`unlock`](Self::unlock); the
     /// motion task drops what was planned and raises the alarm. A trip while halted is no news.
@@ -421,6 +534,9 @@ impl Machine {
             return;
         }
         self.trip.lock(|t| t.set(Some(trip)));
+        if !self.homing() {
+            self.position_lost.store(true, Ordering::Relaxed);
+        }
         self.control_requested.signal(());
         self.changed.signal(());
     }
@@ -568,6 +684,8 @@ impl Machine {
         loop {
             let (epoch, job) = self.jobs.try_receive().ok()?;
             if epoch == self.plan_epoch() {
+                // Taken, it is planned before anything else may look: nothing has stopped.
+                self.plan_empty.store(false, Ordering::Release);
                 return Some(job);
             }
             warn!("job planned before an abort dropped");
@@ -600,6 +718,7 @@ impl Machine {
     /// True when the machine waits for its inputs: idle, or stopped in an alarm.
     pub fn at_rest(&self) -> bool {
         match self.run_state() {
+            _ if self.homing() => false,
             RunState::Idle => self.is_idle(),
             RunState::Alarm => self.stopped(),
             _ => false,

@@ -35,7 +35,7 @@
 //! calls it at the virtual times the hardware would.
 
 use crate::geom::{Axis, StepCmd, TICK_HZ};
-use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, limits_toward};
+use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, limits_toward};
 use crate::machine::Machine;
 use crate::math;
 use crate::settings::Settings;
@@ -227,6 +227,10 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         let settings = machine.settings();
         self.timing = Timing::from_settings(&settings);
         self.inputs = InputSetup::from_settings(&settings);
+        if machine.homing() {
+            // The homing cycle's approaches end at their switch.
+            self.inputs.watched |= LIMITS;
+        }
         self.debounce.clear();
         self.sign_preloaded = self.sign;
         let first = self.next_period(machine);

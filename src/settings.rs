@@ -16,12 +16,11 @@ pub enum SettingError {
     OutOfRange,
 }
 
-/// Identifies one setting: its `$` number, name, unit and range.
+/// Identifies one setting: its `$` number and range (in the unit the comment beside it in
+/// [`SETTING_INFO`] names).
 #[derive(Clone, Copy, Debug)]
 pub struct SettingInfo {
     pub id: u16,
-    pub name: &'static str,
-    pub unit: &'static str,
     pub min: f32,
     pub max: f32,
 }
@@ -33,43 +32,96 @@ pub const MAX_PULSE_RATE_HZ: f32 = 200_000.0;
 /// Longest input debounce (`$206`): a switch held this long is no bounce.
 pub const INPUT_DEBOUNCE_MAX_MS: u32 = 100;
 
+/// `$1` at this value keeps the servos on for good, as GRBL's step idle delay does.
+pub const SERVO_ALWAYS_ON: u32 = 255;
+
+/// Longest wait for a driver to take SON before the first pulse (`$209`).
+pub const SERVO_ENABLE_DELAY_MAX_MS: u32 = 1_000;
+
+/// Without soft limits (`$20=0`) the pen may go this far either way from machine zero: no
+/// drawing on a plotter reaches it, and the position counters and every interpolator's
+/// arithmetic hold far more.
+pub const UNCHECKED_TRAVEL_STEPS: i32 = 1 << 20;
+
+/// Longest pause after each homing move for the switch to settle (`$26`).
+pub const HOMING_DEBOUNCE_MAX_MS: u32 = 1_000;
+
+/// Where a setting is kept, and so which values it takes: any number in its range, or a whole
+/// one.
+enum Field<'a> {
+    Real(&'a mut f32),
+    Whole(&'a mut u32),
+    Mask(&'a mut u8),
+    Flag(&'a mut bool),
+    Method(&'a mut Method),
+}
+
 /// Every setting, in `$$` listing order.
 pub const SETTING_INFO: &[SettingInfo] = &[
-    SettingInfo { id: 0, name: "pulse width", unit: "us", min: 2.5, max: 100.0 },
-    SettingInfo { id: 3, name: "direction invert mask", unit: "mask", min: 0.0, max: 3.0 },
-    SettingInfo {
-        id: 5,
-        name: "limit pins invert (0 normally open, 1 normally closed)",
-        unit: "bool",
-        min: 0.0,
-        max: 1.0,
-    },
-    SettingInfo {
-        id: 10,
-        name: "status report (1 machine position, +2 buffer state)",
-        unit: "mask",
-        min: 0.0,
-        max: 3.0,
-    },
-    SettingInfo { id: 11, name: "junction deviation", unit: "mm", min: 0.0, max: 5.0 },
-    SettingInfo { id: 21, name: "hard limits", unit: "bool", min: 0.0, max: 1.0 },
-    SettingInfo { id: 100, name: "x steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
-    SettingInfo { id: 101, name: "y steps per mm", unit: "step/mm", min: 1.0, max: 200.0 },
-    SettingInfo { id: 110, name: "x max rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 111, name: "y max rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 120, name: "x acceleration", unit: "mm/s^2", min: 1.0, max: 10_000.0 },
-    SettingInfo { id: 121, name: "y acceleration", unit: "mm/s^2", min: 1.0, max: 10_000.0 },
-    SettingInfo { id: 130, name: "x max travel", unit: "mm", min: 1.0, max: 500.0 },
-    SettingInfo { id: 131, name: "y max travel", unit: "mm", min: 1.0, max: 500.0 },
-    SettingInfo { id: 200, name: "direction setup", unit: "us", min: 5.0, max: 100.0 },
-    SettingInfo { id: 201, name: "start rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 202, name: "interpolation (0 classic, 1 diagonal)", unit: "method", min: 0.0, max: 1.0 },
-    SettingInfo { id: 203, name: "default feed rate", unit: "mm/min", min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 204, name: "max function jump", unit: "mm", min: 0.01, max: 500.0 },
-    SettingInfo { id: 205, name: "max pulse rate", unit: "Hz", min: 100.0, max: MAX_PULSE_RATE_HZ },
-    SettingInfo { id: 206, name: "input debounce", unit: "ms", min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
-    SettingInfo { id: 207, name: "driver alarm inputs", unit: "bool", min: 0.0, max: 1.0 },
-    SettingInfo { id: 208, name: "emergency stop input", unit: "bool", min: 0.0, max: 1.0 },
+    // pulse width, us
+    SettingInfo { id: 0, min: 2.5, max: 100.0 },
+    // servo idle off delay (255 always on), ms
+    SettingInfo { id: 1, min: 0.0, max: 255.0 },
+    // direction invert mask, mask
+    SettingInfo { id: 3, min: 0.0, max: 3.0 },
+    // limit pins invert (0 normally open, 1 normally closed), bool
+    SettingInfo { id: 5, min: 0.0, max: 1.0 },
+    // status report (1 machine position, +2 buffer state), mask
+    SettingInfo { id: 10, min: 0.0, max: 3.0 },
+    // junction deviation, mm
+    SettingInfo { id: 11, min: 0.0, max: 5.0 },
+    // soft limits, bool
+    SettingInfo { id: 20, min: 0.0, max: 1.0 },
+    // hard limits, bool
+    SettingInfo { id: 21, min: 0.0, max: 1.0 },
+    // homing cycle, bool
+    SettingInfo { id: 22, min: 0.0, max: 1.0 },
+    // homing direction mask (set: towards min), mask
+    SettingInfo { id: 23, min: 0.0, max: 3.0 },
+    // homing locate feed, mm/min
+    SettingInfo { id: 24, min: 1.0, max: 60_000.0 },
+    // homing seek feed, mm/min
+    SettingInfo { id: 25, min: 1.0, max: 60_000.0 },
+    // homing debounce, ms
+    SettingInfo { id: 26, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
+    // homing pull-off, mm
+    SettingInfo { id: 27, min: 0.1, max: 20.0 },
+    // x steps per mm, step/mm
+    SettingInfo { id: 100, min: 1.0, max: 200.0 },
+    // y steps per mm, step/mm
+    SettingInfo { id: 101, min: 1.0, max: 200.0 },
+    // x max rate, mm/min
+    SettingInfo { id: 110, min: 1.0, max: 60_000.0 },
+    // y max rate, mm/min
+    SettingInfo { id: 111, min: 1.0, max: 60_000.0 },
+    // x acceleration, mm/s^2
+    SettingInfo { id: 120, min: 1.0, max: 10_000.0 },
+    // y acceleration, mm/s^2
+    SettingInfo { id: 121, min: 1.0, max: 10_000.0 },
+    // x max travel, mm
+    SettingInfo { id: 130, min: 1.0, max: 500.0 },
+    // y max travel, mm
+    SettingInfo { id: 131, min: 1.0, max: 500.0 },
+    // direction setup, us
+    SettingInfo { id: 200, min: 5.0, max: 100.0 },
+    // start rate, mm/min
+    SettingInfo { id: 201, min: 1.0, max: 60_000.0 },
+    // interpolation (0 classic, 1 diagonal), method
+    SettingInfo { id: 202, min: 0.0, max: 1.0 },
+    // default feed rate, mm/min
+    SettingInfo { id: 203, min: 1.0, max: 60_000.0 },
+    // max function jump, mm
+    SettingInfo { id: 204, min: 0.01, max: 500.0 },
+    // max pulse rate, Hz
+    SettingInfo { id: 205, min: 100.0, max: MAX_PULSE_RATE_HZ },
+    // input debounce, ms
+    SettingInfo { id: 206, min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
+    // driver alarm inputs, bool
+    SettingInfo { id: 207, min: 0.0, max: 1.0 },
+    // emergency stop input, bool
+    SettingInfo { id: 208, min: 0.0, max: 1.0 },
+    // servo enable delay, ms
+    SettingInfo { id: 209, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -78,6 +130,9 @@ pub const SETTING_INFO: &[SettingInfo] = &[
 pub struct Settings {
     /// Width of the PULS pulse ($0).
     pub pulse_width_us: f32,
+    /// After this long at rest the servos go off (SON low) until the next move;
+    /// [`SERVO_ALWAYS_ON`] keeps them on ($1).
+    pub servo_idle_delay_ms: u32,
     /// Bit 0 inverts X's SIGN output, bit 1 Y's ($3).
     pub dir_invert_mask: u8,
     /// The limit switches are normally closed: pressed reads high ($5).
@@ -87,8 +142,23 @@ pub struct Settings {
     pub status_report_mask: u8,
     /// GRBL's junction deviation for look-ahead at corners ($11).
     pub junction_deviation_mm: f32,
+    /// Drawings and jogs that would leave the travel are refused ($20).
+    pub soft_limits: bool,
     /// A limit switch pressed while moving towards it stops the machine in an alarm ($21).
     pub hard_limits: bool,
+    /// `$H` finds the limit switches and sets machine zero; the machine powers on locked until
+    /// it is homed or unlocked ($22).
+    pub homing: bool,
+    /// Bit 0 homes X, bit 1 Y, towards its min switch; clear, towards its max switch ($23).
+    pub homing_dir_mask: u8,
+    /// Slow approach that locates the switch ($24).
+    pub homing_locate_mm_per_min: f32,
+    /// Fast approach that seeks the switch, and the pull-offs ($25).
+    pub homing_seek_mm_per_min: f32,
+    /// Pause after each homing move for the switch to settle ($26).
+    pub homing_debounce_ms: u32,
+    /// How far homing backs off the switch it found ($27).
+    pub homing_pull_off_mm: f32,
     /// Steps per millimetre, X and Y ($100, $101).
     pub steps_per_mm: [f32; 2],
     /// Fastest travel per axis ($110, $111).
@@ -117,61 +187,99 @@ pub struct Settings {
     pub driver_alarm_input: bool,
     /// The emergency stop input is wired ($208).
     pub estop_input: bool,
+    /// After SON goes high, the driver takes this long to hold its axis: the first pulse waits
+    /// for it ($209).
+    pub servo_enable_delay_ms: u32,
 }
 
 impl Default for Settings {
     fn default() -> Self {
-        Settings {
-            pulse_width_us: 5.0,
-            dir_invert_mask: 0,
-            limit_pins_invert: false,
-            status_report_mask: 1,
-            junction_deviation_mm: 0.02,
-            hard_limits: false,
-            steps_per_mm: [100.0, 100.0],
-            max_rate_mm_per_min: [6_000.0, 6_000.0],
-            accel_mm_per_s2: [500.0, 500.0],
-            max_travel_mm: [200.0, 200.0],
-            dir_setup_us: 10.0,
-            start_rate_mm_per_min: 300.0,
-            method: Method::Diagonal,
-            default_feed_mm_per_min: 3_000.0,
-            max_jump_mm: 5.0,
-            max_pulse_rate_hz: 20_000.0,
-            input_debounce_ms: 2,
-            driver_alarm_input: false,
-            estop_input: false,
-        }
+        DEFAULT_SETTINGS
     }
 }
+
+/// [`Settings::default`], one copy in flash for every caller.
+const DEFAULT_SETTINGS: Settings = Settings {
+    pulse_width_us: 5.0,
+    servo_idle_delay_ms: SERVO_ALWAYS_ON,
+    dir_invert_mask: 0,
+    limit_pins_invert: false,
+    status_report_mask: 1,
+    junction_deviation_mm: 0.02,
+    soft_limits: true,
+    hard_limits: false,
+    homing: false,
+    homing_dir_mask: 3,
+    homing_locate_mm_per_min: 100.0,
+    homing_seek_mm_per_min: 1_000.0,
+    homing_debounce_ms: 250,
+    homing_pull_off_mm: 1.0,
+    steps_per_mm: [100.0, 100.0],
+    max_rate_mm_per_min: [6_000.0, 6_000.0],
+    accel_mm_per_s2: [500.0, 500.0],
+    max_travel_mm: [200.0, 200.0],
+    dir_setup_us: 10.0,
+    start_rate_mm_per_min: 300.0,
+    method: Method::Diagonal,
+    default_feed_mm_per_min: 3_000.0,
+    max_jump_mm: 5.0,
+    max_pulse_rate_hz: 20_000.0,
+    input_debounce_ms: 2,
+    driver_alarm_input: false,
+    estop_input: false,
+    servo_enable_delay_ms: 50,
+};
 
 impl Settings {
     /// The current value of setting `id`.
     pub fn get(&self, id: u16) -> Result<f32, SettingError> {
-        Ok(match id {
-            0 => self.pulse_width_us,
-            3 => self.dir_invert_mask as f32,
-            5 => f32::from(u8::from(self.limit_pins_invert)),
-            10 => self.status_report_mask as f32,
-            11 => self.junction_deviation_mm,
-            21 => f32::from(u8::from(self.hard_limits)),
-            100 | 101 => self.steps_per_mm[(id - 100) as usize],
-            110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize],
-            120 | 121 => self.accel_mm_per_s2[(id - 120) as usize],
-            130 | 131 => self.max_travel_mm[(id - 130) as usize],
-            200 => self.dir_setup_us,
-            201 => self.start_rate_mm_per_min,
-            202 => match self.method {
-                Method::Classic => 0.0,
-                Method::Diagonal => 1.0,
-            },
-            203 => self.default_feed_mm_per_min,
-            204 => self.max_jump_mm,
-            205 => self.max_pulse_rate_hz,
-            206 => self.input_debounce_ms as f32,
-            207 => f32::from(u8::from(self.driver_alarm_input)),
-            208 => f32::from(u8::from(self.estop_input)),
-            _ => return Err(SettingError::Unknown),
+        Ok(match self.clone().field(id).ok_or(SettingError::Unknown)? {
+            Field::Real(v) => *v,
+            Field::Whole(v) => *v as f32,
+            Field::Mask(v) => f32::from(*v),
+            Field::Flag(v) => f32::from(u8::from(*v)),
+            Field::Method(Method::Classic) => 0.0,
+            Field::Method(Method::Diagonal) => 1.0,
+        })
+    }
+
+    /// True when setting `id` takes whole numbers only (a count, a bit mask, a choice).
+    pub fn is_whole(&self, id: u16) -> bool {
+        !matches!(self.clone().field(id), Some(Field::Real(_)) | None)
+    }
+
+    /// The field that holds setting `id`.
+    fn field(&mut self, id: u16) -> Option<Field<'_>> {
+        Some(match id {
+            0 => Field::Real(&mut self.pulse_width_us),
+            1 => Field::Whole(&mut self.servo_idle_delay_ms),
+            3 => Field::Mask(&mut self.dir_invert_mask),
+            5 => Field::Flag(&mut self.limit_pins_invert),
+            10 => Field::Mask(&mut self.status_report_mask),
+            11 => Field::Real(&mut self.junction_deviation_mm),
+            20 => Field::Flag(&mut self.soft_limits),
+            21 => Field::Flag(&mut self.hard_limits),
+            22 => Field::Flag(&mut self.homing),
+            23 => Field::Mask(&mut self.homing_dir_mask),
+            24 => Field::Real(&mut self.homing_locate_mm_per_min),
+            25 => Field::Real(&mut self.homing_seek_mm_per_min),
+            26 => Field::Whole(&mut self.homing_debounce_ms),
+            27 => Field::Real(&mut self.homing_pull_off_mm),
+            100 | 101 => Field::Real(&mut self.steps_per_mm[usize::from(id - 100)]),
+            110 | 111 => Field::Real(&mut self.max_rate_mm_per_min[usize::from(id - 110)]),
+            120 | 121 => Field::Real(&mut self.accel_mm_per_s2[usize::from(id - 120)]),
+            130 | 131 => Field::Real(&mut self.max_travel_mm[usize::from(id - 130)]),
+            200 => Field::Real(&mut self.dir_setup_us),
+            201 => Field::Real(&mut self.start_rate_mm_per_min),
+            202 => Field::Method(&mut self.method),
+            203 => Field::Real(&mut self.default_feed_mm_per_min),
+            204 => Field::Real(&mut self.max_jump_mm),
+            205 => Field::Real(&mut self.max_pulse_rate_hz),
+            206 => Field::Whole(&mut self.input_debounce_ms),
+            207 => Field::Flag(&mut self.driver_alarm_input),
+            208 => Field::Flag(&mut self.estop_input),
+            209 => Field::Whole(&mut self.servo_enable_delay_ms),
+            _ => return None,
         })
     }
 
@@ -212,27 +320,13 @@ impl Settings {
             return Err(SettingError::OutOfRange);
         }
         let whole = value == crate::math::floor(value);
-        match id {
-            0 => self.pulse_width_us = value,
-            3 if whole => self.dir_invert_mask = value as u8,
-            5 if whole => self.limit_pins_invert = value != 0.0,
-            10 if whole => self.status_report_mask = value as u8,
-            11 => self.junction_deviation_mm = value,
-            21 if whole => self.hard_limits = value != 0.0,
-            100 | 101 => self.steps_per_mm[(id - 100) as usize] = value,
-            110 | 111 => self.max_rate_mm_per_min[(id - 110) as usize] = value,
-            120 | 121 => self.accel_mm_per_s2[(id - 120) as usize] = value,
-            130 | 131 => self.max_travel_mm[(id - 130) as usize] = value,
-            200 => self.dir_setup_us = value,
-            201 => self.start_rate_mm_per_min = value,
-            202 if whole => self.method = if value == 0.0 { Method::Classic } else { Method::Diagonal },
-            203 => self.default_feed_mm_per_min = value,
-            204 => self.max_jump_mm = value,
-            205 => self.max_pulse_rate_hz = value,
-            206 if whole => self.input_debounce_ms = value as u32,
-            207 if whole => self.driver_alarm_input = value != 0.0,
-            208 if whole => self.estop_input = value != 0.0,
-            _ => return Err(SettingError::OutOfRange),
+        match self.field(id).ok_or(SettingError::Unknown)? {
+            Field::Real(v) => *v = value,
+            _ if !whole => return Err(SettingError::OutOfRange),
+            Field::Whole(v) => *v = value as u32,
+            Field::Mask(v) => *v = value as u8,
+            Field::Flag(v) => *v = value != 0.0,
+            Field::Method(v) => *v = if value == 0.0 { Method::Classic } else { Method::Diagonal },
         }
         Ok(())
     }
@@ -247,8 +341,19 @@ impl Settings {
         Ok(())
     }
 
-    /// The travel limits ±`$130`, ±`$131` in steps: the lattice points the pen may reach.
+    /// The travel limits in steps, either way from machine zero: the lattice points the pen may
+    /// reach. With soft limits (`$20`) those of `$130`, `$131`: the pen stays inside the travel
+    /// (homing, `$22`, puts machine zero in its middle); without, [`UNCHECKED_TRAVEL_STEPS`].
+    /// The one travel check: the drawing builder, the curves' guard and the jogs all use it.
     pub fn travel_steps(&self) -> [i32; 2] {
+        if !self.soft_limits {
+            return [UNCHECKED_TRAVEL_STEPS; 2];
+        }
+        self.configured_travel_steps()
+    }
+
+    /// `$130`, `$131` in steps, soft limits or not.
+    pub fn configured_travel_steps(&self) -> [i32; 2] {
         [0, 1].map(|i| crate::math::floor(self.max_travel_mm[i] * self.steps_per_mm[i] + 1e-3) as i32)
     }
 

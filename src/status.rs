@@ -2,6 +2,7 @@
 //! reports and the menu see it.
 
 use crate::geom::Point;
+use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::CurveError;
 use crate::overrides::Overrides;
@@ -23,15 +24,17 @@ pub enum RunState {
     /// The host link's check mode (`$C`): lines are parsed and every drawing built and checked,
     /// but nothing moves.
     Check,
+    /// A homing cycle (`$H`) runs.
+    Home,
     /// `$SLP`: the servos are off (SON low) and every line is refused until a reset, after which
     /// the machine is in alarm: the axes were free, the pen may have been moved.
     Sleep,
 }
 
 impl RunState {
-    /// True while the machine moves or holds a job: drawing, held or jogging.
+    /// True while the machine moves or holds a job: drawing, held, jogging or homing.
     pub const fn moving(self) -> bool {
-        matches!(self, RunState::Run | RunState::Hold | RunState::Jog)
+        matches!(self, RunState::Run | RunState::Hold | RunState::Jog | RunState::Home)
     }
 }
 
@@ -44,6 +47,8 @@ pub enum MotionFault {
     Curve(CurveError),
     /// An input stopped the machine at once: a limit switch, a driver alarm, the emergency stop.
     Tripped(Trip),
+    /// A homing cycle failed.
+    Homing(HomingFail),
 }
 
 /// A snapshot of the machine for displays and reports.
@@ -51,7 +56,7 @@ pub enum MotionFault {
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct Status {
     pub state: RunState,
-    /// Pulses emitted so far, per axis: the position, always.
+    /// The machine position, steps: the pulses emitted so far, from machine zero.
     pub position: Point,
     /// Jobs waiting behind the one in progress.
     pub queued_jobs: u8,

@@ -136,3 +136,22 @@ fn the_emergency_stop_stops_everything_resets_the_links_and_locks() {
     assert!(after.contains("[MSG:Caution: Unlocked]"), "{answers}");
     assert_eq!(report.position.y, 0, "nothing moved after the stop");
 }
+
+#[test]
+fn with_an_idle_delay_the_servos_go_off_at_rest_and_come_back_before_the_next_move() {
+    // $1=100: SON low 100 ms after the pen stops; $209=30: the next move waits 30 ms for the
+    // drivers once SON is high again.
+    let report = run("$1=100\n$209=30\nG1 X5 F3000\n", &[(2_000_000, "G1 X0\n")], None, "");
+    let son = &report.son;
+    let first_stop = report.trace.pulses.iter().filter(|p| p.t_us < 2_000_000).map(|p| p.t_us).max().unwrap();
+    let off = son.iter().find(|c| !c.1).expect("SON went low").0;
+    assert!((first_stop + 100_000..first_stop + 115_000).contains(&off), "stopped {first_stop} µs, SON off {off} µs");
+    let on_again = son.iter().find(|c| c.1 && c.0 > off).expect("SON back on").0;
+    assert!((2_000_000..2_015_000).contains(&on_again), "SON on at {on_again} µs");
+    let next_pulse = report.trace.pulses.iter().map(|p| p.t_us).find(|&t| t > 2_000_000).unwrap();
+    assert!(next_pulse >= on_again + 30_000, "first pulse {next_pulse} µs, SON on {on_again} µs");
+    assert_eq!(report.position.x, 0);
+    // The default, 255, keeps them on.
+    let report = run("G1 X5 F3000\n", &[(2_000_000, "G1 X0\n")], None, "");
+    assert!(report.son.iter().all(|c| c.1), "{:?}", report.son);
+}

@@ -32,6 +32,8 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let loose = Settings::default();
     let tight = Settings { max_travel_mm: [50.0, 50.0], ..Settings::default() };
     let machine = Machine::new(tight);
+    // No servo task here: the drivers hold their axes from the start.
+    machine.set_servos_ready(true);
     let epoch = machine.plan_epoch();
     let first = line_to(150.0, Point::ORIGIN, &loose);
     let end = first.drawing.end();

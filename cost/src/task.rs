@@ -58,6 +58,8 @@ const MAX_POLLS: usize = 100_000;
 /// the steps it queued. Returns the steps emitted.
 pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let machine = Machine::new(settings.clone());
+    // No servo task here: the drivers hold their axes from the start.
+    machine.set_servos_ready(true);
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
     let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}, servoplot::tasks::motion::RealTime));

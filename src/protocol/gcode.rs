@@ -258,6 +258,8 @@ pub enum Command {
     Report(Report),
     /// `$X`: leave the alarm state (GRBL answers `[MSG:Caution: Unlocked]`).
     Unlock,
+    /// `$H`: run the homing cycle; `ok` once the machine is homed.
+    Home,
     /// `$C`: enter check mode (`[MSG:Enabled]`), or leave it (`[MSG:Disabled]`, then a soft
     /// reset once the line is answered, as GRBL does, so the parser plans from the pen again).
     CheckMode { on: bool },

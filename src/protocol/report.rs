@@ -15,6 +15,7 @@ use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, StoredPos
 use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::Axis;
+use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::CurveError;
 use crate::protocol::startup::StartupLines;
@@ -29,9 +30,6 @@ pub const BUILD_NAME: &str = "servoplot";
 
 /// Longest single line written here (a status report with a work offset at ±500 mm is 81).
 pub const REPORT_LINE_MAX_BYTES: usize = 128;
-
-/// Settings whose values are whole numbers (a bit mask, a choice), listed without decimals.
-const INTEGER_SETTINGS: &[u16] = &[3, 5, 10, 21, 202, 206, 207, 208];
 
 /// `ok`: the line was executed.
 pub fn ok(out: &mut impl Write) -> fmt::Result {
@@ -78,15 +76,25 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
     out.write_str("]\r\n")
 }
 
-/// The banner after power-up and every soft reset.
-pub fn welcome(out: &mut impl Write) -> fmt::Result {
-    write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")
+/// The banner after power-up and every soft reset; in an alarm, GRBL's hint how to leave it.
+pub fn welcome(out: &mut impl Write, state: RunState) -> fmt::Result {
+    write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")?;
+    if state == RunState::Alarm {
+        message(out, "'$H'|'$X' to unlock")?;
+    }
+    Ok(())
 }
 
 /// GRBL's alarm code for a hard limit: a limit switch stopped the machine.
 pub const ALARM_HARD_LIMIT: u8 = 1;
 /// GRBL's alarm code for the soft limit: a motion would leave the travel.
 pub const ALARM_SOFT_LIMIT: u8 = 2;
+/// GRBL's alarm code for a homing cycle stopped by a reset or an abort.
+pub const ALARM_HOMING_ABORTED: u8 = 6;
+/// GRBL's alarm code for a homing pull-off that left the switch pressed.
+pub const ALARM_HOMING_PULL_OFF: u8 = 8;
+/// GRBL's alarm code for a homing approach that found no switch.
+pub const ALARM_HOMING_APPROACH: u8 = 9;
 /// grblHAL's alarm code for the emergency stop.
 pub const ALARM_ESTOP: u8 = 10;
 /// grblHAL's alarm code for a motor fault: a driver raised its alarm output.
@@ -99,6 +107,7 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
     let e = match fault {
         MotionFault::Curve(e) => e,
         MotionFault::Tripped(trip) => return tripped(out, trip),
+        MotionFault::Homing(fail) => return homing_failed(out, fail),
     };
     let code = if e == CurveError::Travel { ALARM_SOFT_LIMIT } else { ALARM_CURVE_STOPPED };
     let why = match e {
@@ -109,6 +118,16 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
         CurveError::Travel => "travel limit",
     };
     write!(out, "ALARM:{}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n", Int::from(code))
+}
+
+/// The alarm of a failed homing cycle: `ALARM:N` and what failed.
+fn homing_failed(out: &mut impl Write, fail: HomingFail) -> fmt::Result {
+    let (code, axis, why) = match fail {
+        HomingFail::Aborted => (ALARM_HOMING_ABORTED, "", "reset or abort during the cycle"),
+        HomingFail::PullOff(axis) => (ALARM_HOMING_PULL_OFF, axis.name(), " switch still pressed after the pull-off"),
+        HomingFail::Approach(axis) => (ALARM_HOMING_APPROACH, axis.name(), " switch not found"),
+    };
+    write!(out, "ALARM:{}\r\n[MSG:Homing failed: {axis}{why}. '$H' or '$X']\r\n", Int::from(code))
 }
 
 /// The alarm of a trip: `ALARM:N`, what tripped, and what clears it.
@@ -164,6 +183,7 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
         RunState::Alarm => "Alarm",
         RunState::Check => "Check",
         RunState::Sleep => "Sleep",
+        RunState::Home => "Home",
     };
     let machine = settings.status_report_mask & 1 != 0;
     write!(out, "<{state}|{}:", if machine { "MPos" } else { "WPos" })?;
@@ -198,11 +218,12 @@ pub fn settings(out: &mut impl Write, settings: &Settings) -> fmt::Result {
     Ok(())
 }
 
-/// One `$N=value` line; nothing for an unknown id.
+/// One `$N=value` line, whole numbers (a count, a bit mask, a choice) without decimals;
+/// nothing for an unknown id.
 pub fn setting(out: &mut impl Write, id: u16, settings: &Settings) -> fmt::Result {
     let Ok(value) = settings.get(id) else { return Ok(()) };
     write!(out, "${}=", Int::from(id))?;
-    if INTEGER_SETTINGS.contains(&id) {
+    if settings.is_whole(id) {
         write!(out, "{}", Int(value as i64))?;
     } else {
         decimal(out, value)?;
@@ -419,7 +440,11 @@ mod tests {
         assert_eq!(text(ok), "ok\r\n");
         assert_eq!(text(|o| error(o, GrblError::TravelExceeded)), "error:15\r\n");
         assert_eq!(text(|o| error(o, GrblError::ModalGroupViolation)), "error:21\r\n");
-        assert_eq!(text(welcome), "\r\nGrbl 1.1h ['$' for help]\r\n");
+        assert_eq!(text(|o| welcome(o, RunState::Idle)), "\r\nGrbl 1.1h ['$' for help]\r\n");
+        assert_eq!(
+            text(|o| welcome(o, RunState::Alarm)),
+            "\r\nGrbl 1.1h ['$' for help]\r\n[MSG:'$H'|'$X' to unlock]\r\n"
+        );
         assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
         assert_eq!(text(|o| build_info(o, "", 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
         assert!(text(help).starts_with("[HLP:$$ $# $G $I"));

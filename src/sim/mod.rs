@@ -180,7 +180,7 @@ pub fn run(config: SimConfig) -> SimReport {
             tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
             tasks::lcd::run(&machine, lcd),
         ),
-        tasks::servo::run(&machine, son.clone(), || inputs.levels()),
+        join(tasks::servo::run(&machine, son.clone(), || inputs.levels()), tasks::homing::run(&machine)),
     );
     let mut firmware = pin!(firmware);
     let flag = Arc::new(FlagWaker(AtomicBool::new(true)));

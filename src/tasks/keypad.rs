@@ -62,6 +62,9 @@ fn act(machine: &Machine, action: MenuAction) {
         }
         MenuAction::JogStop => machine.request(Control::Abort),
         MenuAction::Control(control) => machine.request(control),
+        MenuAction::Home => {
+            machine.request_homing();
+        }
     }
 }
 

@@ -28,6 +28,9 @@ use crate::status::RunState;
 /// again after this long instead of spinning; also the shortest wait for the queue to drain.
 pub const MOTION_RETRY_US: u64 = 100;
 
+/// How often the task looks whether the servos are ready before it starts the pulses.
+pub const SERVO_READY_POLL_MS: u64 = 1;
+
 /// Steps computed before they are published to the pulse engine: the pulses wait at most this
 /// many steps' work for a refill, however much of the queue is free (32 functions steps are
 /// about 1.3 ms on the F407).
@@ -131,6 +134,10 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
         machine.set_queued(queued.steps, queued.ticks);
         machine.set_plan_free_segments(planner.free_segments());
         if queued.steps != steps_before {
+            // Off after standing still (`$1`), the servos take their enable delay first.
+            while !machine.servos_ready() && !machine.halted() {
+                Timer::after(Duration::from_millis(SERVO_READY_POLL_MS)).await;
+            }
             kick();
         }
         match filled {
@@ -171,7 +178,9 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
 
 /// An input tripped the machine (see [`crate::inputs`]): once the pulse engine has halted,
 /// drops everything planned and queued without braking (the pulses already stopped), takes the
-/// position from the pulses emitted, and raises the alarm. Motion is refused until `$X`.
+/// position from the pulses emitted, and raises the alarm. Motion is refused until `$X`. A limit
+/// switch a homing approach ran into is what the approach looked for: no alarm, the homing task
+/// takes it from there.
 async fn halted(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
@@ -190,6 +199,11 @@ async fn halted(
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
+    if machine.homing() && matches!(trip, Trip::Limit { .. }) {
+        info!("homing found {:?}", trip);
+        machine.found_switch(trip);
+        return;
+    }
     machine.set_run_state(RunState::Alarm);
     machine.set_fault(Some(MotionFault::Tripped(trip)));
     machine.abort_plan();
@@ -235,9 +249,13 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
     info!("job planned to ({}, {}) steps", end.x, end.y);
     machine.set_drawing(job.drawing.kind());
     machine.set_fault(None);
-    let curve = job.drawing.into_curve().keep_within(settings.travel_steps());
+    let curve = match job.kind {
+        // Built without the travel check: see `Job::homing_move`.
+        JobKind::Home => job.drawing.into_curve(),
+        JobKind::Draw | JobKind::Jog => job.drawing.into_curve().keep_within(settings.travel_steps()),
+    };
     let pushed = match job.kind {
-        JobKind::Draw => planner.push(curve, job.feed, settings.method),
+        JobKind::Draw | JobKind::Home => planner.push(curve, job.feed, settings.method),
         JobKind::Jog => planner.push_jog(curve, job.feed, settings.method),
     };
     if pushed.is_err() {
@@ -245,7 +263,7 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
         error!("planner refused a segment it had room for");
     }
     match job.kind {
-        JobKind::Draw => RunState::Run,
+        JobKind::Draw | JobKind::Home => RunState::Run,
         JobKind::Jog => RunState::Jog,
     }
 }

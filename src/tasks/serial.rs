@@ -102,7 +102,7 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     };
     for link in &host.links {
         // The writers are not running yet: each outbox has room for this first answer.
-        link.send(report::welcome).await;
+        link.send(|a| report::welcome(a, machine.state())).await;
     }
     let [a, b] = &host.links;
     join(
@@ -165,9 +165,10 @@ impl Host<'_> {
         }
     }
 
-    /// Waits until nothing is queued, planned or moving, held or not: the position is final.
+    /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
+    /// runs: the position is final.
     async fn machine_stopped(&self) {
-        while !self.machine.stopped() {
+        while !self.machine.stopped() || self.machine.homing() {
             Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
         }
     }
@@ -311,7 +312,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         let settings = machine.settings();
         self.gcode.reset(machine.position(), &settings);
         self.epoch = machine.plan_epoch();
-        link.send(report::welcome).await;
+        link.send(|a| report::welcome(a, machine.state())).await;
         self.startup_blocks(&[link]).await;
     }
 
@@ -441,12 +442,23 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 link.send(|a| report::message(a, "Disabled")).await;
                 self.restart_after_answer = true;
             }
-            Command::Unlock => {
+            Command::Unlock | Command::Home
+                if InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0 =>
+            {
                 // A driver alarm or the e-stop still raised would trip again at once.
-                if InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0 {
-                    link.send(|a| report::message(a, "Driver alarm or e-stop still active")).await;
+                link.send(|a| report::message(a, "Driver alarm or e-stop still active")).await;
+                return Err(Unfinished::Error(GrblError::Locked));
+            }
+            Command::Home => {
+                unless_reset(link, host.machine_stopped()).await?;
+                machine.request_homing();
+                unless_reset(link, host.machine_stopped()).await?;
+                // A failed cycle pushed its alarm.
+                if machine.run_state() == RunState::Alarm {
                     return Err(Unfinished::Error(GrblError::Locked));
                 }
+            }
+            Command::Unlock => {
                 if machine.halted() {
                     // The motion task drops what a trip cut short before the pulses may go on.
                     unless_reset(link, host.machine_stopped()).await?;

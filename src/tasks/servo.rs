@@ -2,13 +2,17 @@
 //! drivers' alarms and the emergency stop whether the axes move or not (the pulse engine watches
 //! them too while they move, at every period). SON stays low from power-on until this task runs
 //! (the board starts it with the pulse engine running); the servos then hold position, and go
-//! off while the machine sleeps (`$SLP`) until a reset, and after a driver alarm until `$X`.
+//! off while the machine sleeps (`$SLP`) until a reset, after a driver alarm until `$X`, and,
+//! unless `$1` is 255, once the machine has stood still for `$1` ms. SON comes back on as soon
+//! as there is motion to make, and the machine counts the servos ready `$209` ms later: the
+//! motion task starts no pulse before (see [`Machine::servos_ready`]).
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 
 use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
+use crate::settings::SERVO_ALWAYS_ON;
 
 /// How often the task reads the inputs and sets SON: well within a person's reach of the axes
 /// after `$SLP`, and an e-stop pressed at rest is an alarm within this (plus the debounce).
@@ -18,10 +22,14 @@ pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 /// trips the machine when a driver alarm or the e-stop read through `levels` stays active.
 pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl FnMut() -> InputLevels) -> ! {
     let mut debounce = Debounce::default();
+    // Since when the machine stands still, and since when SON is high.
+    let mut still_since: Option<Instant> = None;
+    let mut on_since: Option<Instant> = None;
     loop {
         let now = levels();
         machine.set_input_levels(now);
-        let setup = InputSetup::from_settings(&machine.settings());
+        let settings = machine.settings();
+        let setup = InputSetup::from_settings(&settings);
         let active = setup.stops_active(now);
         // The debounce clock in ticks, wrapping as it allows.
         let ticks = Instant::now().as_ticks() as u32;
@@ -29,7 +37,16 @@ pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl F
             machine.trip(trip);
             debounce.clear();
         }
-        if son.set_state(PinState::from(machine.servos_on())).is_err() {
+        let at = Instant::now();
+        let still = machine.stopped() && !machine.homing();
+        still_since = if still { still_since.or(Some(at)) } else { None };
+        let idle_off = settings.servo_idle_delay_ms != SERVO_ALWAYS_ON
+            && still_since.is_some_and(|t| at - t >= Duration::from_millis(settings.servo_idle_delay_ms.into()));
+        let on = machine.servos_on() && !idle_off;
+        on_since = if on { on_since.or(Some(at)) } else { None };
+        let enable_delay = Duration::from_millis(settings.servo_enable_delay_ms.into());
+        machine.set_servos_ready(on_since.is_some_and(|t| at - t >= enable_delay));
+        if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
         }
         Timer::after(Duration::from_millis(SERVO_ENABLE_POLL_MS)).await;

@@ -16,6 +16,7 @@
 //!   field); `C` clears the field; `#` checks the value and moves on, and on the last field
 //!   starts the job. A value that is refused shows why and stays for correction.
 //! - Jog: hold `1`-`4`, `6`-`9` to move (see [`JOG_KEYS`]); releasing the key stops.
+//! - Home (`8`): runs the homing cycle at once when homing is on (`$22`); `D` aborts it.
 //!
 //! Every keypad drawing starts at the pen and is typed relative to it: a line is typed as its
 //! offset (dX, dY) from the pen; curves are placed as described in [`crate::drawing`]. So
@@ -144,7 +145,7 @@ impl Menu {
     /// only outside the jog screen (inside it, the jog keys steer it).
     pub fn is_busy(&self, status: &Status) -> bool {
         match status.state {
-            RunState::Run | RunState::Hold | RunState::Check | RunState::Sleep => true,
+            RunState::Run | RunState::Hold | RunState::Check | RunState::Sleep | RunState::Home => true,
             RunState::Jog => self.screen != Screen::Jog,
             RunState::Idle | RunState::Alarm => false,
         }
@@ -193,7 +194,7 @@ impl Menu {
             if self.jog.take().is_some() {
                 return MenuAction::JogStop;
             }
-            if matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog) {
+            if matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog | RunState::Home) {
                 return MenuAction::Control(Control::Abort);
             }
             self.screen = Screen::Modes;
@@ -206,10 +207,7 @@ impl Menu {
             _ => {}
         }
         let result = match &mut self.screen {
-            Screen::Modes => {
-                self.press_modes(key);
-                Ok(MenuAction::None)
-            }
+            Screen::Modes => self.press_modes(key, settings),
             Screen::Settings { first_line } => {
                 let last = SETTINGS_VIEW_LINES.saturating_sub(SETTINGS_VISIBLE_LINES);
                 match key {
@@ -235,27 +233,32 @@ impl Menu {
         })
     }
 
-    fn press_modes(&mut self, key: Key) {
+    fn press_modes(&mut self, key: Key, settings: &Settings) -> Result<MenuAction, UiError> {
         let last = Mode::ALL.len() - 1;
         match key {
             Key::Digit(d) => {
                 if let Some(&mode) = (d as usize).checked_sub(1).and_then(|i| Mode::ALL.get(i)) {
-                    self.enter(mode);
+                    return self.enter(mode, settings);
                 }
             }
             Key::A => self.selected = Mode::ALL[self.selected.index().saturating_sub(1)],
             Key::B => self.selected = Mode::ALL[(self.selected.index() + 1).min(last)],
-            Key::Hash => self.enter(self.selected),
+            Key::Hash => return self.enter(self.selected, settings),
             _ => {}
         }
+        Ok(MenuAction::None)
     }
 
-    fn enter(&mut self, mode: Mode) {
+    /// Enters `mode`'s screen; homing starts at once, from the mode list.
+    fn enter(&mut self, mode: Mode, settings: &Settings) -> Result<MenuAction, UiError> {
         self.selected = mode;
         self.screen = match mode {
             Mode::Jog => Screen::Jog,
             Mode::Settings => Screen::Settings { first_line: 0 },
+            Mode::Home if !settings.homing => return Err(UiError::HomingOff),
+            Mode::Home => return Ok(MenuAction::Home),
             _ => Screen::Form(Form::new(mode)),
         };
+        Ok(MenuAction::None)
     }
 }

@@ -32,6 +32,7 @@ use heapless::String;
 use crate::decimal::Int;
 use crate::drawing::DrawError;
 use crate::geom::{Axis, Step};
+use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::{CurveError, Method};
 use crate::job::JOG_FEED_MM_PER_MIN;
@@ -209,6 +210,7 @@ fn state_name(status: &Status) -> &'static str {
         RunState::Alarm => "ALARM",
         RunState::Check => "CHECK",
         RunState::Sleep => "SLEEP",
+        RunState::Home => "HOME",
     }
 }
 
@@ -297,6 +299,7 @@ impl fmt::Display for ErrorText {
             UiError::Drawing(DrawError::Fails { .. }) => f.write_str("f(x) undefined there"),
             UiError::Busy => f.write_str("Busy: wait, or D abort"),
             UiError::Alarm => f.write_str("Alarm: motion locked"),
+            UiError::HomingOff => f.write_str("Homing off: $22=1"),
         }
     }
 }
@@ -312,6 +315,10 @@ impl fmt::Display for FaultText {
             }
             MotionFault::Tripped(Trip::DriverAlarm(axis)) => return write!(f, "{} driver alarm", axis.name()),
             MotionFault::Tripped(Trip::EStop) => "E-stop",
+            MotionFault::Homing(HomingFail::Aborted) => return f.write_str("Homing aborted"),
+            MotionFault::Homing(HomingFail::PullOff(axis) | HomingFail::Approach(axis)) => {
+                return write!(f, "Homing {} failed", axis.name());
+            }
             MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
             MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
             MotionFault::Curve(CurveError::Overflow) => "value too large",
@@ -470,7 +477,7 @@ mod tests {
         let s = Settings::default();
         assert_eq!(texts(&view(&m, &idle, &s))[2..], [">1 Jog", " 2 Line"]);
         press(&mut m, "BBBBBB", &idle);
-        assert_eq!(texts(&view(&m, &idle, &s))[2..], [" 6 Function y=f(x)", ">7 Settings"]);
+        assert_eq!(texts(&view(&m, &idle, &s))[2..], [">7 Settings", " 8 Home ($H)"]);
         press(&mut m, "#", &idle);
         assert_eq!(texts(&view(&m, &idle, &s))[1..], ["Steps/mm X100 Y100", "Travel mm X200 Y200", "Feed 3000 mm/min"]);
         press(&mut m, "BBBBBBBB", &idle);

@@ -11,7 +11,7 @@
 //! |---------------------|------|----------------------------------------------------|
 //! | X PULS / X SIGN     | PE9 / PE10  | TIM1 CH1 / GPIO, to the X driver's PULS+/SIGN+ |
 //! | Y PULS / Y SIGN     | PE11 / PE12 | TIM1 CH2 / GPIO, to the Y driver's PULS+/SIGN+ |
-//! | servo on (SON)      | PE13 | high once the tasks run, low while asleep (`$SLP`), after a driver alarm or a fault |
+//! | servo on (SON)      | PE13 | high once the tasks run; low asleep (`$SLP`), after a driver alarm, idle (`$1`), a fault |
 //! | X / Y limit min     | PE4 / PE5 | inputs with pull-ups, switch to GND (normally open; `$5=1` normally closed) |
 //! | X / Y limit max     | PE6 / PE7 | as the min switches                        |
 //! | X / Y driver ALM    | PE8 / PE14 | inputs with pull-ups, from the drivers' ALM+ (ALM- to GND): open = alarm (`$207`) |

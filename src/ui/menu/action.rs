@@ -17,4 +17,6 @@ pub enum MenuAction {
     /// Start jogging in one of the 8 step directions until [`MenuAction::JogStop`].
     JogStart(Step),
     JogStop,
+    /// Run the homing cycle.
+    Home,
 }

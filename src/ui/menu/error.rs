@@ -27,4 +27,6 @@ pub enum UiError {
     Busy,
     /// An alarm locks motion.
     Alarm,
+    /// Homing is switched off (`$22`).
+    HomingOff,
 }

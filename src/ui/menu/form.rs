@@ -127,7 +127,7 @@ impl Mode {
             Mode::Ellipse => ELLIPSE_FIELDS,
             Mode::Sine => SINE_FIELDS,
             Mode::Function => FUNCTION_FIELDS,
-            Mode::Jog | Mode::Settings => &[],
+            Mode::Jog | Mode::Settings | Mode::Home => &[],
         }
     }
 }
@@ -271,7 +271,7 @@ impl Form {
                 let expr = crate::expr::parse(self.preset.expression()).map_err(|_| UiError::Empty)?;
                 Request::Function { expr, x0_mm, x1_mm }
             }
-            Mode::Jog | Mode::Settings => return Err(UiError::Empty),
+            Mode::Jog | Mode::Settings | Mode::Home => return Err(UiError::Empty),
         })
     }
 

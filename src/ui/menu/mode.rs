@@ -12,12 +12,14 @@ pub enum Mode {
     Sine,
     Function,
     Settings,
+    /// Runs the homing cycle (`$H`) at once.
+    Home,
 }
 
 impl Mode {
     /// Every mode, in menu order: `1` picks the first.
-    pub const ALL: [Mode; 7] =
-        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings];
+    pub const ALL: [Mode; 8] =
+        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings, Mode::Home];
 
     /// Screen title.
     pub const fn title(self) -> &'static str {
@@ -29,6 +31,7 @@ impl Mode {
             Mode::Sine => "SINE",
             Mode::Function => "FUNCTION",
             Mode::Settings => "SETTINGS",
+            Mode::Home => "HOME",
         }
     }
 
@@ -42,6 +45,7 @@ impl Mode {
             Mode::Sine => "Sine wave",
             Mode::Function => "Function y=f(x)",
             Mode::Settings => "Settings",
+            Mode::Home => "Home ($H)",
         }
     }
 

@@ -202,7 +202,8 @@ fn mode_list_by_digit_and_by_navigation() {
     for _ in 0..20 {
         m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
     }
-    assert_eq!(m.selected(), Mode::Settings, "stops at the bottom, no wrap");
+    assert_eq!(m.selected(), Mode::Home, "stops at the bottom, no wrap");
+    m.handle(KeyEvent::Press(Key::A), &idle(), &s);
     m.handle(KeyEvent::Press(Key::A), &idle(), &s);
     m.handle(KeyEvent::Press(Key::Hash), &idle(), &s);
     assert_eq!(form(&m).mode(), Mode::Function);
@@ -294,4 +295,17 @@ fn function_presets_and_their_domains() {
     );
     assert_eq!(type_keys(&mut m, "BBBB 9# 9#", &idle()), []);
     assert_eq!(m.message(), Some(UiError::SameEnds));
+}
+
+#[test]
+fn home_runs_the_homing_cycle_when_homing_is_on_and_d_aborts_it() {
+    let mut m = Menu::new();
+    assert_eq!(type_keys(&mut m, "8", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::HomingOff), "$22=0");
+    let homing = Settings { homing: true, ..Settings::default() };
+    assert_eq!(m.handle(KeyEvent::Press(Key::Digit(8)), &idle(), &homing), MenuAction::Home);
+    assert_eq!(*m.screen(), Screen::Modes, "the mode list stays");
+    let running = Status { state: RunState::Home, ..Status::default() };
+    assert_eq!(m.handle(KeyEvent::Press(Key::Digit(2)), &running, &homing), MenuAction::None, "busy");
+    assert_eq!(m.handle(KeyEvent::Press(Key::D), &running, &homing), MenuAction::Control(Control::Abort));
 }
