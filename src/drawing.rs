@@ -326,13 +326,15 @@ fn checked(shape: Shape, ideal: Option<IdealBox>, start: Point, settings: &Setti
         Shape::Function { x0_mm, .. } => *x0_mm,
         _ => 0.0,
     };
-    let (end, bounds, steps) = trace(&curve, start).map_err(|(at, error)| match error {
-        // The ideal curve is inside the travel, its lattice path is not: it strays from the
-        // curve.
-        CurveError::Travel if ideal.is_some_and(|i| i.within(settings.travel_steps(), 0.0)) => DrawError::TooFine,
-        CurveError::Travel => DrawError::Travel,
-        _ => DrawError::Fails { x_mm: x0_mm + settings.steps_to_mm(Axis::X, at.x - start.x), error },
-    })?;
+    // The trace walks a second curve set up the same way: the same steps as the one kept.
+    let (end, bounds, steps) =
+        trace(Curve::new(&shape, start, settings)?, start).map_err(|(at, error)| match error {
+            // The ideal curve is inside the travel, its lattice path is not: it strays from the
+            // curve.
+            CurveError::Travel if ideal.is_some_and(|i| i.within(settings.travel_steps(), 0.0)) => DrawError::TooFine,
+            CurveError::Travel => DrawError::Travel,
+            _ => DrawError::Fails { x_mm: x0_mm + settings.steps_to_mm(Axis::X, at.x - start.x), error },
+        })?;
     if let Some(ideal) = ideal
         && !follows(&bounds, &ideal)
     {
@@ -386,10 +388,9 @@ fn follows(bounds: &Bounds, ideal: &IdealBox) -> bool {
     })
 }
 
-/// Walks a copy of `curve` from `start` to its end: the end, the box and the number of steps,
+/// Walks `copy`, a curve from `start`, to its end: the end, the box and the number of steps,
 /// or where it fails and why.
-fn trace(curve: &Curve, start: Point) -> Result<(Point, Bounds, u64), (Point, CurveError)> {
-    let mut copy = curve.clone();
+fn trace(mut copy: Curve, start: Point) -> Result<(Point, Bounds, u64), (Point, CurveError)> {
     let mut at = start;
     let mut bounds = Bounds::at(start);
     let mut steps = 0u64;

@@ -35,6 +35,7 @@ pub mod status;
 pub mod store;
 pub mod tasks;
 pub mod ui;
+pub mod watchdog;
 
 #[cfg(not(target_os = "none"))]
 pub mod sim;

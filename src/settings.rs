@@ -126,7 +126,7 @@ pub const SETTING_INFO: &[SettingInfo] = &[
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
 /// optocouplers on a lab board.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Settings {
     /// Width of the PULS pulse ($0).
     pub pulse_width_us: f32,
@@ -190,6 +190,14 @@ pub struct Settings {
     /// After SON goes high, the driver takes this long to hold its axis: the first pulse waits
     /// for it ($209).
     pub servo_enable_delay_ms: u32,
+}
+
+/// Equal when every setting has the same value: one comparison through the settings table
+/// rather than one per field.
+impl PartialEq for Settings {
+    fn eq(&self, other: &Self) -> bool {
+        self.values().eq(other.values())
+    }
 }
 
 impl Default for Settings {

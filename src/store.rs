@@ -31,6 +31,10 @@ use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
 
+use crate::protocol::gcode::Offsets;
+use crate::protocol::startup::StartupLines;
+use crate::settings::Settings;
+
 pub use record::{BadRecord, LAYOUT_TAG, RECORD_MAX_BYTES, Record};
 
 /// The flash the store uses on the F407: sectors 10 and 11, its last two, as offsets from the
@@ -131,9 +135,10 @@ impl<F: NorFlash> Store<F> {
         &self.kept
     }
 
-    /// Whether the flash holds `record` already: saving it would change nothing.
-    pub fn holds(&self, record: &Record) -> bool {
-        self.in_flash && *record == self.kept
+    /// Whether the flash holds these values already: saving them would change nothing.
+    pub fn holds(&self, settings: &Settings, offsets: &Offsets, startup: &StartupLines) -> bool {
+        let kept = &self.kept;
+        self.in_flash && kept.settings == *settings && kept.offsets_mm == offsets.kept_mm() && kept.startup == *startup
     }
 
     /// Keeps `record` in place of the one kept so far. If the flash fails, what it keeps is

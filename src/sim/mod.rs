@@ -45,7 +45,7 @@ use flash::SimFlash;
 use inputs::{InputScript, SimInputs, Switches};
 use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SimSpi};
-use pins::{LevelPin, PulseTrace, TracePin};
+use pins::{LevelPin, PulseTrace, SimWatchdog, TracePin};
 use serial::SimSerial;
 use step_timer::SimStepTimer;
 
@@ -113,6 +113,9 @@ pub struct SimReport {
     pub underruns: u32,
     /// Every change of the servo-on output, with its virtual time.
     pub son: Vec<(u64, bool)>,
+    /// The longest the watchdog went unfed, µs: beyond `WATCHDOG_TIMEOUT_MS` the board would
+    /// have been reset.
+    pub watchdog_unfed_us: u64,
 }
 
 impl SimReport {
@@ -158,6 +161,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
     let mut engine = PulseEngine::new(SimStepTimer::new(pins, inputs.clone()), step_consumer);
     let son = LevelPin::default();
+    let watchdog = SimWatchdog::default();
     let kicks = Signal::<NoopRawMutex, ()>::new();
     let matrix = match config.keys_start {
         KeysStart::AtOnce => KeyMatrix::new(config.keys),
@@ -180,7 +184,10 @@ pub fn run(config: SimConfig) -> SimReport {
             tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
             tasks::lcd::run(&machine, lcd),
         ),
-        join(tasks::servo::run(&machine, son.clone(), || inputs.levels()), tasks::homing::run(&machine)),
+        join(
+            tasks::servo::run(&machine, son.clone(), || inputs.levels(), || watchdog.feed()),
+            tasks::homing::run(&machine),
+        ),
     );
     let mut firmware = pin!(firmware);
     let flag = Arc::new(FlagWaker(AtomicBool::new(true)));
@@ -260,6 +267,7 @@ pub fn run(config: SimConfig) -> SimReport {
         timed_out,
         underruns,
         son: son.changes(),
+        watchdog_unfed_us: watchdog.longest_unfed_us(end_us),
     }
 }
 

@@ -187,3 +187,23 @@ impl embedded_hal::digital::OutputPin for LevelPin {
         Ok(())
     }
 }
+
+/// The board's independent watchdog: remembers the longest time it went unfed, in virtual time.
+#[derive(Clone, Default)]
+pub struct SimWatchdog(Rc<RefCell<(u64, u64)>>);
+
+impl SimWatchdog {
+    /// The firmware feeds it.
+    pub fn feed(&self) {
+        let now = clock::now_ticks();
+        let (last, longest) = &mut *self.0.borrow_mut();
+        *longest = (*longest).max(now - *last);
+        *last = now;
+    }
+
+    /// The longest time it went unfed, up to `end_us`, µs.
+    pub fn longest_unfed_us(&self, end_us: u64) -> u64 {
+        let (last, longest) = *self.0.borrow();
+        longest.max(end_us.saturating_sub(last))
+    }
+}

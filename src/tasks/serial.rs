@@ -343,11 +343,11 @@ impl<F: NorFlash> Parser<'_, '_, F> {
     /// stopped (a flash write stalls the pulses), so the line's `ok` means it is kept. A store
     /// that fails is reported; the line stands.
     async fn keep(&mut self, link: &Link) -> Result<(), Unfinished> {
-        let machine = self.host.machine;
-        let record = Record::of(&machine.settings(), self.gcode.offsets(), &self.host.startup.borrow());
-        if self.store.holds(&record) {
+        let settings = self.host.machine.settings();
+        if self.store.holds(&settings, self.gcode.offsets(), &self.host.startup.borrow()) {
             return Ok(());
         }
+        let record = Record::of(&settings, self.gcode.offsets(), &self.host.startup.borrow());
         unless_reset(link, self.host.machine_stopped()).await?;
         if let Err(e) = self.store.save(&record) {
             link.send(|a| report::message(a, e.message())).await;

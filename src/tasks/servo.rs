@@ -6,22 +6,37 @@
 //! unless `$1` is 255, once the machine has stood still for `$1` ms. SON comes back on as soon
 //! as there is motion to make, and the machine counts the servos ready `$209` ms later: the
 //! motion task starts no pulse before (see [`Machine::servos_ready`]).
+//!
+//! It also feeds the board's independent watchdog, while the pulse engine and the motion task
+//! make progress (see [`crate::watchdog`]); once they do not, it stops, and the watchdog resets
+//! the board.
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 
+use crate::geom::TICK_HZ;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
 use crate::settings::SERVO_ALWAYS_ON;
+use crate::status::RunState;
+use crate::watchdog::{Look, Progress};
 
 /// How often the task reads the inputs and sets SON: well within a person's reach of the axes
 /// after `$SLP`, and an e-stop pressed at rest is an alarm within this (plus the debounce).
 pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 
-/// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on, and
-/// trips the machine when a driver alarm or the e-stop read through `levels` stays active.
-pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl FnMut() -> InputLevels) -> ! {
+/// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on, trips
+/// the machine when a driver alarm or the e-stop read through `levels` stays active, and calls
+/// `feed` (the watchdog's) while the machine makes progress.
+pub async fn run<P: OutputPin>(
+    machine: &Machine,
+    mut son: P,
+    mut levels: impl FnMut() -> InputLevels,
+    mut feed: impl FnMut(),
+) -> ! {
     let mut debounce = Debounce::default();
+    let mut progress = Progress::default();
+    let mut stalled = false;
     // Since when the machine stands still, and since when SON is high.
     let mut still_since: Option<Instant> = None;
     let mut on_since: Option<Instant> = None;
@@ -49,6 +64,19 @@ pub async fn run<P: OutputPin>(machine: &Machine, mut son: P, mut levels: impl F
         if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
         }
+        let flowing = machine.queued_steps() > 0 || matches!(machine.run_state(), RunState::Run | RunState::Jog);
+        let look = Look {
+            emitted_steps: machine.emitted_totals().0,
+            expecting: flowing && machine.servos_ready() && !machine.halted(),
+            queued_ms: machine.queued_ticks() / (TICK_HZ / 1_000),
+        };
+        let healthy = progress.healthy(at.as_millis() as u32, look);
+        if healthy {
+            feed();
+        } else if !stalled {
+            error!("no pulse while the motion should run: the watchdog resets the board");
+        }
+        stalled = !healthy;
         Timer::after(Duration::from_millis(SERVO_ENABLE_POLL_MS)).await;
     }
 }
@@ -88,7 +116,7 @@ mod tests {
         crate::sim::clock::reset();
         let machine = Machine::new(Settings::default());
         let son = Cell::new(false);
-        let mut task = pin!(run(&machine, Pin(&son), || 0));
+        let mut task = pin!(run(&machine, Pin(&son), || 0, || {}));
         let mut cx = Context::from_waker(Waker::noop());
         let mut step = || {
             let _ = task.as_mut().poll(&mut cx);

@@ -4,8 +4,8 @@
 //! first: the pulse engine runs in the step timer's update interrupt (TIM1, see `step_timer`);
 //! then embassy-time's timer (TIM2); the motion task on an interrupt executor (UART5's vector,
 //! unused as a UART), so the step queue stays full while a blocking LCD flush (~20 ms) runs;
-//! then the host links' UART and USB port; keypad, serial, the USB device and LCD share the
-//! thread-mode executor.
+//! then the host links' UART and USB port; keypad, serial, the USB device, LCD, servo (which
+//! also feeds the independent watchdog) and homing share the thread-mode executor.
 //!
 //! | signal              | pin  | notes                                              |
 //! |---------------------|------|----------------------------------------------------|
@@ -41,18 +41,21 @@ use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Blocking;
+use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::peripherals::USART2;
 use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
-use embassy_stm32::{Config, bind_interrupts, interrupt};
+use embassy_stm32::wdg::IndependentWatchdog;
+use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
 use servoplot::machine::Machine;
 use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
 use servoplot::tasks::{self, lcd::St7920Lcd};
+use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
 
@@ -117,8 +120,13 @@ async fn serial(
 }
 
 #[embassy_executor::task]
-async fn servo(machine: &'static Machine, son: Output<'static>) -> ! {
-    tasks::servo::run(machine, son, inputs::read).await
+async fn servo(machine: &'static Machine, son: Output<'static>, mut dog: IndependentWatchdog<'static, IWDG>) -> ! {
+    tasks::servo::run(machine, son, inputs::read, || dog.pet()).await
+}
+
+#[embassy_executor::task]
+async fn homing(machine: &'static Machine) -> ! {
+    tasks::homing::run(machine).await
 }
 
 #[embassy_executor::task]
@@ -168,8 +176,18 @@ fn clocks() -> Config {
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
+    // PULS low and SON off before anything else, after a watchdog reset too.
+    panic::safe_outputs();
     let p = embassy_stm32::init(clocks());
     info!("servoplot {} on STM32F407VG at {} MHz", env!("CARGO_PKG_VERSION"), SYSCLK_HZ / 1_000_000);
+    if pac::RCC.csr().read().wdgrstf() {
+        defmt::warn!("reset by the watchdog: the pulses or the motion had stalled");
+    }
+    pac::RCC.csr().modify(|w| w.set_rmvf(true));
+    // Halted by a debugger, the board is not reset under it.
+    pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
+    let mut dog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_MS * 1_000);
+    dog.unleash();
     // What the last power cycle kept: the settings the machine starts with, and the offsets and
     // startup blocks the serial task starts with.
     let (store, loaded) = Store::open(Flash::new_blocking(p.FLASH), STORE_FLASH_RANGE);
@@ -207,7 +225,8 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD11, Pull::Up),
     ];
     spawner.spawn(unwrap!(keypad(machine, columns, rows)));
-    spawner.spawn(unwrap!(servo(machine, son)));
+    spawner.spawn(unwrap!(servo(machine, son, dog)));
+    spawner.spawn(unwrap!(homing(machine)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
     static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();

@@ -22,6 +22,15 @@ const PULS_PINS: [usize; 2] = [9, 11];
 const SON_PIN: usize = 13;
 
 /// Stops every pulse and drops SON, whatever state the firmware is in.
+/// At power-on or after any reset, before the clocks: the step and SON outputs low, as a fault
+/// leaves them.
+pub fn safe_outputs() {
+    pac::RCC.ahb1enr().modify(|w| w.set_gpioeen(true));
+    stop_the_machine();
+    // SAFETY: nothing has run that masks interrupts for a reason of its own.
+    unsafe { cortex_m::interrupt::enable() };
+}
+
 fn stop_the_machine() {
     cortex_m::interrupt::disable();
     pac::TIM1.cr1().modify(|w| w.set_cen(false));

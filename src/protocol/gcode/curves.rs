@@ -80,7 +80,10 @@ impl GcodeState {
             return Ok(None);
         }
         let [a_mm, b_mm] = semi_axes_mm;
-        let ellipse = EllipseParams { a_mm, b_mm, start_deg: start_deg % 360.0, sweep_deg };
+        // Whole turns off (a start angle names a direction). Not `%`: f32 remainder links 650 B
+        // of soft-float code for this one use.
+        let start_deg = start_deg - 360.0 * crate::math::trunc(start_deg / 360.0);
+        let ellipse = EllipseParams { a_mm, b_mm, start_deg, sweep_deg };
         self.draw(Request::Ellipse(ellipse), feed, JobKind::Draw, None, settings)
     }
 
