@@ -133,3 +133,21 @@ fn soft_limits_refuse_what_leaves_the_travel_and_20_0_lets_it_go() {
     assert_eq!(report.answers(), "\r\nGrbl 1.1h ['$' for help]\r\nok\r\nok\r\nok\r\nok\r\n");
     assert_eq!(report.position, Point::new(25_000, -25_000));
 }
+
+#[test]
+fn the_keypad_homes_too_and_d_aborts_it() {
+    // Homing on, kept in flash: the plotter powers on locked, and mode 8 homes it.
+    let first = run("$22=1\n", SWITCHES, "");
+    let keys = servoplot::sim::keys::KeyScript::parse("8").unwrap();
+    let report = sim::run(SimConfig { switches: SWITCHES, flash: first.flash.clone(), keys, ..SimConfig::default() });
+    assert!(!report.timed_out);
+    assert_eq!(report.position, Point::new(-19_900, -19_900));
+    let (px, _) = driven(&report);
+    assert!((PULL_OFF_STEPS - SWITCH_STEPS - 1..=PULL_OFF_STEPS - SWITCH_STEPS).contains(&px), "{px}");
+    // D a second into the seek stops it: ALARM:6, and the pen stays where the seek stopped.
+    let keys = servoplot::sim::keys::KeyScript::parse("8 wait:1000 D").unwrap();
+    let report = sim::run(SimConfig { switches: SWITCHES, flash: first.flash, keys, ..SimConfig::default() });
+    assert!(report.answers().contains("ALARM:6"), "{}", report.answers());
+    let (px, _) = driven(&report);
+    assert!((-2_000..-1_000).contains(&px), "stopped a second into the 1000 mm/min seek: {px}");
+}
