@@ -592,6 +592,7 @@ impl Machine {
         Status {
             state: self.state(),
             position: self.position(),
+            position_lost: self.position_lost(),
             queued_jobs: self.queued_jobs() as u8,
             fault: self.fault(),
             door: self.door.load(Ordering::Relaxed),

@@ -58,6 +58,8 @@ pub struct Status {
     pub state: RunState,
     /// The machine position, steps: the pulses emitted so far, from machine zero.
     pub position: Point,
+    /// The position may be wrong (see `Machine::position_lost`): the LCD shows it inverted.
+    pub position_lost: bool,
     /// Jobs waiting behind the one in progress.
     pub queued_jobs: u8,
     /// Why the last job stopped early, until the next one starts.

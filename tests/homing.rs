@@ -151,3 +151,18 @@ fn the_keypad_homes_too_and_d_aborts_it() {
     let (px, _) = driven(&report);
     assert!((-2_000..-1_000).contains(&px), "stopped a second into the 1000 mm/min seek: {px}");
 }
+
+#[test]
+fn the_position_is_unknown_from_power_on_with_homing_on_and_after_a_hard_limit_until_homed() {
+    use servoplot::inputs::Trip;
+    use servoplot::machine::Machine;
+    use servoplot::settings::Settings;
+    let machine = Machine::new(Settings { homing: true, ..Settings::default() });
+    assert!(machine.status().position_lost, "powered on, not homed");
+    machine.set_origin(Point::new(-19_900, -19_900));
+    assert!(!machine.status().position_lost, "homed");
+    assert_eq!(machine.position(), Point::new(-19_900, -19_900));
+    machine.trip(Trip::Limit { axis: Axis::X, max: true });
+    assert!(machine.status().position_lost, "the pulses stopped without braking");
+    assert!(!Machine::new(Settings::default()).status().position_lost, "homing off: the power-on origin counts");
+}

@@ -12,7 +12,7 @@
 //!
 //! ```text
 //! LINE 1/2            IDLE    title and run state (inverted)
-//! X  12.345 Y  -3.000         pen position, mm
+//! X  12.345 Y  -3.000         pen position, mm (inverted until homed)
 //! dX mm: -12.5_               field being typed, with its unit
 //! X offset from the pen       help, or the error (inverted)
 //! ```
@@ -217,7 +217,9 @@ fn state_name(status: &Status) -> &'static str {
 fn position_line(status: &Status, settings: &Settings) -> TextLine {
     let x = mm_text(settings.steps_to_mm(Axis::X, status.position.x));
     let y = mm_text(settings.steps_to_mm(Axis::Y, status.position.y));
-    TextLine::new(format_args!("X{:>w$} Y{:>w$}", x.as_str(), y.as_str(), w = POSITION_CHARS), false)
+    // Inverted while the position may be wrong: until homed.
+    let line = format_args!("X{:>w$} Y{:>w$}", x.as_str(), y.as_str(), w = POSITION_CHARS);
+    TextLine::new(line, status.position_lost)
 }
 
 /// `mm` with 3 decimals, or fewer when it would not fit [`POSITION_CHARS`].
@@ -426,6 +428,9 @@ mod tests {
         let title = std::format!("{:<20}IDLE", "LINE 1/2");
         assert_eq!(texts(&v), [title.as_str(), "X   12.340 Y   -3.000", "dX mm: -12.5_", "X offset from the pen"]);
         assert!(v.lines[0].inverted && !v.lines[3].inverted);
+        assert!(!v.lines[1].inverted, "the position is known");
+        let lost = Status { position_lost: true, ..status };
+        assert!(view(&m, &lost, &Settings::default()).lines[1].inverted, "until homed, the position shows inverted");
     }
 
     #[test]
@@ -551,6 +556,7 @@ mod tests {
             state: RunState::Run,
             queued_jobs: 255,
             position: crate::geom::Point::new(-50_000, -50_000),
+            position_lost: true,
             fault: None,
             door: false,
             underruns: u32::MAX,
