@@ -31,6 +31,56 @@ pub const BUILD_NAME: &str = "servoplot";
 /// Longest single line written here (a status report with a work offset at ±500 mm is 81).
 pub const REPORT_LINE_MAX_BYTES: usize = 128;
 
+/// One answer to a host, named by what it says: [`Reply::write`] writes it. The serial task
+/// sends every answer as one of these, so one function builds them all and the wait to send
+/// one is the same code for every answer.
+#[derive(Clone, Copy)]
+pub enum Reply<'a> {
+    Ok,
+    Error(GrblError),
+    /// `[MSG:text]`.
+    Message(&'a str),
+    /// The banner, with the hint how to leave an alarm.
+    Welcome(RunState),
+    Status(&'a Status, &'a Settings, &'a StatusFields),
+    Alarm(MotionFault),
+    /// `>line:ok` or `>line:error:N`.
+    StartupResult(&'a str, Result<(), GrblError>),
+    Help,
+    Settings(&'a Settings),
+    ParserState(&'a GcodeState, &'a Settings),
+    Parameters(&'a GcodeState),
+    BuildInfo {
+        info: &'a str,
+        planner_blocks: usize,
+        rx_buffer_bytes: usize,
+    },
+    StartupLines(&'a StartupLines),
+}
+
+impl Reply<'_> {
+    /// Writes the answer.
+    pub fn write(&self, out: &mut impl Write) -> fmt::Result {
+        match *self {
+            Reply::Ok => ok(out),
+            Reply::Error(e) => error(out, e),
+            Reply::Message(text) => message(out, text),
+            Reply::Welcome(state) => welcome(out, state),
+            Reply::Status(s, settings, fields) => status(out, s, settings, fields),
+            Reply::Alarm(fault) => alarm(out, fault),
+            Reply::StartupResult(line, result) => startup_result(out, line, result),
+            Reply::Help => help(out),
+            Reply::Settings(s) => settings(out, s),
+            Reply::ParserState(gcode, s) => parser_state(out, gcode, s),
+            Reply::Parameters(gcode) => parameters(out, gcode),
+            Reply::BuildInfo { info, planner_blocks, rx_buffer_bytes } => {
+                build_info(out, info, planner_blocks, rx_buffer_bytes)
+            }
+            Reply::StartupLines(lines) => startup_lines(out, lines),
+        }
+    }
+}
+
 /// `ok`: the line was executed.
 pub fn ok(out: &mut impl Write) -> fmt::Result {
     out.write_str("ok\r\n")

@@ -56,9 +56,9 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::gcode::Offsets;
 use crate::protocol::refresh::Refresh;
-use crate::protocol::report::StatusFields;
+use crate::protocol::report::{Reply, StatusFields};
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
-use crate::protocol::{Command, GcodeState, GrblError, Report, report};
+use crate::protocol::{Command, GcodeState, GrblError, Report};
 use crate::settings::Settings;
 use crate::status::RunState;
 use crate::store::{Record, Store, StoreError};
@@ -102,7 +102,7 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     };
     for link in &host.links {
         // The writers are not running yet: each outbox has room for this first answer.
-        link.send(|a| report::welcome(a, machine.state())).await;
+        link.send(Reply::Welcome(machine.state())).await;
     }
     let [a, b] = &host.links;
     join(
@@ -129,7 +129,7 @@ impl Host<'_> {
             overrides: occasional.overrides.then_some(overrides),
             buffer: (machine.plan_free_segments(), link.rx_window_free() as u16),
         };
-        link.send(|a| report::status(a, &status, &settings, &fields)).await;
+        link.send(Reply::Status(&status, &settings, &fields)).await;
     }
 
     /// Acts on bytes that arrived on `link`: realtime bytes now, the rest go to the line loop.
@@ -205,7 +205,7 @@ async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(),
     let links = [&host.links[0], &host.links[1]];
     if let Err(e) = loaded {
         for link in links {
-            link.send(|a| report::message(a, e.message())).await;
+            link.send(Reply::Message(e.message())).await;
         }
     }
     parser.startup_blocks(&links).await;
@@ -230,7 +230,7 @@ async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(),
                 // Lines whose bytes found no room: the partial one in the assembler is the first.
                 assembler.clear();
                 for _ in 0..n {
-                    link.send(|a| report::error(a, GrblError::LineOverflow)).await;
+                    link.send(Reply::Error(GrblError::LineOverflow)).await;
                 }
             }
             Intake::Bytes(n) => {
@@ -278,8 +278,8 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             Some(other) => Err(Unfinished::Error(other.error().unwrap_or(GrblError::ExpectedCommandLetter))),
         };
         match result {
-            Ok(()) => link.send(report::ok).await,
-            Err(Unfinished::Error(e)) => link.send(|a| report::error(a, e)).await,
+            Ok(()) => link.send(Reply::Ok).await,
+            Err(Unfinished::Error(e)) => link.send(Reply::Error(e)).await,
             Err(Unfinished::Reset) => {}
         }
         if core::mem::take(&mut self.restart_after_answer) {
@@ -295,7 +295,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         self.restart(link).await;
         // A link resetting too (after an e-stop, all are) hears of its own reset.
         for other in self.host.links.iter().filter(|l| !core::ptr::eq(*l, link) && !l.resetting()) {
-            other.send(|a| report::message(a, "Reset from another host link")).await;
+            other.send(Reply::Message("Reset from another host link")).await;
         }
     }
 
@@ -312,7 +312,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         let settings = machine.settings();
         self.gcode.reset(machine.position(), &settings);
         self.epoch = machine.plan_epoch();
-        link.send(|a| report::welcome(a, machine.state())).await;
+        link.send(Reply::Welcome(machine.state())).await;
         self.startup_blocks(&[link]).await;
     }
 
@@ -332,7 +332,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 // nothing.
                 let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
                 for link in links {
-                    link.send(|a| report::startup_result(a, line, result)).await;
+                    link.send(Reply::StartupResult(line, result)).await;
                 }
             }
         }
@@ -350,7 +350,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         let record = Record::of(&settings, self.gcode.offsets(), &self.host.startup.borrow());
         unless_reset(link, self.host.machine_stopped()).await?;
         if let Err(e) = self.store.save(&record) {
-            link.send(|a| report::message(a, e.message())).await;
+            link.send(Reply::Message(e.message())).await;
         }
         Ok(())
     }
@@ -400,7 +400,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             }
             Command::ProgramEnd => {
                 unless_reset(link, host.machine_at_rest()).await?;
-                link.send(|a| report::message(a, "Pgm End")).await;
+                link.send(Reply::Message("Pgm End")).await;
             }
             Command::SetSetting { id, value } => {
                 machine
@@ -416,37 +416,40 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             Command::StoreStartupLine { index, line } => host.startup.borrow_mut().set(usize::from(index), line),
             Command::StoreBuildInfo(line) => host.startup.borrow_mut().build_info = line,
             Command::Report(kind) => {
+                // The startup blocks may change while the answer waits for room: a copy.
+                let startup = host.startup.borrow().clone();
                 let gcode = &self.gcode;
-                link.send(|a| match kind {
-                    Report::Help => report::help(a),
-                    Report::Settings => report::settings(a, settings),
-                    Report::ParserState => report::parser_state(a, gcode, settings),
-                    Report::Parameters => report::parameters(a, gcode),
-                    Report::BuildInfo => {
-                        let info = &host.startup.borrow().build_info;
-                        report::build_info(a, info, PLANNER_SEGMENTS, SERIAL_RX_WINDOW_BYTES)
-                    }
-                    Report::StartupLines => report::startup_lines(a, &host.startup.borrow()),
-                })
-                .await
+                let reply = match kind {
+                    Report::Help => Reply::Help,
+                    Report::Settings => Reply::Settings(settings),
+                    Report::ParserState => Reply::ParserState(gcode, settings),
+                    Report::Parameters => Reply::Parameters(gcode),
+                    Report::BuildInfo => Reply::BuildInfo {
+                        info: &startup.build_info,
+                        planner_blocks: PLANNER_SEGMENTS,
+                        rx_buffer_bytes: SERIAL_RX_WINDOW_BYTES,
+                    },
+                    Report::StartupLines => Reply::StartupLines(&startup),
+                };
+                link.send(reply).await
             }
             Command::Sleep => {
                 machine.sleep();
-                link.send(|a| report::message(a, "Sleeping")).await;
+                link.send(Reply::Message("Sleeping")).await;
             }
             Command::CheckMode { on: true } => {
                 machine.set_check_mode(true);
-                link.send(|a| report::message(a, "Enabled")).await;
+                link.send(Reply::Message("Enabled")).await;
             }
             Command::CheckMode { on: false } => {
-                link.send(|a| report::message(a, "Disabled")).await;
+                link.send(Reply::Message("Disabled")).await;
                 self.restart_after_answer = true;
             }
             Command::Unlock | Command::Home
                 if InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0 =>
             {
                 // A driver alarm or the e-stop still raised would trip again at once.
-                link.send(|a| report::message(a, "Driver alarm or e-stop still active")).await;
+                link.send(Reply::Message("Driver alarm or e-stop still active")).await;
                 return Err(Unfinished::Error(GrblError::Locked));
             }
             Command::Home => {
@@ -464,7 +467,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                     unless_reset(link, host.machine_stopped()).await?;
                 }
                 machine.unlock();
-                link.send(|a| report::message(a, "Caution: Unlocked")).await;
+                link.send(Reply::Message("Caution: Unlocked")).await;
             }
         }
         Ok(())
@@ -492,7 +495,7 @@ async fn faults(host: &Host<'_>) -> ! {
     loop {
         let fault = host.machine.next_fault().await;
         for link in &host.links {
-            link.send(|a| report::alarm(a, fault)).await;
+            link.send(Reply::Alarm(fault)).await;
         }
         if fault == MotionFault::Tripped(Trip::EStop) {
             host.machine.set_overrides(Overrides::NONE);

@@ -4,7 +4,7 @@
 //! touches it, and the receiver's reads live with the protocol.
 
 use core::cell::Cell;
-use core::fmt;
+
 use core::future::Future;
 
 use embassy_futures::select::{Either, select};
@@ -17,7 +17,7 @@ use embedded_io_async::Write;
 use heapless::String;
 
 use super::dropped::Dropped;
-use crate::protocol::report;
+use crate::protocol::report::{self, Reply};
 
 /// Bytes between a link's receiver and the line loop. GRBL senders keep at most 128 unanswered
 /// bytes in flight, so this never fills for them; it also holds a terminal paste of about 50
@@ -78,13 +78,9 @@ impl Link {
         }
     }
 
-    /// Sends one answer, built by `write`, as a whole.
-    pub fn send(&self, write: impl FnOnce(&mut Answer) -> fmt::Result) -> impl Future<Output = ()> + '_ {
-        let mut answer = Answer::new();
-        if write(&mut answer).is_err() {
-            too_long(&mut answer);
-        }
-        self.outbox.send(answer)
+    /// Sends `reply` as one whole answer, once the outbox has room.
+    pub fn send<'a>(&'a self, reply: Reply<'a>) -> Sending<'a> {
+        Sending { link: self, reply }
     }
 
     /// Runs `work` unless a reset on this link comes first (or is already on its way).
@@ -158,7 +154,7 @@ impl Link {
                 return;
             }
             d.active.set(true);
-            self.send(|a| report::message(a, "Receive buffer full: lines dropped, each answered error:11")).await;
+            self.send(Reply::Message("Receive buffer full: lines dropped, each answered error:11")).await;
         }
         // CR and LF each end a line, as they do for the line assembler.
         if byte == b'\n' || byte == b'\r' {
@@ -171,10 +167,37 @@ impl Link {
     }
 }
 
-/// Every answer fits by construction; should one not, it says so rather than being cut. Out of
-/// line: [`Link::send`] is inlined wherever an answer is written.
+/// The future of [`Link::send`]: it waits for room in the outbox, then writes the answer there.
+/// One type with one `poll` out of line serves every answer, so a call site costs little more
+/// than naming its reply.
+pub struct Sending<'a> {
+    link: &'a Link,
+    reply: Reply<'a>,
+}
+
+impl Future for Sending<'_> {
+    type Output = ();
+
+    #[inline(never)]
+    fn poll(self: core::pin::Pin<&mut Self>, cx: &mut core::task::Context<'_>) -> core::task::Poll<()> {
+        let outbox = &self.link.outbox;
+        if outbox.poll_ready_to_send(cx).is_pending() {
+            return core::task::Poll::Pending;
+        }
+        let mut answer = Answer::new();
+        if self.reply.write(&mut answer).is_err() {
+            too_long(&mut answer);
+        }
+        // The room was seen just now: it is this answer's.
+        if outbox.try_send(answer).is_err() {
+            warn!("host link outbox full after waiting for room");
+        }
+        core::task::Poll::Ready(())
+    }
+}
+
+/// Every answer fits by construction; should one not, it says so rather than being cut.
 #[cold]
-#[inline(never)]
 fn too_long(answer: &mut Answer) {
     answer.clear();
     let _ = report::message(answer, "answer too long");
