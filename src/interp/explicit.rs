@@ -209,6 +209,14 @@ impl Chord {
 #[derive(Clone, Debug)]
 pub struct ExplicitCurve<G> {
     g: G,
+    walk: Walk,
+}
+
+/// Where the walk along an explicit curve stands. Its code takes g as a `&dyn CurveFn`: one
+/// copy serves every kind of curve (a sine, a function), at the cost of one indirect call per
+/// column.
+#[derive(Clone, Debug)]
+struct Walk {
     method: Method,
     /// Direction of travel on X: +1 or -1.
     dir: i8,
@@ -237,6 +245,37 @@ impl<G: CurveFn> ExplicitCurve<G> {
     /// `max_jump_steps` rows between neighbouring columns (`i32::MAX`: no limit). Evaluates
     /// g at the start; an error there is [`CurveSetupError::Start`] and nothing moves.
     pub fn new(g: G, length_steps: i32, max_jump_steps: i32, method: Method) -> Result<Self, CurveSetupError> {
+        let walk = Walk::new(&g, length_steps, max_jump_steps, method)?;
+        Ok(ExplicitCurve { g, walk })
+    }
+
+    /// The curve's g.
+    #[cfg(test)]
+    pub(crate) fn curve_fn(&self) -> &G {
+        &self.g
+    }
+
+    /// Where the steps handed out so far have taken the pen, relative to the start.
+    pub fn position(&self) -> Point {
+        self.walk.position()
+    }
+
+    /// Where the whole curve ends, relative to the start, `(±n, round(h(n)))`, found from its
+    /// last column alone (exactly as the steps reach it); an error there means the curve cannot
+    /// reach its end.
+    pub fn nominal_end(&self) -> Result<Point, CurveError> {
+        self.walk.nominal_end(&self.g)
+    }
+
+    /// The value the curve steps by at `column`, relative to the start, in steps.
+    #[cfg(test)]
+    pub(crate) fn offset_steps(&self, column: i32) -> Result<f32, CurveError> {
+        self.walk.offset(&self.g, column)
+    }
+}
+
+impl Walk {
+    fn new(g: &dyn CurveFn, length_steps: i32, max_jump_steps: i32, method: Method) -> Result<Self, CurveSetupError> {
         let steps_per_unit = g.y_steps_per_unit();
         if max_jump_steps < 0 || !steps_per_unit.is_finite() {
             return Err(CurveSetupError::BadParameter);
@@ -249,8 +288,7 @@ impl<G: CurveFn> ExplicitCurve<G> {
             return Err(CurveSetupError::Start(CurveError::Overflow));
         }
         let dir = if length_steps < 0 { -1 } else { 1 };
-        let mut curve = ExplicitCurve {
-            g,
+        let mut curve = Walk {
             method,
             dir,
             columns: length_steps.abs(),
@@ -268,20 +306,13 @@ impl<G: CurveFn> ExplicitCurve<G> {
         };
         if curve.columns == 0 {
             curve.phase = Phase::Done;
-        } else if let Err(e) = curve.start() {
+        } else if let Err(e) = curve.start(g) {
             curve.phase = Phase::Failed(e);
         }
         Ok(curve)
     }
 
-    /// The curve's g.
-    #[cfg(test)]
-    pub(crate) fn curve_fn(&self) -> &G {
-        &self.g
-    }
-
-    /// Where the steps handed out so far have taken the pen, relative to the start.
-    pub fn position(&self) -> Point {
+    fn position(&self) -> Point {
         let c = &self.chord;
         if c.done == c.total {
             // The current chord is all handed out (or none is left): the pen is on its end.
@@ -291,23 +322,14 @@ impl<G: CurveFn> ExplicitCurve<G> {
         (0..c.done).fold(start, |p, j| p.stepped(c.step(j)))
     }
 
-    /// Where the whole curve ends, relative to the start, `(±n, round(h(n)))`, found from its
-    /// last column alone (exactly as the steps reach it); an error there means the curve cannot
-    /// reach its end.
-    pub fn nominal_end(&self) -> Result<Point, CurveError> {
-        Ok(Point::new(i32::from(self.dir) * self.columns, nearest_step(self.offset(self.columns)?)))
-    }
-
-    /// The value the curve steps by at `column`, relative to the start, in steps.
-    #[cfg(test)]
-    pub(crate) fn offset_steps(&self, column: i32) -> Result<f32, CurveError> {
-        self.offset(column)
+    fn nominal_end(&self, g: &dyn CurveFn) -> Result<Point, CurveError> {
+        Ok(Point::new(i32::from(self.dir) * self.columns, nearest_step(self.offset(g, self.columns)?)))
     }
 
     /// The ideal curve at `column`, relative to the start, in steps.
     #[inline]
-    fn offset(&self, column: i32) -> Result<f32, CurveError> {
-        let h = (self.g.y(column)? - self.origin) * self.steps_per_unit;
+    fn offset(&self, g: &dyn CurveFn, column: i32) -> Result<f32, CurveError> {
+        let h = (g.y(column)? - self.origin) * self.steps_per_unit;
         // False for NaN as well.
         if h.abs() <= MAX_CURVE_OFFSET_STEPS_F32 { Ok(h) } else { Err(CurveError::Overflow) }
     }
@@ -315,8 +337,8 @@ impl<G: CurveFn> ExplicitCurve<G> {
     /// The value and row of `column`, checked against the limits for a chord that starts at
     /// row `r0`, or why that chord cannot be drawn.
     #[inline(always)]
-    fn column(&self, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
-        let h = self.offset(column)?;
+    fn column(&self, g: &dyn CurveFn, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
+        let h = self.offset(g, column)?;
         let r = nearest_step(h);
         if (r - r0).abs() > self.max_jump_steps { Err(CurveError::Jump) } else { Ok((h, r)) }
     }
@@ -354,8 +376,8 @@ impl<G: CurveFn> ExplicitCurve<G> {
     }
 
     /// Makes the chord from column 0 to column 1 current, or tells why it cannot be drawn.
-    fn start(&mut self) -> Result<(), CurveError> {
-        let (h1, r1) = self.column(1, 0)?;
+    fn start(&mut self, g: &dyn CurveFn) -> Result<(), CurveError> {
+        let (h1, r1) = self.column(g, 1, 0)?;
         self.chord = self.chord(0.0, 0, h1, r1);
         self.seg = 0;
         self.h1 = h1;
@@ -379,10 +401,16 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
     }
 
     fn tangent(&self) -> Tangent {
-        unit(self.dir, self.slope)
+        unit(self.walk.dir, self.walk.slope)
     }
 
     fn fill(&mut self, out: &mut [Step]) -> Filled {
+        self.walk.fill(&self.g, out)
+    }
+}
+
+impl Walk {
+    fn fill(&mut self, g: &dyn CurveFn, out: &mut [Step]) -> Filled {
         let mut i = 0;
         loop {
             // An error is handed out only where there is room for a step: where `next_step`
@@ -414,7 +442,7 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
                 if seg + 1 == self.columns {
                     break Phase::Done;
                 }
-                let (h, r) = match self.column(seg + 2, r1) {
+                let (h, r) = match self.column(g, seg + 2, r1) {
                     Ok(v) => v,
                     Err(e) => break Phase::Failed(e),
                 };
