@@ -6,6 +6,7 @@
 
 use crate::drawing::{self, DrawError, Drawing, Request};
 use crate::geom::{Axis, Point, Step};
+use crate::pen::Pen;
 use crate::settings::Settings;
 
 /// Feed of a jog from the keypad.
@@ -39,6 +40,11 @@ pub struct Job {
     pub drawing: Drawing,
     pub feed: Feed,
     pub kind: JobKind,
+    /// Where the pen must be for this job (`None`: it stays where it is). The motion task moves
+    /// it at rest, before the job, and waits for it to settle.
+    pub pen: Option<Pen>,
+    /// The pen goes up once the machine comes to rest after this job (a keypad drawing).
+    pub raise_after: bool,
 }
 
 /// Run-time commands that act on the motion in progress. Requests that arrive before the motion
@@ -68,13 +74,13 @@ impl Control {
 impl Job {
     /// A drawing job.
     pub const fn draw(drawing: Drawing, feed: Feed) -> Job {
-        Job { drawing, feed, kind: JobKind::Draw }
+        Job { drawing, feed, kind: JobKind::Draw, pen: None, raise_after: false }
     }
 
     /// A jog: a straight move from `from` to `to`; `None` when it goes nowhere.
     pub fn jog_to(from: Point, to: Point, feed: Feed, settings: &Settings) -> Result<Option<Job>, DrawError> {
         let drawing = drawing::build(&Request::Straight { to }, from, settings)?;
-        Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog }))
+        Ok(drawing.map(|drawing| Job { drawing, feed, kind: JobKind::Jog, pen: None, raise_after: false }))
     }
 
     /// A move of the homing cycle: a straight line from `from` to `to` at `feed_mm_per_min`,
@@ -83,7 +89,7 @@ impl Job {
     pub fn homing_move(from: Point, to: Point, feed_mm_per_min: f32, settings: &Settings) -> Option<Job> {
         let unchecked = Settings { soft_limits: false, ..settings.clone() };
         let drawing = drawing::build(&Request::Straight { to }, from, &unchecked).ok()??;
-        Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home })
+        Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home, pen: None, raise_after: false })
     }
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a

@@ -27,6 +27,7 @@ pub mod machine;
 pub mod math;
 pub mod method;
 pub mod overrides;
+pub mod pen;
 pub mod planner;
 pub mod protocol;
 pub mod pulse;

@@ -35,6 +35,7 @@ use crate::inputs::{InputLevels, Trip};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
 use crate::overrides::{OverrideCommand, Overrides};
+use crate::pen::Pen;
 use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -70,6 +71,18 @@ pub enum Refused {
     Full,
     /// See [`Stale`].
     Stale,
+}
+
+/// One order to the pen: where, and which order it is. An order the servo task settled is
+/// told apart from a later one to the same place, so a pen sent away and back while the servo
+/// task looked elsewhere never counts as settled early.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PenOrder(u32);
+
+impl PenOrder {
+    pub fn pen(self) -> Pen {
+        if self.0 & 1 != 0 { Pen::Down } else { Pen::Up }
+    }
 }
 
 /// The run states as [`Machine`] stores them.
@@ -149,6 +162,12 @@ pub struct Machine {
     switch_found: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
     /// SON has been high for the drivers' enable delay (written only by the servo task).
     servos_ready: AtomicBool,
+    /// Where the pen is to be, as a [`PenOrder`]: bit 0 set for down, above it a count of the
+    /// times it was sent anywhere (changed only at rest).
+    pen: AtomicU32,
+    /// The last order the pen servo has had its settle time for (written only by the servo
+    /// task): the pen has settled while it equals `pen`.
+    pen_settled: AtomicU32,
     /// Pulses emitted at machine zero (written only by the homing task, at rest).
     origin: [AtomicI32; 2],
     /// The pulses stopped without braking, or the axes were free: the position may be wrong
@@ -196,6 +215,8 @@ impl Machine {
             input_levels: AtomicU8::new(0),
             homing: AtomicBool::new(false),
             servos_ready: AtomicBool::new(false),
+            pen: AtomicU32::new(0),
+            pen_settled: AtomicU32::new(u32::MAX),
             homing_requested: Signal::new(),
             switch_found: Mutex::new(Cell::new(None)),
             origin: [AtomicI32::new(0), AtomicI32::new(0)],
@@ -524,6 +545,38 @@ impl Machine {
     /// True once the drivers hold their axes; no pulse may go out before.
     pub fn servos_ready(&self) -> bool {
         self.servos_ready.load(Ordering::Acquire)
+    }
+
+    /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
+    /// wait for [`pen_settled`](Self::pen_settled) before anything moves.
+    pub fn set_pen(&self, pen: Pen) {
+        let down = u32::from(pen == Pen::Down);
+        let sent = self.pen.fetch_update(Ordering::AcqRel, Ordering::Acquire, |order| {
+            (order & 1 != down).then(|| ((order >> 1).wrapping_add(1) << 1) | down)
+        });
+        if sent.is_ok() {
+            self.changed.signal(());
+        }
+    }
+
+    /// Where the pen is to be.
+    pub fn pen(&self) -> Pen {
+        self.pen_order().pen()
+    }
+
+    /// The pen's last order, for the servo task.
+    pub fn pen_order(&self) -> PenOrder {
+        PenOrder(self.pen.load(Ordering::Acquire))
+    }
+
+    /// The pen servo has settled as `order` says. Only the servo task calls this.
+    pub fn set_pen_settled(&self, order: PenOrder) {
+        self.pen_settled.store(order.0, Ordering::Release);
+    }
+
+    /// True once the pen is where it was last sent: no pulse may go out before.
+    pub fn pen_settled(&self) -> bool {
+        self.pen_settled.load(Ordering::Acquire) == self.pen.load(Ordering::Acquire)
     }
 
     /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it

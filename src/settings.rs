@@ -43,6 +43,13 @@ pub const SERVO_ENABLE_DELAY_MAX_MS: u32 = 1_000;
 /// arithmetic hold far more.
 pub const UNCHECKED_TRAVEL_STEPS: i32 = 1 << 20;
 
+/// The pulses an RC servo takes (`$210`, `$211`), µs.
+pub const PEN_PULSE_MIN_US: u32 = 500;
+pub const PEN_PULSE_MAX_US: u32 = 2_500;
+
+/// Longest wait for the pen to settle (`$212`).
+pub const PEN_SETTLE_MAX_MS: u32 = 2_000;
+
 /// Longest pause after each homing move for the switch to settle (`$26`).
 pub const HOMING_DEBOUNCE_MAX_MS: u32 = 1_000;
 
@@ -122,6 +129,14 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 208, min: 0.0, max: 1.0 },
     // servo enable delay, ms
     SettingInfo { id: 209, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
+    // pen up, RC servo pulse in us
+    SettingInfo { id: 210, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
+    // pen down, RC servo pulse in us
+    SettingInfo { id: 211, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
+    // pen settle time, ms
+    SettingInfo { id: 212, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
+    // pen lift (0 none, 1 M3/M5, 2 also by itself: up for G0, down for drawing)
+    SettingInfo { id: 213, min: 0.0, max: 2.0 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -190,6 +205,13 @@ pub struct Settings {
     /// After SON goes high, the driver takes this long to hold its axis: the first pulse waits
     /// for it ($209).
     pub servo_enable_delay_ms: u32,
+    /// The pen servo's pulse that holds the pen up, and down ($210, $211).
+    pub pen_up_us: u32,
+    pub pen_down_us: u32,
+    /// How long the pen takes to get where it was sent: no pulse goes out before ($212).
+    pub pen_settle_ms: u32,
+    /// How the pen is lifted, see [`crate::pen::PenLift`] ($213).
+    pub pen_lift: u8,
 }
 
 /// Equal when every setting has the same value: one comparison through the settings table
@@ -236,6 +258,10 @@ const DEFAULT_SETTINGS: Settings = Settings {
     driver_alarm_input: false,
     estop_input: false,
     servo_enable_delay_ms: 50,
+    pen_up_us: 1_000,
+    pen_down_us: 2_000,
+    pen_settle_ms: 200,
+    pen_lift: 0,
 };
 
 impl Settings {
@@ -287,6 +313,10 @@ impl Settings {
             207 => Field::Flag(&mut self.driver_alarm_input),
             208 => Field::Flag(&mut self.estop_input),
             209 => Field::Whole(&mut self.servo_enable_delay_ms),
+            210 => Field::Whole(&mut self.pen_up_us),
+            211 => Field::Whole(&mut self.pen_down_us),
+            212 => Field::Whole(&mut self.pen_settle_ms),
+            213 => Field::Mask(&mut self.pen_lift),
             _ => return None,
         })
     }

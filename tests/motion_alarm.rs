@@ -34,6 +34,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let machine = Machine::new(tight);
     // No servo task here: the drivers hold their axes from the start.
     machine.set_servos_ready(true);
+    machine.set_pen_settled(machine.pen_order());
     let epoch = machine.plan_epoch();
     let first = line_to(150.0, Point::ORIGIN, &loose);
     let end = first.drawing.end();

@@ -124,19 +124,22 @@ use super::GrblError;
 use crate::drawing::{self, Request};
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job, JobKind};
+use crate::pen::{self, Pen};
 use crate::protocol::startup::StartupLine;
 use crate::settings::Settings;
 use crate::status::RunState;
 
 use words::{ProgramStop, compact, parse_block};
 
-/// What one line asks of the machine: an iterator over its [`Command`]s in execution order (a
-/// G4 dwell, then the motion or `$` command, then an M0/M2/M30 stop — GRBL's order). Empty for a
+/// What one line asks of the machine: an iterator over its [`Command`]s in execution order (the
+/// pen for M3/M4/M5, a G4 dwell, then the motion or `$` command, then an M0/M2/M30 stop — GRBL's order). Empty for a
 /// line that only changes modes, or a comment: answer `ok`. It holds at most two large commands
 /// (G28 or G30 through an intermediate point: two moves), so it costs little more than two
 /// [`Command`]s.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Commands {
+    /// M3/M4/M5 with a pen lift: the pen goes there first.
+    pen: Option<Pen>,
     dwell_ms: Option<u32>,
     /// The move to the intermediate point of G28 or G30, before `main`.
     via: Option<Command>,
@@ -147,7 +150,8 @@ pub struct Commands {
 impl Commands {
     /// Commands still to come.
     pub fn len(&self) -> usize {
-        self.dwell_ms.is_some() as usize
+        self.pen.is_some() as usize
+            + self.dwell_ms.is_some() as usize
             + self.via.is_some() as usize
             + self.main.is_some() as usize
             + self.stop.is_some() as usize
@@ -161,7 +165,7 @@ impl Commands {
     fn checked(self) -> Self {
         let main = self.main.filter(|c| !matches!(c, Command::Job(_)));
         let stop = self.stop.filter(|s| *s != ProgramStop::Pause);
-        Commands { dwell_ms: None, via: None, main, stop }
+        Commands { pen: None, dwell_ms: None, via: None, main, stop }
     }
 
     fn one(command: Command) -> Self {
@@ -173,6 +177,9 @@ impl Iterator for Commands {
     type Item = Command;
 
     fn next(&mut self) -> Option<Command> {
+        if let Some(pen) = self.pen.take() {
+            return Some(Command::Pen(pen));
+        }
         if let Some(ms) = self.dwell_ms.take() {
             return Some(Command::Dwell { ms });
         }
@@ -260,6 +267,8 @@ pub enum Command {
     Unlock,
     /// `$H`: run the homing cycle; `ok` once the machine is homed.
     Home,
+    /// M3/M4 (down) or M5 (up) with a pen lift (`$213`): at rest, the pen moves and settles.
+    Pen(Pen),
     /// `$C`: enter check mode (`[MSG:Enabled]`), or leave it (`[MSG:Disabled]`, then a soft
     /// reset once the line is answered, as GRBL does, so the parser plans from the pen again).
     CheckMode { on: bool },
@@ -445,7 +454,11 @@ impl GcodeState {
             _ => [settings.steps_to_mm(Axis::X, end.x), settings.steps_to_mm(Axis::Y, end.y)],
         };
         self.position = end;
-        Ok(Some(Command::Job(Job { drawing, feed, kind })))
+        let pen = match kind {
+            JobKind::Draw => pen::for_move(settings, feed == Feed::Rapid, self.spindle != Spindle::Off),
+            JobKind::Jog | JobKind::Home => None,
+        };
+        Ok(Some(Command::Job(Job { drawing, feed, kind, pen, raise_after: false })))
     }
 }
 

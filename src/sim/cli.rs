@@ -230,8 +230,7 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
     }
     let svg_path = out.join("plot.svg");
     let mut svg = std::io::BufWriter::new(std::fs::File::create(&svg_path)?);
-    let path = report.path();
-    picture::write_plot_svg(&path, report.settings.steps_per_mm, &mut svg)?;
+    picture::write_plot_svg(&report.strokes(), report.settings.steps_per_mm, &mut svg)?;
 
     // Consecutive identical frames are one picture.
     let mut distinct: Vec<&(u64, sim::lcd::Frame)> = Vec::new();

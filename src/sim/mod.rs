@@ -45,7 +45,7 @@ use flash::SimFlash;
 use inputs::{InputScript, SimInputs, Switches};
 use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SimSpi};
-use pins::{LevelPin, PulseTrace, SimWatchdog, TracePin};
+use pins::{LevelPin, PulseTrace, SimPen, SimWatchdog, TracePin};
 use serial::SimSerial;
 use step_timer::SimStepTimer;
 
@@ -113,6 +113,8 @@ pub struct SimReport {
     pub underruns: u32,
     /// Every change of the servo-on output, with its virtual time.
     pub son: Vec<(u64, bool)>,
+    /// Every change of the pen servo's pulse, µs, with its virtual time.
+    pub pen: Vec<(u64, u16)>,
     /// The longest the watchdog went unfed, µs: beyond `WATCHDOG_TIMEOUT_MS` the board would
     /// have been reset.
     pub watchdog_unfed_us: u64,
@@ -132,6 +134,30 @@ impl SimReport {
     /// The pen path rebuilt from the pulses.
     pub fn path(&self) -> Vec<Point> {
         self.trace.path(self.settings.dir_invert_mask)
+    }
+
+    /// The pen path split where the pen went up or down: each run with the pen down (`true`) or
+    /// up, neighbouring runs sharing their end point. Without a pen lift (no pen servo pulses)
+    /// the pen counts as down throughout.
+    pub fn strokes(&self) -> Vec<(bool, Vec<Point>)> {
+        let up_us = self.settings.pen_up_us;
+        let down_at = |t: u64| {
+            let pulse = self.pen.iter().take_while(|(at, _)| *at <= t).last().map(|c| u32::from(c.1));
+            pulse.is_none_or(|p| p != up_us)
+        };
+        let mut at = Point::ORIGIN;
+        let mut strokes: Vec<(bool, Vec<Point>)> = Vec::new();
+        for (t, step) in self.trace.steps(self.settings.dir_invert_mask) {
+            let down = down_at(t);
+            if strokes.last().is_none_or(|s| s.0 != down) {
+                strokes.push((down, std::vec![at]));
+            }
+            at = at.stepped(step);
+            if let Some(s) = strokes.last_mut() {
+                s.1.push(at);
+            }
+        }
+        strokes
     }
 
     /// Time of the last pulse.
@@ -162,6 +188,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let mut engine = PulseEngine::new(SimStepTimer::new(pins, inputs.clone()), step_consumer);
     let son = LevelPin::default();
     let watchdog = SimWatchdog::default();
+    let pen = SimPen::default();
     let kicks = Signal::<NoopRawMutex, ()>::new();
     let matrix = match config.keys_start {
         KeysStart::AtOnce => KeyMatrix::new(config.keys),
@@ -185,7 +212,7 @@ pub fn run(config: SimConfig) -> SimReport {
             tasks::lcd::run(&machine, lcd),
         ),
         join(
-            tasks::servo::run(&machine, son.clone(), || inputs.levels(), || watchdog.feed()),
+            tasks::servo::run(&machine, son.clone(), || inputs.levels(), pen.clone(), || watchdog.feed()),
             tasks::homing::run(&machine),
         ),
     );
@@ -268,6 +295,7 @@ pub fn run(config: SimConfig) -> SimReport {
         underruns,
         son: son.changes(),
         watchdog_unfed_us: watchdog.longest_unfed_us(end_us),
+        pen: pen.changes(),
     }
 }
 

@@ -38,12 +38,13 @@ pub fn write_frame_png(frame: &Frame, path: &Path) -> io::Result<()> {
 }
 
 /// Writes the pen path as an SVG drawing in millimetres, Y up, with a 5 mm margin and the origin
-/// marked.
-pub fn write_plot_svg(path: &[Point], steps_per_mm: [f32; 2], out: &mut impl Write) -> io::Result<()> {
+/// marked: the strokes drawn with the pen down in black, the travel with the pen up dashed in
+/// grey (see [`SimReport::strokes`](super::SimReport::strokes)).
+pub fn write_plot_svg(strokes: &[(bool, Vec<Point>)], steps_per_mm: [f32; 2], out: &mut impl Write) -> io::Result<()> {
     const MARGIN_MM: f32 = 5.0;
     let mm = |p: &Point| (p.x as f32 / steps_per_mm[0], p.y as f32 / steps_per_mm[1]);
     let (mut x0, mut y0, mut x1, mut y1) = (0.0f32, 0.0f32, 0.0f32, 0.0f32);
-    for p in path {
+    for p in strokes.iter().flat_map(|s| &s.1) {
         let (x, y) = mm(p);
         x0 = x0.min(x);
         y0 = y0.min(y);
@@ -64,17 +65,24 @@ pub fn write_plot_svg(path: &[Point], steps_per_mm: [f32; 2], out: &mut impl Wri
         -y1 - MARGIN_MM
     )?;
     writeln!(out, r##"<path d="M -2 0 H 2 M 0 -2 V 2" stroke="#c00" stroke-width="0.1" fill="none"/>"##)?;
-    write!(out, r#"<polyline fill="none" stroke="black" stroke-width="0.25" stroke-linejoin="round" points=""#)?;
-    // Collinear runs are merged so the file stays small; the path itself is exact.
-    let mut last_dir = None;
-    for (i, p) in path.iter().enumerate() {
-        let dir = path.get(i + 1).map(|n| (n.x - p.x, n.y - p.y));
-        if i == 0 || dir != last_dir || i + 1 == path.len() {
-            let (x, y) = mm(p);
-            write!(out, "{x:.3},{:.3} ", -y)?;
+    for (down, path) in strokes {
+        let style = if *down {
+            r#"stroke="black" stroke-width="0.25""#
+        } else {
+            r##"stroke="#999" stroke-width="0.15" stroke-dasharray="1 1""##
+        };
+        write!(out, r#"<polyline fill="none" {style} stroke-linejoin="round" points=""#)?;
+        // Collinear runs are merged so the file stays small; the path itself is exact.
+        let mut last_dir = None;
+        for (i, p) in path.iter().enumerate() {
+            let dir = path.get(i + 1).map(|n| (n.x - p.x, n.y - p.y));
+            if i == 0 || dir != last_dir || i + 1 == path.len() {
+                let (x, y) = mm(p);
+                write!(out, "{x:.3},{:.3} ", -y)?;
+            }
+            last_dir = dir;
         }
-        last_dir = dir;
+        writeln!(out, r#""/>"#)?;
     }
-    writeln!(out, r#""/>"#)?;
     writeln!(out, "</svg>")
 }

@@ -207,3 +207,33 @@ impl SimWatchdog {
         longest.max(end_us.saturating_sub(last))
     }
 }
+
+/// The pen servo's PWM: every change of its pulse width, µs, with its virtual time (a 50 Hz
+/// frame, so the duty cycle counts in µs). No pulse at all until the firmware drives it.
+#[derive(Clone, Default)]
+pub struct SimPen(Rc<RefCell<Vec<(u64, u16)>>>);
+
+impl SimPen {
+    /// Every change, in order.
+    pub fn changes(&self) -> Vec<(u64, u16)> {
+        self.0.borrow().clone()
+    }
+}
+
+impl embedded_hal::pwm::ErrorType for SimPen {
+    type Error = core::convert::Infallible;
+}
+
+impl embedded_hal::pwm::SetDutyCycle for SimPen {
+    fn max_duty_cycle(&self) -> u16 {
+        crate::pen::PEN_SERVO_PERIOD_US as u16
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
+        let mut changes = self.0.borrow_mut();
+        if changes.last().is_none_or(|c| c.1 != duty) {
+            changes.push((clock::now_ticks(), duty));
+        }
+        Ok(())
+    }
+}

@@ -7,6 +7,7 @@ use embedded_hal::digital::{InputPin, OutputPin};
 use crate::job::{Control, Job};
 use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
 use crate::machine::Machine;
+use crate::pen::{Pen, PenLift};
 use crate::ui::MenuAction;
 use crate::ui::menu::UiError;
 
@@ -53,7 +54,14 @@ async fn scan<C: OutputPin, R: InputPin>(columns: &mut [C; 4], rows: &mut [R; 4]
 fn act(machine: &Machine, action: MenuAction) {
     match action {
         MenuAction::None => {}
-        MenuAction::Start(job) => queue(machine, job),
+        MenuAction::Start(mut job) => {
+            // A pen lift lowers the pen for a keypad drawing and raises it once it is drawn.
+            if PenLift::of(&machine.settings()) != PenLift::None {
+                job.pen = Some(Pen::Down);
+                job.raise_after = true;
+            }
+            queue(machine, job)
+        }
         MenuAction::JogStart(direction) => {
             // At the edge already, a jog outwards goes nowhere.
             if let Some(job) = Job::jog(direction, machine.status().position, &machine.settings()) {

@@ -19,6 +19,7 @@ use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
 use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
 use crate::overrides::Overrides;
+use crate::pen::Pen;
 use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner, PlannerState};
 use crate::pulse::StepProducer;
 use crate::settings::Settings;
@@ -85,11 +86,19 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
     let mut moving = RunState::Run;
     // The overrides the planner has.
     let mut overrides = Overrides::NONE;
+    // A job that needs the pen elsewhere, waiting for the motion before it to come to rest.
+    let mut held: Option<Job> = None;
+    // The pen goes up at rest: the last job taken was a keypad drawing.
+    let mut raise_at_rest = false;
     loop {
         if let Some(trip) = machine.take_trip() {
+            held = None;
             halted(machine, &mut planner, &mut steps, &mut queued, trip).await;
         }
         if let Some(control) = machine.take_control() {
+            if control == Control::Abort {
+                held = None;
+            }
             apply(machine, &mut planner, control);
         }
         let now = machine.overrides();
@@ -99,7 +108,18 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             planner.set_overrides(now);
         }
         while !planner.is_full() {
-            let Some(job) = machine.next_job() else { break };
+            let Some(job) = held.take().or_else(|| machine.next_job()) else { break };
+            if let Some(pen) = job.pen
+                && pen != machine.pen()
+            {
+                // The pen moves only at rest: the job waits for what is planned before it.
+                if !planner.is_idle() || !machine.pulses_idle() {
+                    held = Some(job);
+                    break;
+                }
+                machine.set_pen(pen);
+            }
+            raise_at_rest = job.raise_after;
             let settings = machine.settings();
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
@@ -134,8 +154,10 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
         machine.set_queued(queued.steps, queued.ticks);
         machine.set_plan_free_segments(planner.free_segments());
         if queued.steps != steps_before {
-            // Off after standing still (`$1`), the servos take their enable delay first.
-            while !machine.servos_ready() && !machine.halted() {
+            // Off after standing still (`$1`), the servos take their enable delay first; a pen
+            // just sent elsewhere, its settle time.
+            let may_start = || machine.halted() || (machine.servos_ready() && machine.pen_settled());
+            while !may_start() {
                 Timer::after(Duration::from_millis(SERVO_READY_POLL_MS)).await;
             }
             kick();
@@ -147,7 +169,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                 select(Timer::after(Duration::from_ticks(wait_us)), machine.control_requested()).await;
             }
             FillEnd::PlanEmpty | FillEnd::CurveFailed(_) => {
-                machine.set_plan_empty(planner.is_idle());
+                machine.set_plan_empty(planner.is_idle() && held.is_none());
                 match planner.state() {
                     PlannerState::Idle => {
                         // Everything planned is queued: rest once it has been emitted.
@@ -156,6 +178,13 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                         }
                         if machine.run_state() != RunState::Idle {
                             info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
+                        }
+                        if held.is_some() {
+                            // At rest now: the held job moves the pen and goes on.
+                            continue;
+                        }
+                        if core::mem::take(&mut raise_at_rest) && machine.queued_jobs() == 0 {
+                            machine.set_pen(Pen::Up);
                         }
                         // An alarm stays until `$X`.
                         if machine.run_state() != RunState::Alarm {

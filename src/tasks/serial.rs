@@ -52,6 +52,7 @@ use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::overrides::Overrides;
+use crate::pen::{Pen, PenLift};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::gcode::Offsets;
@@ -159,17 +160,48 @@ impl Host<'_> {
     }
 
     /// Waits until nothing is queued or moving.
-    async fn machine_at_rest(&self) {
-        while !self.machine.is_idle() {
-            Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
-        }
+    fn machine_at_rest(&self) -> Until<'_> {
+        Until { machine: self.machine, done: Machine::is_idle, timer: None }
+    }
+
+    /// Once nothing is queued or moving, sends the pen to `pen` and waits for it to settle.
+    async fn pen_to(&self, pen: Pen) {
+        self.machine_at_rest().await;
+        self.machine.set_pen(pen);
+        Until { machine: self.machine, done: Machine::pen_settled, timer: None }.await
     }
 
     /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
     /// runs: the position is final.
-    async fn machine_stopped(&self) {
-        while !self.machine.stopped() || self.machine.homing() {
-            Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)).await;
+    fn machine_stopped(&self) -> Until<'_> {
+        Until { machine: self.machine, done: |m| m.stopped() && !m.homing(), timer: None }
+    }
+}
+
+/// Waits until `done` holds for the machine, looking again every `SERIAL_IDLE_POLL_MS`. One
+/// type, its poll out of line, serves every such wait of the serial task.
+struct Until<'m> {
+    machine: &'m Machine,
+    done: fn(&Machine) -> bool,
+    timer: Option<Timer>,
+}
+
+impl Future for Until<'_> {
+    type Output = ();
+
+    #[inline(never)]
+    fn poll(mut self: core::pin::Pin<&mut Self>, cx: &mut core::task::Context<'_>) -> core::task::Poll<()> {
+        loop {
+            if let Some(timer) = &mut self.timer {
+                if core::pin::Pin::new(timer).poll(cx).is_pending() {
+                    return core::task::Poll::Pending;
+                }
+                self.timer = None;
+            }
+            if (self.done)(self.machine) {
+                return core::task::Poll::Ready(());
+            }
+            self.timer = Some(Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)));
         }
     }
 }
@@ -398,8 +430,13 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 unless_reset(link, host.machine_at_rest()).await?;
                 machine.request(Control::Hold);
             }
+            Command::Pen(pen) => unless_reset(link, host.pen_to(pen)).await?,
             Command::ProgramEnd => {
                 unless_reset(link, host.machine_at_rest()).await?;
+                // M2/M30 turn the spindle off: a pen lift raises the pen.
+                if PenLift::of(settings) != PenLift::None {
+                    unless_reset(link, host.pen_to(Pen::Up)).await?;
+                }
                 link.send(Reply::Message("Pgm End")).await;
             }
             Command::SetSetting { id, value } => {

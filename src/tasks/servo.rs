@@ -7,16 +7,21 @@
 //! as there is motion to make, and the machine counts the servos ready `$209` ms later: the
 //! motion task starts no pulse before (see [`Machine::servos_ready`]).
 //!
+//! It drives the pen servo's PWM to where the machine wants the pen (when `$213` names a pen
+//! lift) and tells the machine once it has had its settle time (`$212`).
+//!
 //! It also feeds the board's independent watchdog, while the pulse engine and the motion task
 //! make progress (see [`crate::watchdog`]); once they do not, it stops, and the watchdog resets
 //! the board.
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
+use embedded_hal::pwm::SetDutyCycle;
 
 use crate::geom::TICK_HZ;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
-use crate::machine::Machine;
+use crate::machine::{Machine, PenOrder};
+use crate::pen::{PEN_SERVO_PERIOD_US, PenLift, pulse_us};
 use crate::settings::SERVO_ALWAYS_ON;
 use crate::status::RunState;
 use crate::watchdog::{Look, Progress};
@@ -26,14 +31,18 @@ use crate::watchdog::{Look, Progress};
 pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 
 /// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on, trips
-/// the machine when a driver alarm or the e-stop read through `levels` stays active, and calls
-/// `feed` (the watchdog's) while the machine makes progress.
+/// the machine when a driver alarm or the e-stop read through `levels` stays active, drives
+/// `pen` (the pen servo's 50 Hz PWM), and calls `feed` (the watchdog's) while the machine makes
+/// progress.
 pub async fn run<P: OutputPin>(
     machine: &Machine,
     mut son: P,
     mut levels: impl FnMut() -> InputLevels,
+    mut pen: impl SetDutyCycle,
     mut feed: impl FnMut(),
 ) -> ! {
+    // The pen order and pulse the PWM has, and since when.
+    let mut pen_applied: Option<(PenOrder, u32, Instant)> = None;
     let mut debounce = Debounce::default();
     let mut progress = Progress::default();
     let mut stalled = false;
@@ -63,6 +72,24 @@ pub async fn run<P: OutputPin>(
         machine.set_servos_ready(on_since.is_some_and(|t| at - t >= enable_delay));
         if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
+        }
+        let order = machine.pen_order();
+        if PenLift::of(&settings) == PenLift::None {
+            // No pen servo: the pen is where it is told at once.
+            machine.set_pen_settled(order);
+        } else {
+            let pulse = pulse_us(&settings, order.pen());
+            if pen_applied.is_none_or(|(o, p, _)| (o, p) != (order, pulse)) {
+                // Both fit 16 bits: the pulse is at most PEN_PULSE_MAX_US.
+                if pen.set_duty_cycle_fraction(pulse as u16, PEN_SERVO_PERIOD_US as u16).is_err() {
+                    warn!("pen servo output failed");
+                }
+                pen_applied = Some((order, pulse, at));
+            }
+            let settle = Duration::from_millis(settings.pen_settle_ms.into());
+            if pen_applied.is_some_and(|(_, _, since)| at - since >= settle) {
+                machine.set_pen_settled(order);
+            }
         }
         let flowing = machine.queued_steps() > 0 || matches!(machine.run_state(), RunState::Run | RunState::Jog);
         let look = Look {
@@ -116,7 +143,7 @@ mod tests {
         crate::sim::clock::reset();
         let machine = Machine::new(Settings::default());
         let son = Cell::new(false);
-        let mut task = pin!(run(&machine, Pin(&son), || 0, || {}));
+        let mut task = pin!(run(&machine, Pin(&son), || 0, crate::sim::pins::SimPen::default(), || {}));
         let mut cx = Context::from_waker(Waker::noop());
         let mut step = || {
             let _ = task.as_mut().poll(&mut cx);

@@ -15,6 +15,7 @@
 //! | X / Y limit min     | PE4 / PE5 | inputs with pull-ups, switch to GND (normally open; `$5=1` normally closed) |
 //! | X / Y limit max     | PE6 / PE7 | as the min switches                        |
 //! | X / Y driver ALM    | PE8 / PE14 | inputs with pull-ups, from the drivers' ALM+ (ALM- to GND): open = alarm (`$207`) |
+//! | pen servo (PWM)     | PC6  | TIM3 CH1, 50 Hz: the RC servo's signal (`$210`-`$213`) |
 //! | e-stop              | PE15 | input with pull-up, normally closed button to GND: open = stop (`$208`) |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
@@ -28,6 +29,7 @@
 
 mod inputs;
 mod panic;
+mod pen;
 mod step_timer;
 mod usb;
 
@@ -51,6 +53,7 @@ use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
+use pen::PenPwm;
 use servoplot::machine::Machine;
 use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
@@ -62,6 +65,9 @@ use step_timer::Tim1StepTimer;
 /// Crystal and core clock (see `clocks`).
 const HSE_HZ: u32 = 8_000_000;
 const SYSCLK_HZ: u32 = 168_000_000;
+
+/// What TIM2-TIM7 count at: twice APB1's SYSCLK / 4 (see `clocks`).
+const APB1_TIMER_HZ: u32 = SYSCLK_HZ / 4 * 2;
 
 /// Interrupt priorities, most urgent first: the step timer (the pulse engine), embassy-time's
 /// timer, motion, then the host links' UART and USB port; keypad, LCD, the serial protocol and
@@ -120,8 +126,13 @@ async fn serial(
 }
 
 #[embassy_executor::task]
-async fn servo(machine: &'static Machine, son: Output<'static>, mut dog: IndependentWatchdog<'static, IWDG>) -> ! {
-    tasks::servo::run(machine, son, inputs::read, || dog.pet()).await
+async fn servo(
+    machine: &'static Machine,
+    son: Output<'static>,
+    pen: PenPwm,
+    mut dog: IndependentWatchdog<'static, IWDG>,
+) -> ! {
+    tasks::servo::run(machine, son, inputs::read, pen, || dog.pet()).await
 }
 
 #[embassy_executor::task]
@@ -204,6 +215,8 @@ async fn main(spawner: Spawner) {
     );
     // Servo on: low until the servo task, started with the pulse engine running, turns it on.
     let son = Output::new(p.PE13, Level::Low, Speed::Low);
+    // The pen servo: TIM3's 50 Hz PWM, no pulse until the servo task drives it (`$213`).
+    let pen = PenPwm::new(p.TIM3, PwmPin::new(p.PC6, OutputType::PushPull), APB1_TIMER_HZ);
 
     interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
     let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
@@ -225,7 +238,7 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD11, Pull::Up),
     ];
     spawner.spawn(unwrap!(keypad(machine, columns, rows)));
-    spawner.spawn(unwrap!(servo(machine, son, dog)));
+    spawner.spawn(unwrap!(servo(machine, son, pen, dog)));
     spawner.spawn(unwrap!(homing(machine)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();

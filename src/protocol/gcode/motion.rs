@@ -12,6 +12,7 @@ use super::{
 use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
 use crate::job::{Feed, JobKind};
+use crate::pen::{Pen, PenLift};
 use crate::protocol::GrblError;
 use crate::settings::Settings;
 
@@ -54,6 +55,11 @@ impl GcodeState {
         }
 
         let mut out = Commands::default();
+        if let Some(s) = block.spindle
+            && PenLift::of(settings) != PenLift::None
+        {
+            out.pen = Some(if s == Spindle::Off { Pen::Up } else { Pen::Down });
+        }
         if block.non_modal == Some(NonModal::Dwell) {
             let p = words.take(b'P').ok_or(GrblError::ValueWordMissing)?;
             let ms = crate::math::round(p * 1000.0);

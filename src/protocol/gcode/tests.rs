@@ -47,7 +47,7 @@ fn refused(g: &mut GcodeState, line: &str, code: u8) {
 /// A straight job from `from` to (`x`, `y`) steps.
 fn line_from(from: Point, x: i32, y: i32, feed: Feed, kind: JobKind) -> Command {
     let drawing = crate::drawing::build(&Request::Straight { to: Point::new(x, y) }, from, &settings());
-    Command::Job(Job { drawing: drawing.unwrap().unwrap(), feed, kind })
+    Command::Job(Job { drawing: drawing.unwrap().unwrap(), feed, kind, pen: None, raise_after: false })
 }
 
 /// Runs `l` and asserts that it hands out exactly one straight job, from where the parser
