@@ -11,6 +11,9 @@
 //! over with the [`PlanEpoch`] it was planned in; an abort starts a new epoch, and a job from
 //! an earlier one is refused ([`Stale`]) or, if it was queued already, dropped.
 //!
+//! The pen's orders are kept here too: where it is to be, and whether the servo task has seen it
+//! settle there ([`set_pen`](Machine::set_pen), [`pen_settled`](Machine::pen_settled)).
+//!
 //! The machine also owns where machine zero is: the position is the pulses emitted less the
 //! origin homing found ([`set_origin`](Machine::set_origin)), and whether it can be trusted
 //! ([`position_lost`](Machine::position_lost)).

@@ -7,8 +7,12 @@
 //! `STEP_QUEUE_MAX_US` of motion, so a hold acts within that time even at the slowest feed —
 //! publishes what it queued, and wakes the pulse engine. Then it waits for exactly one of three
 //! things: the queue half emitted, a job when the planner has room for one, or a control
-//! request (or a change of override, which it hands to the planner). On target it runs on its own interrupt executor, between the pulse engine and
-//! everything else.
+//! request (or a change of override, which it hands to the planner). On target it runs on its
+//! own interrupt executor, between the pulse engine and everything else.
+//!
+//! It moves the pen for the jobs that need it elsewhere (see [`crate::pen`]), only at rest: such
+//! a job waits until the motion before it has been emitted. It starts the pulses only once the
+//! servos are ready and the pen has settled.
 
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
