@@ -239,7 +239,7 @@ pub const WRITE_MAX_DECIMALS: u8 = 6;
 /// to the nearest, halfway away from zero, and never as `-0.000`. The integer part is exact up
 /// to 2^24 (every whole `f32` is) and rounded like the `f32` beyond; the decimals are those of
 /// the `f32`'s own fraction. `nan`, `inf`, `-inf` for what is not a finite number.
-pub fn write_fixed(out: &mut impl core::fmt::Write, value: f32, decimals: u8) -> core::fmt::Result {
+pub fn write_fixed(out: &mut dyn core::fmt::Write, value: f32, decimals: u8) -> core::fmt::Result {
     let Some((negative, whole, fraction)) = split(value, decimals.min(WRITE_MAX_DECIMALS)) else {
         return out.write_str(if value.is_nan() {
             "nan"
@@ -267,7 +267,7 @@ const U64_MAX_DIGITS: usize = 20;
 /// Writes `value` in decimal, with leading zeros up to `min_digits` digits (at most
 /// [`U64_MAX_DIGITS`]). The firmware writes every integer through here: core's integer
 /// formatting and padding would cost flash for widths it never uses.
-pub fn write_digits(out: &mut impl core::fmt::Write, mut value: u64, min_digits: usize) -> core::fmt::Result {
+pub fn write_digits(out: &mut dyn core::fmt::Write, mut value: u64, min_digits: usize) -> core::fmt::Result {
     let mut digits = [0u8; U64_MAX_DIGITS];
     let mut start = U64_MAX_DIGITS;
     let min_start = U64_MAX_DIGITS - min_digits.clamp(1, U64_MAX_DIGITS);
@@ -312,7 +312,7 @@ impl From<usize> for Int {
 /// Writes `value` with at most `max_decimals` decimals, leaving off trailing zeros down to
 /// `min_decimals` (`2.5` with 0 to 6 is `2.5`, `20000` is `20000`, with 3 to 6 `20000.000`).
 pub fn write_trimmed(
-    out: &mut impl core::fmt::Write,
+    out: &mut dyn core::fmt::Write,
     value: f32,
     min_decimals: u8,
     max_decimals: u8,
