@@ -1,4 +1,4 @@
-//! The LCD's geometry: its visible size, the text grid the 5x8 font makes of it, and how the
+//! The LCD's geometry: its visible size, the text grid the 5x7 font makes of it, and how the
 //! settings view scrolls in that grid.
 //!
 //! The menu keeps the settings view's scroll position and the screen draws it; both take the
@@ -8,9 +8,9 @@
 pub const SCREEN_WIDTH_PX: u32 = 122;
 /// Visible height of the LCD.
 pub const SCREEN_HEIGHT_PX: u32 = 32;
-/// Height of one text line (the 5x8 font).
+/// Height of one text line (the 5x7 font and a row between lines).
 pub const SCREEN_LINE_HEIGHT_PX: u32 = 8;
-/// Width of one character (the 5x8 font).
+/// Width of one character (the 5x7 font).
 pub const SCREEN_CHAR_WIDTH_PX: u32 = 5;
 /// Left margin, so inverted lines do not start with a glyph at the glass' edge.
 pub const SCREEN_MARGIN_PX: u32 = 1;

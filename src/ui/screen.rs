@@ -1,7 +1,8 @@
 //! What the 122x32 LCD shows, and drawing it on any monochrome embedded-graphics target.
 //!
 //! [`view`] turns the menu, the machine status and the settings into a [`ScreenView`]: four
-//! text lines of [`SCREEN_COLUMNS`] characters in the 5x8 font, the title line inverted, an
+//! text lines of [`SCREEN_COLUMNS`] characters in the 5x7 font (whose decimal point is a dot; the
+//! 5x8 font's is a cross, and "0.000" read "0+000"), the title line inverted, an
 //! error (if any) inverted on the bottom line. The view is small and compares cheaply, so the LCD
 //! task redraws only when it changes. [`render`] draws a whole view: every line's full width is
 //! cleared before its text is drawn, so no pixel of an earlier frame survives (no stale digits),
@@ -23,7 +24,7 @@ use embedded_graphics::Drawable;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::mono_font::MonoTextStyle;
-use embedded_graphics::mono_font::ascii::FONT_5X8;
+use embedded_graphics::mono_font::ascii::FONT_5X7;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::primitives::Rectangle;
 use embedded_graphics::text::{Baseline, Text};
@@ -186,8 +187,10 @@ where
         let top = (i as u32 * SCREEN_LINE_HEIGHT_PX) as i32;
         let area = Rectangle::new(Point::new(0, top), Size::new(SCREEN_WIDTH_PX, SCREEN_LINE_HEIGHT_PX));
         target.fill_solid(&area, bg)?;
-        let style = MonoTextStyle::new(&FONT_5X8, fg);
-        Text::with_baseline(&line.text, Point::new(SCREEN_MARGIN_PX as i32, top), style, Baseline::Top).draw(target)?;
+        let style = MonoTextStyle::new(&FONT_5X7, fg);
+        // The 7-pixel glyphs sit on the line's last row: a row apart from the line above.
+        let at = Point::new(SCREEN_MARGIN_PX as i32, top + 1);
+        Text::with_baseline(&line.text, at, style, Baseline::Top).draw(target)?;
     }
     Ok(())
 }
@@ -539,14 +542,32 @@ mod tests {
         for line in 1..SCREEN_LINES {
             assert!(f.lit_in_rows(line * 8..line * 8 + 8) > 0, "line {line} is blank\n{f:?}");
         }
-        // The title's first glyph ('C') is where the 5x8 font puts it.
+        // The title's first glyph ('C') is where the 5x7 font puts it.
         let mut reference = Frame::filled(true);
-        Text::with_baseline("C", Point::new(1, 0), MonoTextStyle::new(&FONT_5X8, BinaryColor::Off), Baseline::Top)
+        Text::with_baseline("C", Point::new(1, 1), MonoTextStyle::new(&FONT_5X7, BinaryColor::Off), Baseline::Top)
             .draw(&mut reference)
             .unwrap();
         for y in 0..8 {
             assert_eq!(f.px[y][..6], reference.px[y][..6], "row {y}\n{f:?}");
         }
+    }
+
+    #[test]
+    fn the_decimal_point_is_a_dot_at_the_foot_of_its_cell() {
+        // "X    0.000": the point is the 6th character of the position line's X value.
+        let status = Status::default();
+        let f = fresh(&Menu::new(), &status);
+        let v = view(&Menu::new(), &status, &Settings::default());
+        let column = texts(&v)[1].find('.').unwrap();
+        let x0 = SCREEN_MARGIN_PX as usize + column * crate::ui::layout::SCREEN_CHAR_WIDTH_PX as usize;
+        let line = SCREEN_LINE_HEIGHT_PX as usize;
+        let lit: std::vec::Vec<(usize, usize)> =
+            (line..2 * line).flat_map(|y| (x0..x0 + 5).map(move |x| (x, y))).filter(|&(x, y)| f.px[y][x]).collect();
+        assert!(!lit.is_empty(), "{f:?}");
+        // Nothing in the upper half of the cell, nothing beside the dot: no cross.
+        assert!(lit.iter().all(|&(_, y)| y >= line + 4), "{lit:?}\n{f:?}");
+        let width = lit.iter().map(|p| p.0).max().unwrap() - lit.iter().map(|p| p.0).min().unwrap() + 1;
+        assert!(width <= 2, "{lit:?}");
     }
 
     #[test]
