@@ -6,7 +6,7 @@
 
 use crate::drawing::{self, DrawError, Drawing, Request};
 use crate::geom::{Axis, Point, Step};
-use crate::pen::Pen;
+use crate::pen::{Pen, PenLift};
 use crate::settings::Settings;
 
 /// Feed of a jog from the keypad.
@@ -89,7 +89,9 @@ impl Job {
     pub fn homing_move(from: Point, to: Point, feed_mm_per_min: f32, settings: &Settings) -> Option<Job> {
         let unchecked = Settings { soft_limits: false, ..settings.clone() };
         let drawing = drawing::build(&Request::Straight { to }, from, &unchecked).ok()??;
-        Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home, pen: None, raise_after: false })
+        // Homing never draws: with a pen lift, the pen is up.
+        let pen = (PenLift::of(settings) != PenLift::None).then_some(Pen::Up);
+        Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home, pen, raise_after: false })
     }
 
     /// A jog from `from` in `direction` (one of the 8), as far as the travel limits allow along a

@@ -173,8 +173,8 @@ pub struct Machine {
     pen_settled: AtomicU32,
     /// Pulses emitted at machine zero (written only by the homing task, at rest).
     origin: [AtomicI32; 2],
-    /// The pulses stopped without braking, or the axes were free: the position may be wrong
-    /// until the next homing.
+    /// The pulses stopped without braking, or the axes were free (`$SLP`): the position may be
+    /// wrong until the next homing.
     position_lost: AtomicBool,
 }
 
@@ -519,6 +519,8 @@ impl Machine {
     /// until [`wake`](Self::wake). Only the serial task calls this.
     pub fn sleep(&self) {
         self.asleep.store(true, Ordering::Relaxed);
+        // The axes are free until the reset.
+        self.position_lost.store(true, Ordering::Relaxed);
         self.changed.signal(());
     }
 
@@ -542,12 +544,13 @@ impl Machine {
     /// Whether the drivers hold their axes: SON high for the enable delay (`$209`). Only the
     /// servo task calls this.
     pub fn set_servos_ready(&self, ready: bool) {
-        self.servos_ready.store(ready, Ordering::Release);
+        // Sequentially consistent: the servo task's going-off handshake with the motion task.
+        self.servos_ready.store(ready, Ordering::SeqCst);
     }
 
     /// True once the drivers hold their axes; no pulse may go out before.
     pub fn servos_ready(&self) -> bool {
-        self.servos_ready.load(Ordering::Acquire)
+        self.servos_ready.load(Ordering::SeqCst)
     }
 
     /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
@@ -590,7 +593,8 @@ impl Machine {
             return;
         }
         self.trip.lock(|t| t.set(Some(trip)));
-        if !self.homing() {
+        // A limit switch a homing approach looks for stops nothing it does not expect.
+        if !(self.homing() && matches!(trip, Trip::Limit { .. })) {
             self.position_lost.store(true, Ordering::Relaxed);
         }
         self.control_requested.signal(());
@@ -784,6 +788,6 @@ impl Machine {
 
     /// True when nothing is queued, planned or moving.
     pub fn is_idle(&self) -> bool {
-        self.run_state() == RunState::Idle && self.jobs.is_empty() && self.pulses_idle()
+        self.run_state() == RunState::Idle && self.stopped()
     }
 }

@@ -7,8 +7,10 @@
 //! (steps queued, or the motion running, with the servos ready and nothing tripped), the pulses
 //! emitted must grow within [`WATCHDOG_STALL_MS`] more than the queued motion takes.
 
-/// The independent watchdog resets the board when it has not been fed for this long.
-pub const WATCHDOG_TIMEOUT_MS: u32 = 500;
+/// The independent watchdog resets the board when it has not been fed for this long: longer
+/// than the flash store's sector erase (up to 2 s on the F407, at 3.3 V), during which the
+/// processor stalls and nothing feeds it.
+pub const WATCHDOG_TIMEOUT_MS: u32 = 4_000;
 
 /// Longest time without a pulse, beyond the motion queued, before the machine counts as stalled.
 pub const WATCHDOG_STALL_MS: u32 = 1_000;

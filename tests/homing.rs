@@ -162,7 +162,63 @@ fn the_position_is_unknown_from_power_on_with_homing_on_and_after_a_hard_limit_u
     machine.set_origin(Point::new(-19_900, -19_900));
     assert!(!machine.status().position_lost, "homed");
     assert_eq!(machine.position(), Point::new(-19_900, -19_900));
+    // During homing the switch an approach looks for is no loss; an e-stop is.
+    assert!(machine.request_homing());
+    machine.trip(Trip::Limit { axis: Axis::X, max: false });
+    assert!(!machine.status().position_lost, "the switch homing looked for");
+    let machine = Machine::new(Settings { homing: true, ..Settings::default() });
+    machine.set_origin(Point::new(-19_900, -19_900));
+    assert!(machine.request_homing());
+    machine.trip(Trip::EStop);
+    assert!(machine.status().position_lost, "an e-stop during homing");
+    let machine = Machine::new(Settings::default());
     machine.trip(Trip::Limit { axis: Axis::X, max: true });
     assert!(machine.status().position_lost, "the pulses stopped without braking");
     assert!(!Machine::new(Settings::default()).status().position_lost, "homing off: the power-on origin counts");
+}
+
+/// The pauses between homing moves (gaps of more than 100 ms between pulses), µs.
+fn pauses(report: &SimReport) -> Vec<(u64, u64)> {
+    let pulses = &report.trace.pulses;
+    pulses.windows(2).filter(|w| w[1].t_us - w[0].t_us > 100_000).map(|w| (w[0].t_us, w[1].t_us)).collect()
+}
+
+#[test]
+fn a_reset_or_an_e_stop_between_homing_moves_stops_the_cycle_and_leaves_the_machine_usable() {
+    let reference = run("$22=1\n$208=1\n$H\n", SWITCHES, "");
+    let (a, b) = pauses(&reference)[0];
+    let pause = (a + b) / 2;
+    // A reset in the pause after the X seek: ALARM:6, and not one pulse more.
+    let report = run_with("$22=1\n$208=1\n$H\n", &[(pause, "\x18")], SWITCHES, "", SimFlash::default());
+    assert!(report.answers().contains("ALARM:6"), "{}", report.answers());
+    assert!(report.trace.pulses.iter().all(|p| p.t_us < pause), "moved after the reset");
+    // The e-stop in the same pause: ALARM:10; after a reset `$X` and `$H` are answered, and
+    // the second cycle homes.
+    let ms = pause / 1_000;
+    let events = format!("{ms} on estop\n{} off estop\n", ms + 50);
+    let later = [(pause + 2_000_000, "\x18"), (pause + 3_000_000, "$X\n"), (pause + 4_000_000, "$H\n")];
+    let report = run_with("$22=1\n$208=1\n$H\n", &later, SWITCHES, &events, SimFlash::default());
+    let answers = report.answers();
+    assert!(answers.contains("ALARM:10"), "{answers}");
+    assert!(answers.ends_with("[MSG:Caution: Unlocked]\r\nok\r\nok\r\n"), "{answers}");
+    assert_eq!(report.position, Point::new(-19_900, -19_900));
+}
+
+#[test]
+fn host_motion_is_refused_while_the_keypad_homes() {
+    let first = run("$22=1\n", SWITCHES, "");
+    let keys = servoplot::sim::keys::KeyScript::parse("8").unwrap();
+    let reference =
+        sim::run(SimConfig { switches: SWITCHES, flash: first.flash.clone(), keys, ..SimConfig::default() });
+    let (a, b) = pauses(&reference)[4];
+    // A G0 in a pause of Y's cycle: refused, and the cycle still homes where the switches are.
+    let mut serial = SimSerial::default();
+    for (k, byte) in "G0 X50\n".bytes().enumerate() {
+        serial = serial.with_byte_at((a + b) / 2 + k as u64, byte);
+    }
+    let keys = servoplot::sim::keys::KeyScript::parse("8").unwrap();
+    let report = sim::run(SimConfig { serial, switches: SWITCHES, flash: first.flash, keys, ..SimConfig::default() });
+    assert!(report.answers().ends_with("error:9\r\n"), "{}", report.answers());
+    assert_eq!(report.position, Point::new(-19_900, -19_900));
+    assert_eq!(driven(&report), driven(&reference), "the same pulses as without the G0");
 }

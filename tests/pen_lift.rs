@@ -109,3 +109,19 @@ fn a_keypad_drawing_lowers_the_pen_first_and_raises_it_at_the_end() {
     assert!(settled);
     assert!(report.pen[2].0 >= report.last_pulse_us(), "up once drawn");
 }
+
+#[test]
+fn a_reset_while_the_pen_settles_sends_no_pulse_and_a_long_settle_keeps_the_watchdog_fed() {
+    let lines = "$213=2\n$212=2000\nG1 X10 F3000\n";
+    let reference = run(lines);
+    assert!(reference.watchdog_unfed_us <= 20_000, "unfed {} µs", reference.watchdog_unfed_us);
+    let down = reference.pen.iter().find(|c| c.1 == DOWN_US).unwrap().0;
+    let reset = down + 1_000_000;
+    let serial = SimSerial::with_input(lines.as_bytes()).with_byte_at(reset, 0x18);
+    let report = sim::run(SimConfig { serial, ..SimConfig::default() });
+    assert!(
+        report.trace.pulses.is_empty(),
+        "{} pulses after a reset before the pen settled",
+        report.trace.pulses.len()
+    );
+}

@@ -418,7 +418,7 @@ impl GcodeState {
         if compact.is_empty() || compact.as_slice() == b"%" {
             return Ok(Commands::default());
         }
-        if matches!(state, RunState::Alarm | RunState::Jog) {
+        if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
             return Err(GrblError::Locked);
         }
         let block = parse_block(&compact)?;

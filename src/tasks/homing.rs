@@ -9,7 +9,7 @@ use crate::geom::{Axis, Point};
 use crate::homing::{HOMING_ORDER, HomingFail, Phase, homed_steps, homing_move, towards_max};
 use crate::inputs::{InputSetup, Trip};
 use crate::job::Job;
-use crate::machine::{Machine, MotionFault};
+use crate::machine::{Machine, MotionFault, PlanEpoch};
 use crate::status::RunState;
 use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
 
@@ -43,6 +43,18 @@ pub async fn run(machine: &Machine) -> ! {
     }
 }
 
+/// The cycle may go on: no trip raised an alarm (`Err(None)`: it said why), and no abort came
+/// since the cycle began in `epoch`.
+fn still_homing(machine: &Machine, epoch: PlanEpoch) -> Result<(), Option<HomingFail>> {
+    if machine.run_state() == RunState::Alarm || machine.halted() {
+        return Err(None);
+    }
+    if machine.plan_epoch() != epoch {
+        return Err(Some(HomingFail::Aborted));
+    }
+    Ok(())
+}
+
 /// Waits until nothing is queued, planned or moving.
 async fn until_stopped(machine: &Machine) {
     while !machine.stopped() {
@@ -54,6 +66,9 @@ async fn until_stopped(machine: &Machine) {
 /// raised an alarm of its own.
 async fn cycle(machine: &Machine) -> Result<(), Option<HomingFail>> {
     let settings = machine.settings();
+    // A healthy cycle never aborts: any abort from here on, even between moves, is a reset or a
+    // keypad D that stops it.
+    let epoch = machine.plan_epoch();
     for axis in HOMING_ORDER {
         let switch = Trip::Limit { axis, max: towards_max(&settings, axis) };
         for phase in Phase::ALL {
@@ -64,22 +79,17 @@ async fn cycle(machine: &Machine) -> Result<(), Option<HomingFail>> {
                 Axis::Y => Point::new(from.x, from.y + step.steps),
             };
             let job = Job::homing_move(from, to, step.feed_mm_per_min, &settings).ok_or(HomingFail::Approach(axis))?;
-            let epoch = machine.plan_epoch();
             machine.submit(job, epoch).await.map_err(|_| HomingFail::Aborted)?;
             until_stopped(machine).await;
             let found = machine.take_switch_found();
-            if machine.run_state() == RunState::Alarm {
-                return Err(None);
-            }
-            if machine.plan_epoch() != epoch {
-                return Err(Some(HomingFail::Aborted));
-            }
+            still_homing(machine, epoch)?;
             if phase.approaches() && found != Some(switch) {
                 return Err(Some(HomingFail::Approach(axis)));
             }
             // The switch settles, and the inputs are read again.
             let settle_ms = u64::from(settings.homing_debounce_ms) + SERVO_ENABLE_POLL_MS;
             Timer::after(Duration::from_millis(settle_ms)).await;
+            still_homing(machine, epoch)?;
             if !phase.approaches() && InputSetup::from_settings(&settings).pressed(machine.input_levels(), switch) {
                 return Err(Some(HomingFail::PullOff(axis)));
             }

@@ -14,6 +14,8 @@
 //! a job waits until the motion before it has been emitted. It starts the pulses only once the
 //! servos are ready and the pen has settled.
 
+use core::sync::atomic::{Ordering, fence};
+
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 
@@ -130,6 +132,12 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             }
             moving = plan(machine, &mut planner, job, &settings);
         }
+        if machine.pulses_idle() && !planner.is_idle() && !ready_to_start(machine) {
+            // Starting from rest: servos off for standing still (`$1`) take their enable delay,
+            // a pen just sent elsewhere its settle time. A control meanwhile is taken first.
+            select(until_ready_to_start(machine), machine.control_requested()).await;
+            continue;
+        }
         let steps_before = queued.steps;
         let filled = fill(machine, &mut planner, &mut steps, &mut queued, &mut work).await;
         if queued.steps != steps_before {
@@ -139,6 +147,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             }
         }
         if let FillEnd::CurveFailed(e) = filled {
+            held = None;
             // A curve stopped part way (the travel guard at the edge, or a curve failing where
             // the builder's trace did not): a defect upstream, since the builder refuses both.
             // Stop there, drop what was planned after it (it was planned from a point the pen
@@ -158,12 +167,6 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
         machine.set_queued(queued.steps, queued.ticks);
         machine.set_plan_free_segments(planner.free_segments());
         if queued.steps != steps_before {
-            // Off after standing still (`$1`), the servos take their enable delay first; a pen
-            // just sent elsewhere, its settle time.
-            let may_start = || machine.halted() || (machine.servos_ready() && machine.pen_settled());
-            while !may_start() {
-                Timer::after(Duration::from_millis(SERVO_READY_POLL_MS)).await;
-            }
             kick();
         }
         match filled {
@@ -298,6 +301,21 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
     match job.kind {
         JobKind::Draw | JobKind::Home => RunState::Run,
         JobKind::Jog => RunState::Jog,
+    }
+}
+
+/// True when pulses may start from rest: the servos hold their axes and the pen has settled (or
+/// a trip halted the machine, which starts nothing).
+fn ready_to_start(machine: &Machine) -> bool {
+    // What this task planned is visible before it looks: see the servo task's going-off check.
+    fence(Ordering::SeqCst);
+    machine.halted() || (machine.servos_ready() && machine.pen_settled())
+}
+
+/// Waits until [`ready_to_start`].
+async fn until_ready_to_start(machine: &Machine) {
+    while !ready_to_start(machine) {
+        Timer::after(Duration::from_millis(SERVO_READY_POLL_MS)).await;
     }
 }
 

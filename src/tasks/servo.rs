@@ -14,6 +14,8 @@
 //! make progress (see [`crate::watchdog`]); once they do not, it stops, and the watchdog resets
 //! the board.
 
+use core::sync::atomic::{Ordering, fence};
+
 use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 use embedded_hal::pwm::SetDutyCycle;
@@ -64,8 +66,16 @@ pub async fn run<P: OutputPin>(
         let at = Instant::now();
         let still = machine.stopped() && !machine.homing();
         still_since = if still { still_since.or(Some(at)) } else { None };
-        let idle_off = settings.servo_idle_delay_ms != SERVO_ALWAYS_ON
+        let mut idle_off = settings.servo_idle_delay_ms != SERVO_ALWAYS_ON
             && still_since.is_some_and(|t| at - t >= Duration::from_millis(settings.servo_idle_delay_ms.into()));
+        if idle_off && on_since.is_some() {
+            // Going off for standing still: first no longer ready, then still standing still?
+            // The motion task queues its steps before it looks whether the servos are ready, so
+            // one of the two sees the other.
+            machine.set_servos_ready(false);
+            fence(Ordering::SeqCst);
+            idle_off = machine.stopped();
+        }
         let on = machine.servos_on() && !idle_off;
         on_since = if on { on_since.or(Some(at)) } else { None };
         let enable_delay = Duration::from_millis(settings.servo_enable_delay_ms.into());
@@ -94,7 +104,7 @@ pub async fn run<P: OutputPin>(
         let flowing = machine.queued_steps() > 0 || matches!(machine.run_state(), RunState::Run | RunState::Jog);
         let look = Look {
             emitted_steps: machine.emitted_totals().0,
-            expecting: flowing && machine.servos_ready() && !machine.halted(),
+            expecting: flowing && machine.servos_ready() && machine.pen_settled() && !machine.halted(),
             queued_ms: machine.queued_ticks() / (TICK_HZ / 1_000),
         };
         let healthy = progress.healthy(at.as_millis() as u32, look);

@@ -55,7 +55,7 @@ impl GcodeState {
             [b'J', b'=', body @ ..] => self.jog(body, settings, state),
             [b'0'..=b'9', ..] => self.set_setting(&c, settings, state),
             [which @ (b'E' | b'O' | b'S'), ..] => {
-                if matches!(state, RunState::Alarm | RunState::Jog) {
+                if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
                 let mut next = self.clone();
@@ -64,7 +64,7 @@ impl GcodeState {
                 Ok(commands)
             }
             [b'F', ..] => {
-                if matches!(state, RunState::Alarm | RunState::Jog) {
+                if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
                 let mut next = self.clone();

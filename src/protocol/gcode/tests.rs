@@ -370,10 +370,13 @@ fn dwell_motion_and_stop_of_one_line_come_out_in_order() {
 }
 
 #[test]
-fn alarm_and_jog_lock_out_gcode_but_not_system_commands() {
+fn alarm_jog_and_homing_lock_out_gcode_but_not_system_commands() {
     let mut g = GcodeState::new();
     refused_in(&mut g, "G0 X1", RunState::Alarm, 9);
     refused_in(&mut g, "G0 X1", RunState::Jog, 9);
+    refused_in(&mut g, "G0 X1", RunState::Home, 9);
+    refused_in(&mut g, "$O R5", RunState::Home, 9);
+    refused_in(&mut g, "$J=G91 X1 F100", RunState::Home, 8);
     refused_in(&mut g, "$O R5", RunState::Alarm, 9);
     refused_in(&mut g, "$F X0 U1 Y=x", RunState::Alarm, 9);
     refused_in(&mut g, "$J=G91 X1 F100", RunState::Alarm, 8);
