@@ -246,6 +246,8 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
     if let Some((_, last)) = distinct.last() {
         picture::write_frame_png(last, &out.join("lcd-final.png"))?;
     }
+    let session: Vec<(u64, sim::lcd::Frame)> = distinct.iter().map(|&f| f.clone()).collect();
+    picture::write_session_gif(&session, &out.join("session.gif"))?;
     let [xf, xb, yf, yb] = report.trace.counts();
     let mm = |axis: usize, steps: i32| steps as f32 / report.settings.steps_per_mm[axis];
     eprintln!();
@@ -265,5 +267,6 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
         if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
     );
     eprintln!("final LCD frame: {}", out.join("lcd-final.png").display());
+    eprintln!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
     Ok(())
 }

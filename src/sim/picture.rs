@@ -1,4 +1,5 @@
-//! Pictures the simulator writes: the pen path as SVG and LCD frames as PNG.
+//! Pictures the simulator writes: the pen path as SVG, LCD frames as PNG, and the whole
+//! session's LCD as an animated GIF.
 
 use std::io::{self, Write};
 use std::path::Path;
@@ -10,24 +11,56 @@ use crate::sim::lcd::Frame;
 /// Each LCD pixel becomes a square of this many image pixels.
 pub const LCD_PNG_SCALE: usize = 4;
 /// Border around the LCD picture, in LCD pixels.
-const LCD_PNG_BORDER: usize = 2;
+pub const LCD_PNG_BORDER: usize = 2;
 /// Pixel colours of a yellow-green STN panel, lit and unlit, RGB.
 const LCD_ON_RGB: [u8; 3] = [0x20, 0x30, 0x20];
 const LCD_OFF_RGB: [u8; 3] = [0x9a, 0xc8, 0x3c];
 
-/// Writes `frame` as a PNG, scaled up so a person can read it.
-pub fn write_frame_png(frame: &Frame, path: &Path) -> io::Result<()> {
+/// Shortest and longest time a frame of the session GIF is shown, centiseconds: viewers show
+/// shorter delays slower, and a long wait is shown shortened.
+pub const GIF_MIN_DELAY_CS: u64 = 2;
+pub const GIF_MAX_DELAY_CS: u64 = 300;
+
+/// `frame` scaled up with its border, one byte per image pixel: 1 lit, 0 not.
+fn scaled(frame: &Frame) -> (usize, usize, Vec<u8>) {
     let w = (frame.pixels[0].len() + 2 * LCD_PNG_BORDER) * LCD_PNG_SCALE;
     let h = (frame.pixels.len() + 2 * LCD_PNG_BORDER) * LCD_PNG_SCALE;
-    let mut rgb = Vec::with_capacity(w * h * 3);
+    let mut lit = Vec::with_capacity(w * h);
     for y in 0..h {
         for x in 0..w {
             let (fx, fy) =
                 ((x / LCD_PNG_SCALE).wrapping_sub(LCD_PNG_BORDER), (y / LCD_PNG_SCALE).wrapping_sub(LCD_PNG_BORDER));
-            let lit = frame.pixels.get(fy).and_then(|row| row.get(fx)).copied().unwrap_or(false);
-            rgb.extend_from_slice(if lit { &LCD_ON_RGB } else { &LCD_OFF_RGB });
+            lit.push(u8::from(frame.pixels.get(fy).and_then(|row| row.get(fx)).copied().unwrap_or(false)));
         }
     }
+    (w, h, lit)
+}
+
+/// Writes the LCD of a whole session as an animated GIF, scaled as the PNGs: each of `frames`
+/// (with the virtual time it was sent, µs) is shown until the next one came, within
+/// [`GIF_MIN_DELAY_CS`]..=[`GIF_MAX_DELAY_CS`]; the last for the longest.
+pub fn write_session_gif(frames: &[(u64, Frame)], path: &Path) -> io::Result<()> {
+    let Some((_, first)) = frames.first() else { return Ok(()) };
+    let (w, h, _) = scaled(first);
+    let file = io::BufWriter::new(std::fs::File::create(path)?);
+    let palette: Vec<u8> = [LCD_OFF_RGB, LCD_ON_RGB].concat();
+    let mut enc = gif::Encoder::new(file, w as u16, h as u16, &palette).map_err(io::Error::other)?;
+    enc.set_repeat(gif::Repeat::Infinite).map_err(io::Error::other)?;
+    for (i, (t_us, frame)) in frames.iter().enumerate() {
+        let shown_us = frames.get(i + 1).map_or(u64::MAX, |next| next.0 - t_us);
+        let delay_cs = (shown_us / 10_000).clamp(GIF_MIN_DELAY_CS, GIF_MAX_DELAY_CS);
+        let (_, _, lit) = scaled(frame);
+        let mut image = gif::Frame::from_indexed_pixels(w as u16, h as u16, lit, None);
+        image.delay = delay_cs as u16;
+        enc.write_frame(&image).map_err(io::Error::other)?;
+    }
+    Ok(())
+}
+
+/// Writes `frame` as a PNG, scaled up so a person can read it.
+pub fn write_frame_png(frame: &Frame, path: &Path) -> io::Result<()> {
+    let (w, h, lit) = scaled(frame);
+    let rgb: Vec<u8> = lit.iter().flat_map(|&on| if on != 0 { LCD_ON_RGB } else { LCD_OFF_RGB }).collect();
     let file = std::fs::File::create(path)?;
     let mut enc = png::Encoder::new(io::BufWriter::new(file), w as u32, h as u32);
     enc.set_color(png::ColorType::Rgb);
