@@ -195,6 +195,8 @@ impl Menu {
                 return MenuAction::JogStop;
             }
             if matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog | RunState::Home) {
+                // Said on screen until the next key, so an abort is never silent.
+                self.message = Some(UiError::Aborted);
                 return MenuAction::Control(Control::Abort);
             }
             self.screen = Screen::Modes;

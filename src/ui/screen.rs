@@ -305,6 +305,7 @@ impl fmt::Display for ErrorText {
             UiError::Busy => f.write_str("Busy: wait, or D abort"),
             UiError::Alarm => f.write_str("Alarm: motion locked"),
             UiError::HomingOff => f.write_str("Homing off: $22=1"),
+            UiError::Aborted => f.write_str("Aborted"),
         }
     }
 }

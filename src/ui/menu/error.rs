@@ -29,4 +29,6 @@ pub enum UiError {
     Alarm,
     /// Homing is switched off (`$22`).
     HomingOff,
+    /// `D` aborted the motion.
+    Aborted,
 }

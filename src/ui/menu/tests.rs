@@ -147,6 +147,7 @@ fn run_hold_resume_abort() {
     assert_eq!(type_keys(&mut m, "D", &run), [MenuAction::Control(Control::Abort)]);
     assert_eq!(type_keys(&mut m, "D", &hold), [MenuAction::Control(Control::Abort)]);
     assert_eq!(form(&m).entry().digits(), "1");
+    assert_eq!(m.message(), Some(UiError::Aborted), "an abort is said until the next key");
     // Idle again: D goes back to the mode list.
     assert_eq!(type_keys(&mut m, "D", &idle()), []);
     assert_eq!(*m.screen(), Screen::Modes);
