@@ -138,6 +138,9 @@ pub struct Form {
     field: usize,
     entries: [NumberEntry; FORM_MAX_FIELDS],
     preset: FunctionPreset,
+    /// The form started its drawing: it stays as typed (no empty form flashes up before the
+    /// drawing shows) until the next key starts a new one.
+    started: bool,
 }
 
 impl Form {
@@ -147,6 +150,7 @@ impl Form {
             field: 0,
             entries: [const { NumberEntry::new() }; FORM_MAX_FIELDS],
             preset: FunctionPreset::Parabola,
+            started: false,
         }
     }
 
@@ -181,6 +185,9 @@ impl Form {
         status: &Status,
         settings: &Settings,
     ) -> Result<MenuAction, UiError> {
+        if self.started {
+            *self = Form { preset: self.preset, ..Form::new(self.mode) };
+        }
         let Some(field) = self.field() else { return Ok(MenuAction::None) };
         let entry = &mut self.entries[self.field.min(FORM_MAX_FIELDS - 1)];
         match (field, key) {
@@ -220,7 +227,7 @@ impl Form {
             return Ok(MenuAction::None);
         }
         let action = self.build(status, settings)?;
-        *self = Form { preset: self.preset, ..Form::new(self.mode) };
+        self.started = true;
         Ok(action)
     }
 

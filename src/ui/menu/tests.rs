@@ -58,9 +58,13 @@ fn form(menu: &Menu) -> &Form {
 fn line_mode_starts_a_line_in_steps() {
     let mut m = Menu::new();
     assert_eq!(type_keys(&mut m, "2 10# 5#", &idle()), [line(1000, 500)]);
-    // The form is ready for the next line, empty.
+    // The form stays as typed until the drawing shows (no empty form flashes up before it)...
+    assert_eq!(form(&m).field_index(), 1);
+    assert_eq!(form(&m).entry().digits(), "5");
+    // ...and the next key starts the next line in an empty form.
+    assert_eq!(type_keys(&mut m, "3", &idle()), []);
     assert_eq!(form(&m).field_index(), 0);
-    assert!(form(&m).entry().is_empty());
+    assert_eq!(form(&m).entry().digits(), "3");
 }
 
 #[test]
