@@ -32,6 +32,7 @@ pub mod planner;
 pub mod protocol;
 pub mod pulse;
 pub mod settings;
+pub mod signals;
 pub mod status;
 pub mod store;
 pub mod tasks;

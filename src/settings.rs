@@ -137,6 +137,10 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 212, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
     // pen lift (0 none, 1 M3/M5, 2 also by itself: up for G0, down for drawing)
     SettingInfo { id: 213, min: 0.0, max: 2.0 },
+    // run LED, bool
+    SettingInfo { id: 214, min: 0.0, max: 1.0 },
+    // buzzer, bool
+    SettingInfo { id: 215, min: 0.0, max: 1.0 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -212,6 +216,10 @@ pub struct Settings {
     pub pen_settle_ms: u32,
     /// How the pen is lifted, see [`crate::pen::PenLift`] ($213).
     pub pen_lift: u8,
+    /// The run LED lights while a drawing runs ($214).
+    pub run_led: bool,
+    /// The buzzer beeps at the end of a drawing and on an alarm ($215).
+    pub buzzer: bool,
 }
 
 /// Equal when every setting has the same value: one comparison through the settings table
@@ -262,6 +270,8 @@ const DEFAULT_SETTINGS: Settings = Settings {
     pen_down_us: 2_000,
     pen_settle_ms: 200,
     pen_lift: 0,
+    run_led: true,
+    buzzer: true,
 };
 
 impl Settings {
@@ -317,6 +327,8 @@ impl Settings {
             211 => Field::Whole(&mut self.pen_down_us),
             212 => Field::Whole(&mut self.pen_settle_ms),
             213 => Field::Mask(&mut self.pen_lift),
+            214 => Field::Flag(&mut self.run_led),
+            215 => Field::Flag(&mut self.buzzer),
             _ => return None,
         })
     }

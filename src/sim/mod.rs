@@ -113,6 +113,9 @@ pub struct SimReport {
     pub underruns: u32,
     /// Every change of the servo-on output, with its virtual time.
     pub son: Vec<(u64, bool)>,
+    /// Every change of the run LED and of the buzzer, with its virtual time.
+    pub led: Vec<(u64, bool)>,
+    pub buzzer: Vec<(u64, bool)>,
     /// Every change of the pen servo's pulse, µs, with its virtual time.
     pub pen: Vec<(u64, u16)>,
     /// The longest the watchdog went unfed, µs: beyond `WATCHDOG_TIMEOUT_MS` the board would
@@ -189,6 +192,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let son = LevelPin::default();
     let watchdog = SimWatchdog::default();
     let pen = SimPen::default();
+    let (led, buzzer) = (LevelPin::default(), LevelPin::default());
     let kicks = Signal::<NoopRawMutex, ()>::new();
     let matrix = match config.keys_start {
         KeysStart::AtOnce => KeyMatrix::new(config.keys),
@@ -212,7 +216,14 @@ pub fn run(config: SimConfig) -> SimReport {
             tasks::lcd::run(&machine, lcd),
         ),
         join(
-            tasks::servo::run(&machine, son.clone(), || inputs.levels(), pen.clone(), || watchdog.feed()),
+            tasks::servo::run(
+                &machine,
+                son.clone(),
+                || inputs.levels(),
+                pen.clone(),
+                [led.clone(), buzzer.clone()],
+                || watchdog.feed(),
+            ),
             tasks::homing::run(&machine),
         ),
     );
@@ -296,6 +307,8 @@ pub fn run(config: SimConfig) -> SimReport {
         son: son.changes(),
         watchdog_unfed_us: watchdog.longest_unfed_us(end_us),
         pen: pen.changes(),
+        led: led.changes(),
+        buzzer: buzzer.changes(),
     }
 }
 

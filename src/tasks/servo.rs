@@ -10,6 +10,8 @@
 //! It drives the pen servo's PWM to where the machine wants the pen (when `$213` names a pen
 //! lift) and tells the machine once it has had its settle time (`$212`).
 //!
+//! It lights the run LED and sounds the buzzer as [`crate::signals`] says.
+//!
 //! It also feeds the board's independent watchdog, while the pulse engine and the motion task
 //! make progress (see [`crate::watchdog`]); once they do not, it stops, and the watchdog resets
 //! the board.
@@ -25,6 +27,7 @@ use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::{Machine, PenOrder};
 use crate::pen::{PEN_SERVO_PERIOD_US, PenLift, pulse_us};
 use crate::settings::SERVO_ALWAYS_ON;
+use crate::signals::Signals;
 use crate::status::RunState;
 use crate::watchdog::{Look, Progress};
 
@@ -34,15 +37,17 @@ pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 
 /// Keeps `son` (both drivers' SON, active high) on while the machine wants the servos on, trips
 /// the machine when a driver alarm or the e-stop read through `levels` stays active, drives
-/// `pen` (the pen servo's 50 Hz PWM), and calls `feed` (the watchdog's) while the machine makes
-/// progress.
+/// `pen` (the pen servo's 50 Hz PWM) and `lights` (the run LED and the buzzer, active high), and
+/// calls `feed` (the watchdog's) while the machine makes progress.
 pub async fn run<P: OutputPin>(
     machine: &Machine,
     mut son: P,
     mut levels: impl FnMut() -> InputLevels,
     mut pen: impl SetDutyCycle,
+    mut lights: [P; 2],
     mut feed: impl FnMut(),
 ) -> ! {
+    let mut signals = Signals::default();
     // The pen order and pulse the PWM has, and since when.
     let mut pen_applied: Option<(PenOrder, u32, Instant)> = None;
     let mut debounce = Debounce::default();
@@ -82,6 +87,13 @@ pub async fn run<P: OutputPin>(
         machine.set_servos_ready(on_since.is_some_and(|t| at - t >= enable_delay));
         if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
+        }
+        // The run LED and the buzzer.
+        let (led, buzzer) = signals.update(at.as_millis() as u32, machine.state(), &settings);
+        for (pin, on) in lights.iter_mut().zip([led, buzzer]) {
+            if pin.set_state(PinState::from(on)).is_err() {
+                warn!("run LED or buzzer output failed");
+            }
         }
         let order = machine.pen_order();
         if PenLift::of(&settings) == PenLift::None {
@@ -153,7 +165,9 @@ mod tests {
         crate::sim::clock::reset();
         let machine = Machine::new(Settings::default());
         let son = Cell::new(false);
-        let mut task = pin!(run(&machine, Pin(&son), || 0, crate::sim::pins::SimPen::default(), || {}));
+        let led = Cell::new(false);
+        let mut task =
+            pin!(run(&machine, Pin(&son), || 0, crate::sim::pins::SimPen::default(), [Pin(&led), Pin(&led)], || {}));
         let mut cx = Context::from_waker(Waker::noop());
         let mut step = || {
             let _ = task.as_mut().poll(&mut cx);

@@ -15,6 +15,7 @@
 //! | X / Y limit min     | PE4 / PE5 | inputs with pull-ups, switch to GND (normally open; `$5=1` normally closed) |
 //! | X / Y limit max     | PE6 / PE7 | as the min switches                        |
 //! | X / Y driver ALM    | PE8 / PE14 | inputs with pull-ups, from the drivers' ALM+ (ALM- to GND): open = alarm (`$207`) |
+//! | run LED / buzzer    | PD12 / PB0 | high lights / sounds (`$214`, `$215`)          |
 //! | pen servo (PWM)     | PC6  | TIM3 CH1, 50 Hz: the RC servo's signal (`$210`-`$213`) |
 //! | e-stop              | PE15 | input with pull-up, normally closed button to GND: open = stop (`$208`) |
 //! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
@@ -130,9 +131,10 @@ async fn servo(
     machine: &'static Machine,
     son: Output<'static>,
     pen: PenPwm,
+    lights: [Output<'static>; 2],
     mut dog: IndependentWatchdog<'static, IWDG>,
 ) -> ! {
-    tasks::servo::run(machine, son, inputs::read, pen, || dog.pet()).await
+    tasks::servo::run(machine, son, inputs::read, pen, lights, || dog.pet()).await
 }
 
 #[embassy_executor::task]
@@ -217,6 +219,8 @@ async fn main(spawner: Spawner) {
     let son = Output::new(p.PE13, Level::Low, Speed::Low);
     // The pen servo: TIM3's 50 Hz PWM, no pulse until the servo task drives it (`$213`).
     let pen = PenPwm::new(p.TIM3, PwmPin::new(p.PC6, OutputType::PushPull), APB1_TIMER_HZ);
+    // The run LED (the Discovery board's green LED) and the buzzer, off.
+    let lights = [Output::new(p.PD12, Level::Low, Speed::Low), Output::new(p.PB0, Level::Low, Speed::Low)];
 
     interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
     let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
@@ -238,7 +242,7 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD11, Pull::Up),
     ];
     spawner.spawn(unwrap!(keypad(machine, columns, rows)));
-    spawner.spawn(unwrap!(servo(machine, son, pen, dog)));
+    spawner.spawn(unwrap!(servo(machine, son, pen, lights, dog)));
     spawner.spawn(unwrap!(homing(machine)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
