@@ -35,7 +35,8 @@ use crate::status::RunState;
 /// again after this long instead of spinning; also the shortest wait for the queue to drain.
 pub const MOTION_RETRY_US: u64 = 100;
 
-/// How often the task looks whether the servos are ready before it starts the pulses.
+/// How often the task looks whether the servos and the pen are ready before it starts the
+/// pulses.
 pub const SERVO_READY_POLL_MS: u64 = 1;
 
 /// Steps computed before they are published to the pulse engine: the pulses wait at most this
