@@ -95,7 +95,7 @@ impl ArcInterp {
         // The nearest point of the circle lies on the end's own ray, as does the gate.
         let near = (e.0 * GATE_SCALE, e.1 * GATE_SCALE);
         // Ceiling of the radius, for the step budget.
-        let r = r2.unsigned_abs().isqrt() as i32 + 1;
+        let r = isqrt(r2.unsigned_abs()) as i32 + 1;
         let tracer = Tracer::new(narrow(s), narrow(e), near, (1, 1), r2, (r, r), rotation, method);
         Ok(ArcInterp { tracer })
     }
@@ -119,6 +119,19 @@ impl Interpolator for ArcInterp {
     fn fill(&mut self, out: &mut [Step]) -> Filled {
         self.tracer.fill(out)
     }
+}
+
+/// ⌊√n⌋, exactly as `u64::isqrt`, for `n` up to 2·[`MAX_RADIUS_STEPS`]² (a squared radius):
+/// the FPU's square root, then corrected by whole steps. `u64::isqrt` links 540 B of code.
+fn isqrt(n: u64) -> u64 {
+    let mut r = math::sqrt(n as f32) as u64;
+    while r * r > n {
+        r -= 1;
+    }
+    while (r + 1) * (r + 1) <= n {
+        r += 1;
+    }
+    r
 }
 
 /// `p − origin` in `i64` (cannot overflow).

@@ -410,3 +410,23 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn isqrt_matches_the_integer_square_root_over_every_squared_radius() {
+    let max = MAX_RADIUS_STEPS as u64;
+    let limit = 2 * max * max;
+    // Perfect squares and their neighbours, across the whole range, and the limit itself.
+    let mut r = 0u64;
+    while r * r <= limit {
+        for n in [r * r, (r * r).saturating_sub(1), r * r + 1, (r + 1) * (r + 1) - 1] {
+            if n <= limit {
+                assert_eq!(super::isqrt(n), n.isqrt(), "isqrt({n})");
+            }
+        }
+        r += 1 + r / 64;
+    }
+    assert_eq!(super::isqrt(limit), limit.isqrt());
+    for n in 0..10_000u64 {
+        assert_eq!(super::isqrt(n), n.isqrt(), "isqrt({n})");
+    }
+}
