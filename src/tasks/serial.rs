@@ -161,20 +161,25 @@ impl Host<'_> {
 
     /// Waits until nothing is queued or moving.
     fn machine_at_rest(&self) -> Until<'_> {
-        Until { machine: self.machine, done: Machine::is_idle, timer: None }
+        Until { machine: self.machine, done: Machine::is_idle, timer: None, then_pen: None }
     }
 
     /// Once nothing is queued or moving, sends the pen to `pen` and waits for it to settle.
-    async fn pen_to(&self, pen: Pen) {
-        self.machine_at_rest().await;
-        self.machine.set_pen(pen);
-        Until { machine: self.machine, done: Machine::pen_settled, timer: None }.await
+    fn pen_to(&self, pen: Pen) -> Until<'_> {
+        Until { then_pen: Some(pen), ..self.machine_at_rest() }
+    }
+
+    /// Waits `ms` milliseconds: an [`Until`] whose first look waits out the time, so every wait
+    /// of the line loop shares one future type.
+    fn dwell(&self, ms: u32) -> Until<'_> {
+        let timer = Some(Timer::after(Duration::from_millis(u64::from(ms))));
+        Until { machine: self.machine, done: |_| true, timer, then_pen: None }
     }
 
     /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
     /// runs: the position is final.
     fn machine_stopped(&self) -> Until<'_> {
-        Until { machine: self.machine, done: |m| m.stopped() && !m.homing(), timer: None }
+        Until { machine: self.machine, done: |m| m.stopped() && !m.homing(), timer: None, then_pen: None }
     }
 }
 
@@ -184,6 +189,8 @@ struct Until<'m> {
     machine: &'m Machine,
     done: fn(&Machine) -> bool,
     timer: Option<Timer>,
+    /// Once `done` holds: send the pen here, then wait until it has settled.
+    then_pen: Option<Pen>,
 }
 
 impl Future for Until<'_> {
@@ -199,7 +206,12 @@ impl Future for Until<'_> {
                 self.timer = None;
             }
             if (self.done)(self.machine) {
-                return core::task::Poll::Ready(());
+                let Some(pen) = self.then_pen.take() else {
+                    return core::task::Poll::Ready(());
+                };
+                self.machine.set_pen(pen);
+                self.done = Machine::pen_settled;
+                continue;
             }
             self.timer = Some(Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)));
         }
@@ -420,11 +432,8 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         match command {
             Command::Job(job) => self.queue(link, job).await?,
             Command::Dwell { ms } => {
-                unless_reset(link, async {
-                    host.machine_at_rest().await;
-                    Timer::after(Duration::from_millis(u64::from(ms))).await;
-                })
-                .await?
+                unless_reset(link, host.machine_at_rest()).await?;
+                unless_reset(link, host.dwell(ms)).await?;
             }
             Command::Pause => {
                 unless_reset(link, host.machine_at_rest()).await?;
