@@ -11,12 +11,7 @@ use crate::settings::Settings;
 impl GcodeState {
     /// `$E`, `$O`, `$S` with their words in `body` (compacted, after the command letter).
     pub(super) fn plotter_curve(&mut self, which: u8, body: &[u8], settings: &Settings) -> Result<Commands, GrblError> {
-        let mut words = Words::default();
-        for word in WordIter::new(body) {
-            let (letter, value) = word?;
-            words.insert(letter, value)?;
-        }
-        let feed = self.curve_feed(&mut words, settings)?;
+        let (mut words, feed) = self.curve_words(body, settings)?;
         let start_deg = words.take(b'S').unwrap_or(0.0);
         let command = match which {
             b'E' => {
@@ -52,15 +47,23 @@ impl GcodeState {
         Ok(command.map(Commands::one).unwrap_or_default())
     }
 
-    /// The F word of a curve command (mm/min, modal) or the current feed rate.
-    fn curve_feed(&mut self, words: &mut Words, settings: &Settings) -> Result<Feed, GrblError> {
+    /// The words of a curve command in `body` (compacted, after the command letter) but its F
+    /// word, and its feed: the F word (mm/min, modal) or the current feed rate. Out of line: one
+    /// copy for every curve command.
+    #[inline(never)]
+    fn curve_words(&mut self, body: &[u8], settings: &Settings) -> Result<(Words, Feed), GrblError> {
+        let mut words = Words::default();
+        for word in WordIter::new(body) {
+            let (letter, value) = word?;
+            words.insert(letter, value)?;
+        }
         if let Some(f) = words.take(b'F') {
             if f < 0.0 {
                 return Err(GrblError::NegativeValue);
             }
             self.feed_mm_per_min = Some(f);
         }
-        Ok(Feed::MmPerMin(self.checked_feed(settings)?))
+        Ok((words, Feed::MmPerMin(self.checked_feed(settings)?)))
     }
 
     /// `$E` / `$O`: the pen is at parametric angle `start_deg`; `sweep_deg` omitted is a full turn.
@@ -112,13 +115,8 @@ impl GcodeState {
             found.ok_or(if seen_y { GrblError::BadNumberFormat } else { GrblError::ValueWordMissing })?;
         let expr_text = rest.get(expr_at..).unwrap_or("").split(';').next().unwrap_or("");
         let head = compact(rest.get(..y_at).unwrap_or(""), true)?;
-        let mut words = Words::default();
         // `head` starts with the command letter F.
-        for word in WordIter::new(head.get(1..).unwrap_or(&[])) {
-            let (letter, value) = word?;
-            words.insert(letter, value)?;
-        }
-        let feed = self.curve_feed(&mut words, settings)?;
+        let (mut words, feed) = self.curve_words(head.get(1..).unwrap_or(&[]), settings)?;
         let x0_mm = words.take(b'X').ok_or(GrblError::ValueWordMissing)?;
         let x1_mm = words.take(b'U').ok_or(GrblError::ValueWordMissing)?;
         no_unused(&words)?;
