@@ -414,7 +414,7 @@ fn measure_curve(case: &CurveCase, method: Method) -> Result<CurveRow, String> {
     let interp_ns = ns_per_step(|| curve.clone(), |c| black_box(step_all(c)).0);
     let planned_ns = ns_per_step(|| curve.clone(), |c| black_box(plan_all(c, method, limits)).0);
     let seed_s = seed_seconds(&settings, walk.axis_steps);
-    let slow = Limits::from_settings(&Settings { max_pulse_rate_hz: SLOW_PULSE_RATE_HZ, ..settings.clone() });
+    let slow = Limits::from_settings(&Settings { max_pulse_rate_hz: SLOW_PULSE_RATE_HZ, ..settings });
     let fast_slow_pulses_s = plan_at(curve, FAST_FEED, method, slow).1 as f64 / f64::from(TICK_HZ);
     let plot_s = ticks as f64 / f64::from(TICK_HZ);
     Ok(CurveRow { walk, plot_s, interp_ns, planned_ns, seed_s, fast_slow_pulses_s })

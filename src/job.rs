@@ -87,7 +87,7 @@ impl Job {
     /// wherever the pen and the travel are (the position is unknown until homed). `None` when
     /// it goes nowhere, or beyond what any plotter reaches.
     pub fn homing_move(from: Point, to: Point, feed_mm_per_min: f32, settings: &Settings) -> Option<Job> {
-        let unchecked = Settings { soft_limits: false, ..settings.clone() };
+        let unchecked = Settings { soft_limits: false, ..*settings };
         let drawing = drawing::build(&Request::Straight { to }, from, &unchecked).ok()??;
         // Homing never draws: with a pen lift, the pen is up.
         let pen = (PenLift::of(settings) != PenLift::None).then_some(Pen::Up);

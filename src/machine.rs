@@ -663,7 +663,7 @@ impl Machine {
 
     /// A copy of the current settings.
     pub fn settings(&self) -> Settings {
-        self.settings.lock(|s| s.borrow().clone())
+        self.settings.lock(|s| *s.borrow())
     }
 
     /// Changes the settings through `f`; the planner picks them up for the next job.

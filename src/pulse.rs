@@ -506,7 +506,7 @@ mod tests {
         // last pulse is stretched to 15 µs, the steps after it keep their 10 µs.
         let fast = Settings { max_pulse_rate_hz: 100_000.0, ..Settings::default() };
         let cmds = [step(1, 0, 50), step(-1, 0, 10), step(-1, 0, 10), step(-1, 1, 10)];
-        assert_eq!(period_ticks(fast.clone(), &cmds)[..4], [50, 15, 10, 15]);
+        assert_eq!(period_ticks(fast, &cmds)[..4], [50, 15, 10, 15]);
         // At the default 20 kHz the 50 µs floor of `$205` covers the setup.
         assert_eq!(period_ticks(Settings::default(), &cmds)[..4], [50, 50, 50, 50]);
         // SIGN changes at the start of the period that ends with the reversed pulse.

@@ -145,7 +145,7 @@ pub const SETTING_INFO: &[SettingInfo] = &[
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
 /// optocouplers on a lab board.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub struct Settings {
     /// Width of the PULS pulse ($0).
     pub pulse_width_us: f32,
@@ -335,7 +335,7 @@ impl Settings {
 
     /// Sets setting `id` to `value`; out of range, unknown or not finite changes nothing.
     pub fn set(&mut self, id: u16, value: f32) -> Result<(), SettingError> {
-        let mut next = self.clone();
+        let mut next = *self;
         next.assign(id, value)?;
         next.check()?;
         *self = next;

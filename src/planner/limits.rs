@@ -97,7 +97,7 @@ impl Limits {
             return limits;
         }
         let defaults = Settings::default();
-        let mut fixed = s.clone();
+        let mut fixed = *s;
         for id in CHECKED_SETTINGS {
             let range = SETTING_INFO.iter().find(|info| info.id == id).map(|info| (info.min, info.max));
             let default = defaults.get(id).ok();

@@ -182,7 +182,7 @@ pub fn run(config: SimConfig) -> SimReport {
     clock::reset();
     let flash = config.flash.clone();
     let (store, loaded) = Store::open(config.flash, STORE_RANGE);
-    let machine = Machine::new(store.kept().settings.clone());
+    let machine = Machine::new(store.kept().settings);
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
     let (steps, step_consumer) = step_queue.split();

@@ -53,7 +53,7 @@ pub struct Record {
 impl Record {
     /// The values a power cycle keeps of these.
     pub fn of(settings: &Settings, offsets: &Offsets, startup: &StartupLines) -> Record {
-        Record { settings: settings.clone(), offsets_mm: offsets.kept_mm(), startup: startup.clone() }
+        Record { settings: *settings, offsets_mm: offsets.kept_mm(), startup: startup.clone() }
     }
 
     /// Writes the record into `out` (at least [`RECORD_MAX_BYTES`] long); returns its length.

@@ -204,7 +204,7 @@ async fn main(spawner: Spawner) {
     // What the last power cycle kept: the settings the machine starts with, and the offsets and
     // startup blocks the serial task starts with.
     let (store, loaded) = Store::open(Flash::new_blocking(p.FLASH), STORE_FLASH_RANGE);
-    let machine: &'static Machine = MACHINE.init(Machine::new(store.kept().settings.clone()));
+    let machine: &'static Machine = MACHINE.init(Machine::new(store.kept().settings));
 
     // Step/direction outputs, low (no pulse) until the pulse task drives them.
     // PULS on TIM1's PWM outputs (low until a period ends with a pulse), SIGN on GPIO.

@@ -89,7 +89,7 @@ impl GcodeState {
         let id = id_text.iter().fold(0u32, |n, d| n * 10 + (d - b'0') as u32);
         let id = u16::try_from(id).map_err(|_| GrblError::InvalidStatement)?;
         let value = parse_number(value_text)?;
-        let mut next = settings.clone();
+        let mut next = *settings;
         next.set(id, value).map_err(|e| match e {
             SettingError::OutOfRange if value < 0.0 => GrblError::NegativeValue,
             SettingError::Unknown | SettingError::OutOfRange => GrblError::InvalidStatement,
