@@ -275,7 +275,7 @@ pub enum Command {
 }
 
 /// GRBL's parser state; see the module documentation.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GcodeState {
     motion: MotionMode,
     units: Units,
@@ -422,7 +422,7 @@ impl GcodeState {
             return Err(GrblError::Locked);
         }
         let block = parse_block(&compact)?;
-        let mut next = self.clone();
+        let mut next = *self;
         let commands = next.run_block(block, settings)?;
         *self = next;
         Ok(commands)

@@ -27,7 +27,7 @@ impl StoredPosition {
 }
 
 /// The coordinate data; see the module documentation.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Offsets {
     /// G54 to G59.
     systems_mm: [[f32; 2]; WORK_SYSTEMS],
@@ -97,6 +97,6 @@ impl Offsets {
 
     /// What a soft reset keeps: all but the G92 offset.
     pub(super) fn after_reset(&self) -> Offsets {
-        Offsets { g92_mm: [0.0; 2], ..self.clone() }
+        Offsets { g92_mm: [0.0; 2], ..*self }
     }
 }

@@ -58,7 +58,7 @@ impl GcodeState {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                let mut next = self.clone();
+                let mut next = *self;
                 let commands = next.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings)?;
                 *self = next;
                 Ok(commands)
@@ -67,7 +67,7 @@ impl GcodeState {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                let mut next = self.clone();
+                let mut next = *self;
                 let commands = next.function(line, rest, settings)?;
                 *self = next;
                 Ok(commands)
@@ -122,7 +122,7 @@ impl GcodeState {
             if text.starts_with('$') {
                 return Err(GrblError::InvalidStatement);
             }
-            let mut trial = self.clone();
+            let mut trial = *self;
             if !trial.execute(text, settings, RunState::Idle)?.is_empty() {
                 return Err(GrblError::InvalidStatement);
             }

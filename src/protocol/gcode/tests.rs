@@ -32,7 +32,7 @@ fn ok_all(g: &mut GcodeState, lines: &[&str]) {
 
 /// Asserts that `line` is refused with GRBL error `code` and that nothing changed.
 fn refused_in(g: &mut GcodeState, line: &str, state: RunState, code: u8) {
-    let before = g.clone();
+    let before = *g;
     match run_in(g, line, state) {
         Err(e) => assert_eq!(e.code(), code, "{line:?} gave {e:?}"),
         Ok(c) => panic!("{line:?} accepted: {c:?}"),
@@ -602,7 +602,7 @@ fn a_sine_steeper_than_the_jump_limit_is_refused() {
     let mut g = GcodeState::new();
     assert!(g.execute("$S A100 W5.1 L10", &s, RunState::Idle).is_ok());
     s.max_jump_mm = 1.0;
-    let before = g.clone();
+    let before = g;
     assert_eq!(
         g.execute("$S A10 W11 L10", &s, RunState::Idle).map(|_| ()),
         Err(GrblError::Drawing(crate::drawing::DrawError::TooSteep))
@@ -672,7 +672,7 @@ fn function_command() {
 fn function_command_errors() {
     let mut g = GcodeState::new();
     // The `(` opened at column 15 is never closed.
-    let before = g.clone();
+    let before = g;
     let e = run(&mut g, "$F X0 U1 Y=sin(x").unwrap_err();
     assert_eq!(e, GrblError::Expression { column: 15, kind: crate::expr::ParseErrorKind::MismatchedParen });
     assert_eq!(e.code(), 2);
@@ -727,7 +727,7 @@ fn no_line_panics_and_a_refused_line_changes_nothing() {
         let text: std::string::String = picks.iter().map(|&i| alphabet[i]).collect();
         let mut g = GcodeState::new();
         g.sync_position(Point::new(start.0, start.1), &s);
-        let before = g.clone();
+        let before = g;
         match g.execute(&text, &s, RunState::Idle) {
             Err(_) => prop_assert_eq!(&g, &before),
             Ok(cmds) => {
@@ -768,7 +768,7 @@ fn random_gcode_blocks_keep_the_plan_consistent() {
         let mut g = GcodeState::new();
         for words in lines {
             let text = words.join(" ");
-            let before = g.clone();
+            let before = g;
             match g.execute(&text, &s, RunState::Idle) {
                 Err(_) => prop_assert_eq!(&g, &before, "{}", text),
                 Ok(cmds) => {

@@ -254,7 +254,7 @@ fn a_reset_keeps_the_systems_and_stored_positions_but_not_g92() {
     let mut g = GcodeState::new();
     ok_all(&mut g, &["G0 X10 Y5", "G10 L20 P1 X0 Y0", "G10 L2 P6 X3 Y3", "G28.1", "G0 X1", "G30.1"]);
     ok_all(&mut g, &["G92 X0 Y0", "G59", "G91"]);
-    let kept = g.offsets().clone();
+    let kept = *g.offsets();
     g.reset(Point::new(123, 456), &s);
     assert_eq!(g.planned_position(), Point::new(123, 456));
     assert_eq!((g.work_system(), g.distance()), (g54(), Distance::Absolute));
@@ -284,7 +284,7 @@ fn restoring_parameters_clears_every_offset() {
     }
     let mut g = GcodeState::new();
     ok_all(&mut g, &["G10 L2 P1 X1", "G28.1"]);
-    let before = g.offsets().clone();
+    let before = *g.offsets();
     g.execute("$RST=$", &s, RunState::Idle).unwrap();
     assert_eq!(g.offsets(), &before, "$RST=$ restores settings only");
 }
@@ -309,7 +309,7 @@ fn random_coordinate_blocks_keep_the_plan_consistent() {
         let mut g = GcodeState::new();
         for words in lines {
             let line = words.join(" ");
-            let before = g.clone();
+            let before = g;
             match g.execute(&line, &s, RunState::Idle) {
                 Err(_) => prop_assert_eq!(&g, &before, "{}", line),
                 Ok(cmds) => {
