@@ -124,7 +124,7 @@ impl Interpolator for ArcInterp {
 /// ⌊√n⌋, exactly as `u64::isqrt`, for `n` up to 2·[`MAX_RADIUS_STEPS`]² (a squared radius):
 /// the FPU's square root, then corrected by whole steps. `u64::isqrt` links 540 B of code.
 fn isqrt(n: u64) -> u64 {
-    let mut r = math::sqrt(n as f32) as u64;
+    let mut r = u64::from(math::sqrt(n as f32) as u32);
     while r * r > n {
         r -= 1;
     }
