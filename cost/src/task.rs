@@ -57,7 +57,7 @@ const MAX_POLLS: usize = 100_000;
 /// Runs `job` through the motion task from rest to rest; reports each poll's instructions with
 /// the steps it queued. Returns the steps emitted.
 pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
-    let machine = Machine::new(settings.clone());
+    let machine = Machine::new(*settings);
     // No servo task here: the drivers hold their axes from the start.
     machine.set_servos_ready(true);
     machine.set_pen_settled(machine.pen_order());
