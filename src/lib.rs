@@ -33,6 +33,7 @@ pub mod protocol;
 pub mod pulse;
 pub mod settings;
 pub mod signals;
+pub mod son;
 pub mod status;
 pub mod store;
 pub mod tasks;

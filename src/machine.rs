@@ -38,7 +38,7 @@ use crate::inputs::{InputLevels, Trip};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
 use crate::overrides::{OverrideCommand, Overrides};
-use crate::pen::Pen;
+use crate::pen::{Pen, PenOrder};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -74,18 +74,6 @@ pub enum Refused {
     Full,
     /// See [`Stale`].
     Stale,
-}
-
-/// One order to the pen: where, and which order it is. An order the servo task settled is
-/// told apart from a later one to the same place, so a pen sent away and back while the servo
-/// task looked elsewhere never counts as settled early.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PenOrder(u32);
-
-impl PenOrder {
-    pub fn pen(self) -> Pen {
-        if self.0 & 1 != 0 { Pen::Down } else { Pen::Up }
-    }
 }
 
 /// The run states as [`Machine`] stores them.
@@ -272,6 +260,17 @@ impl Machine {
     /// True while a homing cycle runs.
     pub fn homing(&self) -> bool {
         self.homing.load(Ordering::Acquire)
+    }
+
+    /// True when `trip` is what a homing approach looks for: a limit switch, while homing.
+    pub fn is_homing_switch(&self, trip: Trip) -> bool {
+        self.homing() && matches!(trip, Trip::Limit { .. })
+    }
+
+    /// True when nothing is queued, planned or moving and no homing cycle runs: the machine
+    /// stands still for good (a homing cycle pauses between its moves).
+    pub fn at_standstill(&self) -> bool {
+        self.stopped() && !self.homing()
     }
 
     /// The homing cycle ended: at rest, in an alarm if it failed. Only the homing task calls
@@ -556,9 +555,8 @@ impl Machine {
     /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
     /// wait for [`pen_settled`](Self::pen_settled) before anything moves.
     pub fn set_pen(&self, pen: Pen) {
-        let down = u32::from(pen == Pen::Down);
-        let sent = self.pen.fetch_update(Ordering::AcqRel, Ordering::Acquire, |order| {
-            (order & 1 != down).then(|| ((order >> 1).wrapping_add(1) << 1) | down)
+        let sent = self.pen.fetch_update(Ordering::AcqRel, Ordering::Acquire, |bits| {
+            PenOrder::from_bits(bits).then(pen).map(PenOrder::bits)
         });
         if sent.is_ok() {
             self.changed.signal(());
@@ -572,12 +570,12 @@ impl Machine {
 
     /// The pen's last order, for the servo task.
     pub fn pen_order(&self) -> PenOrder {
-        PenOrder(self.pen.load(Ordering::Acquire))
+        PenOrder::from_bits(self.pen.load(Ordering::Acquire))
     }
 
     /// The pen servo has settled as `order` says. Only the servo task calls this.
     pub fn set_pen_settled(&self, order: PenOrder) {
-        self.pen_settled.store(order.0, Ordering::Release);
+        self.pen_settled.store(order.bits(), Ordering::Release);
     }
 
     /// True once the pen is where it was last sent: no pulse may go out before.
@@ -594,7 +592,7 @@ impl Machine {
         }
         self.trip.lock(|t| t.set(Some(trip)));
         // A limit switch a homing approach looks for stops nothing it does not expect.
-        if !(self.homing() && matches!(trip, Trip::Limit { .. })) {
+        if !self.is_homing_switch(trip) {
             self.position_lost.store(true, Ordering::Relaxed);
         }
         self.control_requested.signal(());

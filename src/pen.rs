@@ -21,6 +21,61 @@ pub enum Pen {
     Down,
 }
 
+/// One order to the pen: where, and which order it is (bit 0 set for down, above it a count of
+/// the orders). An order the servo task settled is told apart from a later one to the same
+/// place, so a pen sent away and back while the servo task looked elsewhere never counts as
+/// settled early.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PenOrder(u32);
+
+impl PenOrder {
+    /// The order kept as `bits` (see [`bits`](Self::bits)).
+    pub const fn from_bits(bits: u32) -> PenOrder {
+        PenOrder(bits)
+    }
+
+    /// The order as kept in one word.
+    pub const fn bits(self) -> u32 {
+        self.0
+    }
+
+    pub fn pen(self) -> Pen {
+        if self.0 & 1 != 0 { Pen::Down } else { Pen::Up }
+    }
+
+    /// The order that sends the pen to `pen`; `None` when it is sent there already.
+    pub fn then(self, pen: Pen) -> Option<PenOrder> {
+        let down = u32::from(pen == Pen::Down);
+        (self.0 & 1 != down).then(|| PenOrder(((self.0 >> 1).wrapping_add(1) << 1) | down))
+    }
+}
+
+/// The pen servo as the servo task drives it: the pulse sent last, for which order, and since
+/// when.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PenServo {
+    sent: Option<(PenOrder, u32, u32)>,
+}
+
+impl PenServo {
+    /// At `now_ms` (a wrapping clock), with the machine's last `order`: the pulse to send now,
+    /// µs, if it changed, and whether the pen has settled where the order says. Without a pen
+    /// lift nothing is sent and the pen is where it is told at once.
+    pub fn update(&mut self, now_ms: u32, order: PenOrder, settings: &Settings) -> (Option<u32>, bool) {
+        if PenLift::of(settings) == PenLift::None {
+            return (None, true);
+        }
+        let pulse = pulse_us(settings, order.pen());
+        let mut send = None;
+        if self.sent.is_none_or(|(o, p, _)| (o, p) != (order, pulse)) {
+            self.sent = Some((order, pulse, now_ms));
+            send = Some(pulse);
+        }
+        let settled = self.sent.is_some_and(|(_, _, since)| now_ms.wrapping_sub(since) >= settings.pen_settle_ms);
+        (send, settled)
+    }
+}
+
 /// How the pen is lifted (`$213`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PenLift {
@@ -76,5 +131,23 @@ mod tests {
         assert_eq!(for_move(&mode(2), false, false), Some(Pen::Down), "auto: drawing moves draw");
         let s = Settings::default();
         assert_eq!((pulse_us(&s, Pen::Up), pulse_us(&s, Pen::Down)), (1_000, 2_000));
+    }
+
+    #[test]
+    fn an_order_counts_and_the_servo_settles_for_the_last_one() {
+        let first = PenOrder::from_bits(0);
+        assert_eq!(first.then(Pen::Up), None, "up already");
+        let down = first.then(Pen::Down).unwrap();
+        let up_again = down.then(Pen::Up).unwrap();
+        assert_ne!(up_again, first, "sent away and back: another order");
+        let s = Settings { pen_lift: 1, pen_settle_ms: 200, ..Settings::default() };
+        let mut servo = PenServo::default();
+        assert_eq!(servo.update(0, first, &s), (Some(1_000), false));
+        assert_eq!(servo.update(199, first, &s), (None, false));
+        assert_eq!(servo.update(200, first, &s), (None, true));
+        assert_eq!(servo.update(300, down, &s), (Some(2_000), false));
+        assert_eq!(servo.update(500, down, &s), (None, true));
+        let none = Settings::default();
+        assert_eq!(PenServo::default().update(0, down, &none), (None, true), "no pen lift");
     }
 }

@@ -7,6 +7,10 @@
 //! (steps queued, or the motion running, with the servos ready and nothing tripped), the pulses
 //! emitted must grow within [`WATCHDOG_STALL_MS`] more than the queued motion takes.
 
+use crate::geom::TICK_HZ;
+use crate::machine::Machine;
+use crate::status::RunState;
+
 /// The independent watchdog resets the board when it has not been fed for this long: longer
 /// than the flash store's sector erase (up to 2 s on the F407, at 3.3 V), during which the
 /// processor stalls and nothing feeds it.
@@ -24,6 +28,19 @@ pub struct Look {
     pub expecting: bool,
     /// The motion queued and not yet emitted, ms.
     pub queued_ms: u32,
+}
+
+impl Look {
+    /// What `machine` shows now: steps should flow while steps are queued or a drawing or jog
+    /// runs, the servos ready, the pen settled and nothing tripped.
+    pub fn of(machine: &Machine) -> Look {
+        let flowing = machine.queued_steps() > 0 || matches!(machine.run_state(), RunState::Run | RunState::Jog);
+        Look {
+            emitted_steps: machine.emitted_totals().0,
+            expecting: flowing && machine.servos_ready() && machine.pen_settled() && !machine.halted(),
+            queued_ms: machine.queued_ticks() / (TICK_HZ / 1_000),
+        }
+    }
 }
 
 /// The progress seen so far.

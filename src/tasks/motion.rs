@@ -236,7 +236,7 @@ async fn halted(
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
-    if machine.homing() && matches!(trip, Trip::Limit { .. }) {
+    if machine.is_homing_switch(trip) {
         info!("homing found {:?}", trip);
         machine.found_switch(trip);
         return;

@@ -179,7 +179,7 @@ impl Host<'_> {
     /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
     /// runs: the position is final.
     fn machine_stopped(&self) -> Until<'_> {
-        Until { machine: self.machine, done: |m| m.stopped() && !m.homing(), timer: None, then_pen: None }
+        Until { machine: self.machine, done: Machine::at_standstill, timer: None, then_pen: None }
     }
 }
 

@@ -22,13 +22,11 @@ use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 use embedded_hal::pwm::SetDutyCycle;
 
-use crate::geom::TICK_HZ;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
-use crate::machine::{Machine, PenOrder};
-use crate::pen::{PEN_SERVO_PERIOD_US, PenLift, pulse_us};
-use crate::settings::SERVO_ALWAYS_ON;
+use crate::machine::Machine;
+use crate::pen::{PEN_SERVO_PERIOD_US, PenServo};
 use crate::signals::Signals;
-use crate::status::RunState;
+use crate::son::ServoEnable;
 use crate::watchdog::{Look, Progress};
 
 /// How often the task reads the inputs and sets SON: well within a person's reach of the axes
@@ -48,14 +46,11 @@ pub async fn run<P: OutputPin>(
     mut feed: impl FnMut(),
 ) -> ! {
     let mut signals = Signals::default();
-    // The pen order and pulse the PWM has, and since when.
-    let mut pen_applied: Option<(PenOrder, u32, Instant)> = None;
+    let mut pen_servo = PenServo::default();
+    let mut enable = ServoEnable::default();
     let mut debounce = Debounce::default();
     let mut progress = Progress::default();
     let mut stalled = false;
-    // Since when the machine stands still, and since when SON is high.
-    let mut still_since: Option<Instant> = None;
-    let mut on_since: Option<Instant> = None;
     loop {
         let now = levels();
         machine.set_input_levels(now);
@@ -68,12 +63,10 @@ pub async fn run<P: OutputPin>(
             machine.trip(trip);
             debounce.clear();
         }
-        let at = Instant::now();
-        let still = machine.stopped() && !machine.homing();
-        still_since = if still { still_since.or(Some(at)) } else { None };
-        let mut idle_off = settings.servo_idle_delay_ms != SERVO_ALWAYS_ON
-            && still_since.is_some_and(|t| at - t >= Duration::from_millis(settings.servo_idle_delay_ms.into()));
-        if idle_off && on_since.is_some() {
+        // The clock of the timings below, wrapping as it allows.
+        let ms = Instant::now().as_millis() as u32;
+        let mut idle_off = enable.idle_off(ms, machine.at_standstill(), &settings);
+        if idle_off && enable.is_on() {
             // Going off for standing still: first no longer ready, then still standing still?
             // The motion task queues its steps before it looks whether the servos are ready, so
             // one of the two sees the other.
@@ -82,44 +75,29 @@ pub async fn run<P: OutputPin>(
             idle_off = machine.stopped();
         }
         let on = machine.servos_on() && !idle_off;
-        on_since = if on { on_since.or(Some(at)) } else { None };
-        let enable_delay = Duration::from_millis(settings.servo_enable_delay_ms.into());
-        machine.set_servos_ready(on_since.is_some_and(|t| at - t >= enable_delay));
+        machine.set_servos_ready(enable.ready(ms, on, &settings));
         if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
         }
         // The run LED and the buzzer.
-        let (led, buzzer) = signals.update(at.as_millis() as u32, machine.state(), &settings);
+        let (led, buzzer) = signals.update(ms, machine.state(), &settings);
         for (pin, on) in lights.iter_mut().zip([led, buzzer]) {
             if pin.set_state(PinState::from(on)).is_err() {
                 warn!("run LED or buzzer output failed");
             }
         }
         let order = machine.pen_order();
-        if PenLift::of(&settings) == PenLift::None {
-            // No pen servo: the pen is where it is told at once.
-            machine.set_pen_settled(order);
-        } else {
-            let pulse = pulse_us(&settings, order.pen());
-            if pen_applied.is_none_or(|(o, p, _)| (o, p) != (order, pulse)) {
-                // Both fit 16 bits: the pulse is at most PEN_PULSE_MAX_US.
-                if pen.set_duty_cycle_fraction(pulse as u16, PEN_SERVO_PERIOD_US as u16).is_err() {
-                    warn!("pen servo output failed");
-                }
-                pen_applied = Some((order, pulse, at));
-            }
-            let settle = Duration::from_millis(settings.pen_settle_ms.into());
-            if pen_applied.is_some_and(|(_, _, since)| at - since >= settle) {
-                machine.set_pen_settled(order);
-            }
+        let (send, settled) = pen_servo.update(ms, order, &settings);
+        // Both fit 16 bits: the pulse is at most PEN_PULSE_MAX_US.
+        if let Some(pulse) = send
+            && pen.set_duty_cycle_fraction(pulse as u16, PEN_SERVO_PERIOD_US as u16).is_err()
+        {
+            warn!("pen servo output failed");
         }
-        let flowing = machine.queued_steps() > 0 || matches!(machine.run_state(), RunState::Run | RunState::Jog);
-        let look = Look {
-            emitted_steps: machine.emitted_totals().0,
-            expecting: flowing && machine.servos_ready() && machine.pen_settled() && !machine.halted(),
-            queued_ms: machine.queued_ticks() / (TICK_HZ / 1_000),
-        };
-        let healthy = progress.healthy(at.as_millis() as u32, look);
+        if settled {
+            machine.set_pen_settled(order);
+        }
+        let healthy = progress.healthy(ms, Look::of(machine));
         if healthy {
             feed();
         } else if !stalled {
