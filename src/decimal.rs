@@ -309,6 +309,16 @@ impl From<usize> for Int {
     }
 }
 
+/// A value for format strings with up to three decimals, trailing zeros left off: `2.5`, `20`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Num(pub f32);
+
+impl core::fmt::Display for Num {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write_trimmed(f, self.0, 0, 3)
+    }
+}
+
 /// Writes `value` with at most `max_decimals` decimals, leaving off trailing zeros down to
 /// `min_decimals` (`2.5` with 0 to 6 is `2.5`, `20000` is `20000`, with 3 to 6 `20000.000`).
 pub fn write_trimmed(

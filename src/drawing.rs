@@ -205,11 +205,13 @@ pub struct Bounds {
 }
 
 impl Bounds {
-    fn at(p: Point) -> Bounds {
+    /// The box of the one point `p`.
+    pub fn at(p: Point) -> Bounds {
         Bounds { min: p, max: p }
     }
 
-    fn add(&mut self, p: Point) {
+    /// Grows the box to take `p`.
+    pub fn add(&mut self, p: Point) {
         self.min = Point::new(self.min.x.min(p.x), self.min.y.min(p.y));
         self.max = Point::new(self.max.x.max(p.x), self.max.y.max(p.y));
     }
@@ -264,6 +266,31 @@ impl Drawing {
     /// Steps the interpolator hands out from start to end.
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// Walks the lattice path again (`settings` as it was built with) and hands `at` its start,
+    /// every `every`-th point and its end.
+    pub fn sample_path(&self, settings: &Settings, every: u64, at: &mut dyn FnMut(Point)) {
+        let Ok(mut copy) = Curve::new(&self.shape, self.start, settings) else { return };
+        let (mut p, mut n) = (self.start, 0u64);
+        at(p);
+        let mut buf = [Step::new(0, 0); TRACE_BATCH_STEPS];
+        loop {
+            let Filled { steps, end, .. } = copy.fill(&mut buf);
+            for step in &buf[..steps] {
+                p = p.stepped(*step);
+                n += 1;
+                if n % every == 0 && n != self.steps {
+                    at(p);
+                }
+            }
+            if end.is_some() {
+                break;
+            }
+        }
+        if n > 0 {
+            at(p);
+        }
     }
 }
 

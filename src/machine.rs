@@ -656,6 +656,8 @@ impl Machine {
             door: self.door.load(Ordering::Relaxed),
             underruns: self.underruns(),
             overrides: self.overrides(),
+            emitted_steps: self.emitted_steps.load(Ordering::Acquire),
+            work_left: !self.stopped(),
         }
     }
 
@@ -693,6 +695,13 @@ impl Machine {
     pub fn set_menu(&self, menu: Menu) {
         self.menu.lock(|m| *m.borrow_mut() = menu);
         self.changed.signal(());
+    }
+
+    /// Changes the menu in place through `f`, inside the lock; tells displays if `f` says so.
+    pub fn update_menu(&self, f: impl FnOnce(&mut Menu) -> bool) {
+        if self.menu.lock(|m| f(&mut m.borrow_mut())) {
+            self.changed.signal(());
+        }
     }
 
     /// The epoch positions are planned in now: until the next abort, a job planned from the

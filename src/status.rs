@@ -71,4 +71,8 @@ pub struct Status {
     pub underruns: u32,
     /// The feed, rapid and spindle overrides in force.
     pub overrides: Overrides,
+    /// Steps emitted since power-on (wrapping): how far the motion has come.
+    pub emitted_steps: u32,
+    /// Something is queued, planned or moving, held or not.
+    pub work_left: bool,
 }

@@ -99,7 +99,7 @@ fn program_end_raises_the_pen() {
 #[test]
 fn a_keypad_drawing_lowers_the_pen_first_and_raises_it_at_the_end() {
     let setup = run("$213=2\n");
-    let keys = KeyScript::parse("2 1 0 # 5 #").unwrap();
+    let keys = KeyScript::parse("2 1 0 # 5 # #").unwrap();
     let report = sim::run(SimConfig { flash: setup.flash, keys, ..SimConfig::default() });
     assert!(!report.timed_out);
     let widths: Vec<u16> = report.pen.iter().map(|c| c.1).collect();

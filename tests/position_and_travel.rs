@@ -407,7 +407,8 @@ fn typed(value: &str) -> String {
     keys.join(" ")
 }
 
-/// The keys of a form: its mode digit, then every field typed and confirmed with `#`.
+/// The keys of a form: its mode digit, then every field typed and confirmed with `#`, and `#`
+/// to draw what the preview shows.
 fn form_keys(mode: u8, fields: &[&str]) -> String {
     let mut keys = mode.to_string();
     for field in fields {
@@ -418,6 +419,7 @@ fn form_keys(mode: u8, fields: &[&str]) -> String {
         }
         keys.push_str(" #");
     }
+    keys.push_str(" #");
     keys
 }
 
@@ -456,8 +458,9 @@ fn from_start(start: (&str, &str), name: String, keys: String, gcode: String) ->
     let (x, y) = start;
     SameDrawing {
         name: format!("{name} from ({x}, {y})"),
-        // A line from the pen, given time to finish, then D back to the mode list.
-        keys: format!("{} wait:3000 D {keys}", form_keys(2, &[x, y])),
+        // A line from the pen, given time to finish; a key puts the end screen away, D goes back
+        // to the mode list.
+        keys: format!("{} wait:3000 # D {keys}", form_keys(2, &[x, y])),
         gcode: format!("G1 X{x} Y{y} F3000\n{gcode}"),
     }
 }
@@ -542,7 +545,7 @@ fn drawings() -> Vec<SameDrawing> {
         all.push(from_start(
             starts[k % starts.len()],
             format!("function {expr} x {x0}..{x1}"),
-            format!("6 {} # {} # {} #", k + 1, typed(x0), typed(x1)),
+            format!("6 {} # {} # {} # #", k + 1, typed(x0), typed(x1)),
             format!("$F X{x0} U{x1} F3000 Y={expr}\n"),
         ));
     }
@@ -552,7 +555,7 @@ fn drawings() -> Vec<SameDrawing> {
         all.push(from_start(
             starts[(k + 1) % starts.len()],
             format!("function {expr} x {x0}..{x1}"),
-            format!("6 {p} # {} # {} #", typed(x0), typed(x1)),
+            format!("6 {p} # {} # {} # #", typed(x0), typed(x1)),
             format!("$F X{x0} U{x1} F3000 Y={expr}\n"),
         ));
     }

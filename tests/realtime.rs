@@ -140,8 +140,8 @@ fn a_jog_cancel_makes_the_next_jog_start_from_where_the_pen_stopped() {
 
 #[test]
 fn a_jog_cancel_does_not_stop_a_keypad_drawing_after_a_host_jog() {
-    let reference = run_timed("$J=G91 X10 F3000\n", &[], Some("wait:1000 3 8 # # #"));
-    let report = run_timed("$J=G91 X10 F3000\n", &[(2_157_000, 0x85)], Some("wait:1000 3 8 # # #"));
+    let reference = run_timed("$J=G91 X10 F3000\n", &[], Some("wait:1000 3 8 # # # #"));
+    let report = run_timed("$J=G91 X10 F3000\n", &[(2_317_000, 0x85)], Some("wait:1000 3 8 # # # #"));
     assert_eq!(report.path(), reference.path(), "the circle was drawn whole");
 }
 

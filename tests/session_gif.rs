@@ -6,7 +6,7 @@ use servoplot::sim::picture::{GIF_MAX_DELAY_CS, GIF_MIN_DELAY_CS, LCD_PNG_BORDER
 
 #[test]
 fn the_session_gif_shows_every_frame_in_order_for_its_time() {
-    let report = sim::run_keys("2 1 0 # 5 #").unwrap();
+    let report = sim::run_keys("2 1 0 # 5 # #").unwrap();
     let frames = report.frames.clone();
     assert!(frames.len() > 3);
     let path = std::env::temp_dir().join(format!("servoplot-session-{}.gif", std::process::id()));

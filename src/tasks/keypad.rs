@@ -31,6 +31,9 @@ pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 
             machine.set_menu(menu);
             act(machine, action);
         }
+        // The run screen follows the machine between keys.
+        let status = machine.status();
+        machine.update_menu(|menu| menu.observe(&status, now_ms));
     }
 }
 

@@ -1,11 +1,14 @@
 //! The LCD task: redraws the 122x32 screen when what it shows changes, at most every
-//! `LCD_FRAME_MIN_MS`, at the lowest priority.
+//! `LCD_FRAME_MIN_MS`, at the lowest priority, and keeps the path drawn for the preview.
 //!
 //! Every frame is drawn whole from the menu and machine state (no stale digits), into the
 //! driver's buffer, and only the visible region is sent to the controller (~14 ms at 600 kHz).
+//! While a run is under way the task reads the pen's position every `PREVIEW_SAMPLE_MS` into
+//! the run's [`Trail`]: the path of the steps emitted, read from the position the pulse engine
+//! counts, which costs the motion and the pulses nothing.
 
 use embassy_futures::select::select;
-use embassy_time::{Duration, Timer};
+use embassy_time::{Duration, Instant, Timer};
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_hal::delay::DelayNs;
@@ -13,13 +16,18 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::SpiDevice;
 
 use crate::machine::Machine;
+use crate::pen::{Pen, PenLift};
 use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
-use crate::ui::screen;
+use crate::ui::screen::{self, Live};
+use crate::ui::trail::Trail;
 
 /// Shortest time between two frames (10 Hz at most).
 pub const LCD_FRAME_MIN_MS: u64 = 100;
 /// While the pen moves, the position is redrawn this often even without other changes.
 pub const LCD_POLL_MS: u64 = 200;
+/// While a run is under way, the pen's position is read into the path this often: at 3000
+/// mm/min, a point every millimetre.
+pub const PREVIEW_SAMPLE_MS: u64 = 20;
 
 /// A display the LCD task can draw on and show.
 pub trait Lcd: DrawTarget<Color = BinaryColor> {
@@ -81,16 +89,47 @@ impl<SPI: SpiDevice, RST: OutputPin, D: DelayNs> Lcd for St7920Lcd<SPI, RST, D> 
 pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
     lcd.init();
     let mut shown = None;
+    let mut last_frame_ms = 0u32;
+    // The path of the run that started at `run_started_ms`.
+    let mut drawn = Trail::new();
+    let mut run_started_ms = None;
     loop {
+        let now_ms = Instant::now().as_millis() as u32;
         let status = machine.status();
         let settings = machine.settings();
-        let view = screen::view(&machine.menu(), &status, &settings);
-        if shown.as_ref() != Some(&view) {
-            let _ = screen::render(&view, &mut lcd);
-            lcd.show();
-            shown = Some(view);
-            Timer::after(Duration::from_millis(LCD_FRAME_MIN_MS)).await;
+        let menu = machine.menu();
+        let run = menu.run();
+        if run.map(|r| r.started_ms) != run_started_ms {
+            run_started_ms = run.map(|r| r.started_ms);
+            drawn.clear();
         }
-        select(machine.changed(), Timer::after(Duration::from_millis(LCD_POLL_MS))).await;
+        // Sampled from the run's start, once more at its end.
+        if run.is_some_and(|r| r.started_ms.is_some()) {
+            // With a pen lift, the way travelled with the pen up is not drawn.
+            let pen_down = PenLift::of(&settings) == PenLift::None || machine.pen() == Pen::Down;
+            drawn.sample(status.position, pen_down);
+        }
+        let live = Live {
+            now_ms,
+            speed_mm_per_min: machine.speed_mm_per_min(&settings),
+            work_offset_mm: machine.work_offset_mm(),
+            drawn: Some(&drawn),
+        };
+        let view = screen::view(&menu, &status, &settings, &live);
+        let since_frame_ms = now_ms.wrapping_sub(last_frame_ms);
+        let running = run.is_some_and(|r| r.ended_ms.is_none());
+        let mut wait_ms = if running { PREVIEW_SAMPLE_MS } else { LCD_POLL_MS };
+        if shown.as_ref() != Some(&view) {
+            if u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none() {
+                let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn), &mut lcd);
+                lcd.show();
+                shown = Some(view);
+                last_frame_ms = now_ms;
+            } else {
+                // Shown once the frame time has passed.
+                wait_ms = wait_ms.min(LCD_FRAME_MIN_MS - u64::from(since_frame_ms));
+            }
+        }
+        select(machine.changed(), Timer::after(Duration::from_millis(wait_ms))).await;
     }
 }

@@ -116,6 +116,8 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
         }
         while !planner.is_full() {
             let Some(job) = held.take().or_else(|| machine.next_job()) else { break };
+            // Planned from now on, moving or not yet (the pen or the servos may make it wait).
+            machine.set_plan_empty(false);
             if let Some(pen) = job.pen
                 && pen != machine.pen()
             {

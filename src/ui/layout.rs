@@ -22,3 +22,7 @@ pub const SCREEN_COLUMNS: usize = ((SCREEN_WIDTH_PX - SCREEN_MARGIN_PX) / SCREEN
 pub const SETTINGS_VIEW_LINES: usize = 7;
 /// Settings lines visible at once (under the title).
 pub const SETTINGS_VISIBLE_LINES: usize = SCREEN_LINES - 1;
+/// Width of the preview beside the run screen's numbers, at the right edge.
+pub const PREVIEW_BESIDE_WIDTH_PX: u32 = 28;
+/// Width of the preview of a drawing before it starts, at the right edge.
+pub const PREVIEW_CONFIRM_WIDTH_PX: u32 = 56;

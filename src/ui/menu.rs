@@ -14,7 +14,12 @@
 //! - Number fields: digits; `*` decimal point; `A` sign; `B` deletes the last character (held,
 //!   it repeats but stays in the field; pressed on an empty field it goes back to the previous
 //!   field); `C` clears the field; `#` checks the value and moves on, and on the last field
-//!   starts the job. A value that is refused shows why and stays for correction.
+//!   builds the drawing and shows its preview. A value that is refused shows why and stays for
+//!   correction.
+//! - Preview: the whole planned path; `#` starts the drawing, `D` goes back to the form.
+//! - While drawing: `#` steps through the run screen's pages ([`RunPage`]). Once the machine
+//!   comes to rest, the run screen stays, with the plot time, until a key is pressed; that key
+//!   does nothing else.
 //! - Jog: hold `1`-`4`, `6`-`9` to move (see [`JOG_KEYS`]); releasing the key stops.
 //! - Home (`8`): runs the homing cycle at once when homing is on (`$22`); `D` aborts it.
 //!
@@ -32,6 +37,7 @@ use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::ui::layout::{SETTINGS_VIEW_LINES, SETTINGS_VISIBLE_LINES};
+use crate::ui::run::{Plan, Run, RunPage};
 
 mod action;
 mod error;
@@ -80,14 +86,19 @@ pub struct ActiveJog {
     pub step: Step,
 }
 
-/// The form of a drawing mode: which field is being typed and what was typed so far.
 /// What the menu shows.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub enum Screen {
     /// The mode list.
     Modes,
     Jog,
     Form(Form),
+    /// A drawing built from the form, shown before it starts.
+    Preview {
+        form: Form,
+        plan: Plan,
+    },
     /// Read-only list of the main settings, scrolled to `first_line`.
     Settings {
         first_line: usize,
@@ -102,6 +113,9 @@ pub struct Menu {
     selected: Mode,
     message: Option<UiError>,
     jog: Option<ActiveJog>,
+    /// The run in progress or just ended, if any.
+    run: Option<Run>,
+    run_page: RunPage,
 }
 
 impl Default for Menu {
@@ -113,7 +127,14 @@ impl Default for Menu {
 impl Menu {
     /// The mode list, cursor on the first mode.
     pub const fn new() -> Self {
-        Menu { screen: Screen::Modes, selected: Mode::Jog, message: None, jog: None }
+        Menu {
+            screen: Screen::Modes,
+            selected: Mode::Jog,
+            message: None,
+            jog: None,
+            run: None,
+            run_page: RunPage::Numbers,
+        }
     }
 
     pub fn screen(&self) -> &Screen {
@@ -135,15 +156,67 @@ impl Menu {
         self.jog
     }
 
+    /// The run in progress, or the one just ended until a key is pressed.
+    pub fn run(&self) -> Option<&Run> {
+        self.run.as_ref()
+    }
+
+    /// The plan shown: the preview's, or the run's (a keypad drawing).
+    pub fn plan(&self) -> Option<&Plan> {
+        match (&self.run, &self.screen) {
+            (Some(run), _) => run.plan.as_ref(),
+            (None, Screen::Preview { plan, .. }) => Some(plan),
+            (None, _) => None,
+        }
+    }
+
+    /// The run screen's page.
+    pub fn run_page(&self) -> RunPage {
+        self.run_page
+    }
+
     /// Shows why the job just confirmed could not start (the job queue was full, the curve
     /// could not be built).
     pub fn refuse(&mut self, why: UiError) {
         self.message = Some(why);
+        self.run = None;
     }
 
-    /// True while the machine's motion takes the keypad: only `C` and `D` act. A jog counts
+    /// Follows the machine between keys: a run starts when the machine draws (a keypad drawing's
+    /// at once when confirmed) and ends when it stops, at `now_ms`. Returns true when the run
+    /// changed.
+    pub fn observe(&mut self, status: &Status, now_ms: u32) -> bool {
+        let drawing = matches!(status.state, RunState::Run | RunState::Hold);
+        match &mut self.run {
+            Some(run) if run.ended_ms.is_none() => {
+                if run.started_ms.is_none() {
+                    run.started_ms = Some(now_ms);
+                } else if !status.work_left && !drawing {
+                    run.ended_ms = Some(now_ms);
+                } else {
+                    return false;
+                }
+            }
+            _ if drawing => {
+                self.run = Some(Run { plan: None, started_ms: Some(now_ms), ended_ms: None });
+                self.run_page = RunPage::Numbers;
+            }
+            _ => return false,
+        }
+        true
+    }
+
+    /// True while a run is under way (a keypad drawing confirmed counts from then on).
+    fn running(&self) -> bool {
+        self.run.as_ref().is_some_and(|r| r.ended_ms.is_none())
+    }
+
+    /// True while the machine's motion takes the keypad: only `C`, `D` and `#` act. A jog counts
     /// only outside the jog screen (inside it, the jog keys steer it).
     pub fn is_busy(&self, status: &Status) -> bool {
+        if self.running() {
+            return true;
+        }
         match status.state {
             RunState::Run | RunState::Hold | RunState::Check | RunState::Sleep | RunState::Home => true,
             RunState::Jog => self.screen != Screen::Jog,
@@ -184,27 +257,41 @@ impl Menu {
                 Some(Field::Number(_)) => key == Key::B,
                 None => false,
             },
-            Screen::Jog => false,
+            Screen::Jog | Screen::Preview { .. } => false,
         }
     }
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
         self.message = None;
+        if self.run.as_ref().is_some_and(|r| r.ended_ms.is_some()) {
+            // The end screen: the key only puts it away.
+            self.run = None;
+            return MenuAction::None;
+        }
         if key == Key::D {
             if self.jog.take().is_some() {
                 return MenuAction::JogStop;
             }
-            if matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog | RunState::Home) {
+            if self.running() || matches!(status.state, RunState::Run | RunState::Hold | RunState::Jog | RunState::Home)
+            {
                 // Said on screen until the next key, so an abort is never silent.
                 self.message = Some(UiError::Aborted);
                 return MenuAction::Control(Control::Abort);
             }
-            self.screen = Screen::Modes;
+            self.screen = match &self.screen {
+                // Back from the preview to the form, as typed.
+                Screen::Preview { form, .. } => Screen::Form(form.clone()),
+                _ => Screen::Modes,
+            };
             return MenuAction::None;
         }
         match (key, status.state) {
             (Key::C, RunState::Run) => return MenuAction::Control(Control::Hold),
             (Key::C, RunState::Hold) => return MenuAction::Control(Control::Resume),
+            (Key::Hash, _) if self.running() => {
+                self.run_page = self.run_page.next();
+                return MenuAction::None;
+            }
             _ if self.is_busy(status) => return MenuAction::None,
             _ => {}
         }
@@ -227,7 +314,27 @@ impl Menu {
                 }
                 None => Ok(MenuAction::None),
             },
-            Screen::Form(form) => form.press(key, repeated, status, settings),
+            Screen::Form(form) => match form.press(key, repeated, status, settings) {
+                Ok(Some(plan)) => {
+                    self.screen = Screen::Preview { form: form.clone(), plan };
+                    Ok(MenuAction::None)
+                }
+                Ok(None) => Ok(MenuAction::None),
+                Err(e) => Err(e),
+            },
+            Screen::Preview { form, plan } => match key {
+                Key::Hash => {
+                    let start = form.start(status, settings);
+                    if start.is_ok() {
+                        let plan = Plan { first_step: status.emitted_steps, ..core::mem::take(plan) };
+                        self.run = Some(Run { plan: Some(plan), started_ms: None, ended_ms: None });
+                        self.run_page = RunPage::Numbers;
+                        self.screen = Screen::Form(form.clone());
+                    }
+                    start
+                }
+                _ => Ok(MenuAction::None),
+            },
         };
         result.unwrap_or_else(|e| {
             self.message = Some(e);

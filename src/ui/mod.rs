@@ -9,7 +9,9 @@ pub mod entry;
 pub mod layout;
 pub mod menu;
 pub mod presets;
+pub mod run;
 pub mod screen;
+pub mod trail;
 
 pub use layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 pub use menu::{Menu, MenuAction};

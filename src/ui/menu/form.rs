@@ -1,15 +1,18 @@
 //! The forms of the drawing modes: the ranges of their parameters, the fields each mode asks
 //! for, and [`Form`], which takes the keys of a form, checks the values and builds the job from
-//! the pen.
+//! the pen, with the [`Plan`] its preview and run screen show.
 
+use core::fmt::Write;
 use core::ops::RangeInclusive;
 
 use core::f32::consts::TAU;
+use heapless::String;
 
 use super::action::MenuAction;
 use super::error::UiError;
 use super::mode::Mode;
 use super::unit::Unit;
+use crate::decimal::Num;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job};
@@ -18,6 +21,7 @@ use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::ui::entry::NumberEntry;
 use crate::ui::presets::FunctionPreset;
+use crate::ui::run::{JOB_NAME_CHARS, Plan};
 
 /// Line: offset of the end point from the pen, per axis.
 pub const LINE_DELTA_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
@@ -178,17 +182,19 @@ impl Form {
         self.preset
     }
 
+    /// Takes a key; `#` on the last field builds the drawing and gives its plan, for the
+    /// preview.
     pub(super) fn press(
         &mut self,
         key: Key,
         repeated: bool,
         status: &Status,
         settings: &Settings,
-    ) -> Result<MenuAction, UiError> {
+    ) -> Result<Option<Plan>, UiError> {
         if self.started {
             *self = Form { preset: self.preset, ..Form::new(self.mode) };
         }
-        let Some(field) = self.field() else { return Ok(MenuAction::None) };
+        let Some(field) = self.field() else { return Ok(None) };
         let entry = &mut self.entries[self.field.min(FORM_MAX_FIELDS - 1)];
         match (field, key) {
             (_, Key::Hash) => return self.confirm(status, settings),
@@ -214,21 +220,29 @@ impl Form {
             (Field::Number(_), Key::C) => entry.clear(),
             _ => {}
         }
-        Ok(MenuAction::None)
+        Ok(None)
     }
 
     /// `#`: checks the field, then moves on or, after the last one, builds the job.
-    fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
+    fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<Option<Plan>, UiError> {
         if let Some(Field::Number(spec)) = self.field() {
             spec.value(self.entry())?;
         }
         if self.field + 1 < self.mode.fields().len() {
             self.field += 1;
-            return Ok(MenuAction::None);
+            return Ok(None);
         }
-        let action = self.build(status, settings)?;
+        let job = self.job(status, settings)?;
+        Ok(Some(Plan::of(&job.drawing, self.name(), job.feed, settings)))
+    }
+
+    /// `#` on the preview: the job, built again from the pen (still where the preview was
+    /// built: the machine is at rest), if the machine is still free for it. The form then stays
+    /// as typed until the next key.
+    pub(super) fn start(&mut self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
+        let job = self.job(status, settings)?;
         self.started = true;
-        Ok(action)
+        Ok(MenuAction::Start(job))
     }
 
     /// The checked value of number field `i`.
@@ -283,16 +297,37 @@ impl Form {
     }
 
     /// The job the form describes, from the pen at `status.position`.
-    fn build(&self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
+    fn job(&self, status: &Status, settings: &Settings) -> Result<Job, UiError> {
+        free(status)?;
         let feed = Feed::MmPerMin(settings.default_feed_mm_per_min);
         let request = self.request(status.position, settings)?;
         let drawing = drawing::build(&request, status.position, settings).map_err(UiError::Drawing)?;
         // Shorter than a step: nothing to draw.
-        let drawing = drawing.ok_or(UiError::Zero)?;
-        match status.state {
-            RunState::Alarm => Err(UiError::Alarm),
-            RunState::Idle if status.queued_jobs == 0 => Ok(MenuAction::Start(Job::draw(drawing, feed))),
-            _ => Err(UiError::Busy),
-        }
+        Ok(Job::draw(drawing.ok_or(UiError::Zero)?, feed))
+    }
+
+    /// The drawing's name on the run screen: the mode and its main figures.
+    pub fn name(&self) -> String<JOB_NAME_CHARS> {
+        let mut name = String::new();
+        let n = |i: usize| Num(self.number(i).unwrap_or(0.0));
+        let _ = match self.mode {
+            Mode::Line => write!(name, "Line {},{}", n(0), n(1)),
+            Mode::Circle if self.sweep(2).unwrap_or(360.0).abs() >= 360.0 => write!(name, "Circle r{}", n(0)),
+            Mode::Circle => write!(name, "Arc r{} {}deg", n(0), n(2)),
+            Mode::Ellipse => write!(name, "Ellipse {}x{}", n(0), n(1)),
+            Mode::Sine => write!(name, "Sine A{} P{}", n(0), n(1)),
+            Mode::Function => write!(name, "y={}", self.preset.expression()),
+            Mode::Jog | Mode::Settings | Mode::Home => name.push_str(self.mode.label()).map_err(|_| core::fmt::Error),
+        };
+        name
+    }
+}
+
+/// The keypad starts a drawing only at rest with nothing queued, so it starts at the pen.
+fn free(status: &Status) -> Result<(), UiError> {
+    match status.state {
+        RunState::Alarm => Err(UiError::Alarm),
+        RunState::Idle if status.queued_jobs == 0 => Ok(()),
+        _ => Err(UiError::Busy),
     }
 }

@@ -24,13 +24,34 @@ fn key(ch: char) -> Key {
     }
 }
 
-/// Presses each key of `keys` (spaces ignored); returns the actions other than `None`.
+/// Presses each key of `keys` (spaces ignored); returns the actions other than `None`. A
+/// drawing's preview is confirmed with `#` at once, and a drawing started is drawn at once, as
+/// if between two keys: the machine runs and comes to rest, and a key puts the end screen away.
 fn type_keys(menu: &mut Menu, keys: &str, status: &Status) -> Vec<MenuAction> {
-    keys.chars()
-        .filter(|c| !c.is_whitespace())
-        .map(|c| menu.handle(KeyEvent::Press(key(c)), status, &Settings::default()))
-        .filter(|a| *a != MenuAction::None)
-        .collect()
+    let s = Settings::default();
+    let mut actions = Vec::new();
+    for c in keys.chars().filter(|c| !c.is_whitespace()) {
+        let mut action = menu.handle(KeyEvent::Press(key(c)), status, &s);
+        if matches!(menu.screen(), Screen::Preview { .. }) {
+            action = menu.handle(KeyEvent::Press(Key::Hash), status, &s);
+        }
+        if let MenuAction::Start(_) = action {
+            draw_to_the_end(menu);
+            menu.handle(KeyEvent::Press(Key::Star), &idle(), &s);
+        }
+        if action != MenuAction::None {
+            actions.push(action);
+        }
+    }
+    actions
+}
+
+/// The machine draws what the menu started and comes to rest: the run ends.
+fn draw_to_the_end(menu: &mut Menu) {
+    let drawing = Status { state: RunState::Run, work_left: true, ..Status::default() };
+    assert!(menu.observe(&drawing, 0));
+    assert!(menu.observe(&idle(), 1000));
+    assert_eq!(menu.run().and_then(|r| r.ended_ms), Some(1000));
 }
 
 fn idle() -> Status {
