@@ -34,7 +34,7 @@ use heapless::String;
 
 use crate::decimal::{Int, Num};
 use crate::drawing::DrawError;
-use crate::geom::{self, Axis, Step};
+use crate::geom::Step;
 use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::{CurveError, Method};
@@ -47,76 +47,11 @@ use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCR
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
 use crate::ui::trail::{self, Trail};
 
+mod lines;
 mod run;
 
-/// Widest position value shown (`-500.000`, or fewer decimals for larger values).
-const POSITION_CHARS: usize = 9;
-
-/// One line of text; longer text is cut at [`SCREEN_COLUMNS`].
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct TextLine {
-    pub text: String<SCREEN_COLUMNS>,
-    /// Light text on a dark bar.
-    pub inverted: bool,
-}
-
-impl TextLine {
-    fn new(args: fmt::Arguments, inverted: bool) -> Self {
-        let mut line = TextLine { text: String::new(), inverted };
-        let _ = Cut(&mut line.text).write_fmt(args);
-        line
-    }
-}
-
-/// Where a path is shown and what it shows: the plan (the preview's, or the run's), the path
-/// drawn so far (as many points, the last one given), and the pen.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PreviewBox {
-    pub area: Rectangle,
-    pub plan: bool,
-    pub drawn_points: usize,
-    pub drawn_last: Option<geom::Point>,
-    pub pen: Option<geom::Point>,
-}
-
-/// Everything the screen shows; equal views draw identical frames (for the same plan and path).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct ScreenView {
-    pub lines: [TextLine; SCREEN_LINES],
-    pub preview: Option<PreviewBox>,
-}
-
-/// What the LCD task knows besides the menu, the status and the settings.
-#[derive(Clone, Copy, Debug)]
-pub struct Live<'a> {
-    /// The LCD task's clock, ms (wrapping).
-    pub now_ms: u32,
-    /// How fast the pen moves now.
-    pub speed_mm_per_min: f32,
-    /// Machine = work + offset, mm.
-    pub work_offset_mm: [f32; 2],
-    /// The path drawn in the current run.
-    pub drawn: Option<&'a Trail>,
-}
-
-impl Live<'_> {
-    /// At time zero, at rest, work = machine coordinates, nothing drawn.
-    pub const NONE: Live<'static> = Live { now_ms: 0, speed_mm_per_min: 0.0, work_offset_mm: [0.0; 2], drawn: None };
-}
-
-/// Writes into a fixed string, silently cutting what does not fit.
-struct Cut<'a, const N: usize>(&'a mut String<N>);
-
-impl<const N: usize> Write for Cut<'_, N> {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        for c in s.chars() {
-            if self.0.push(c).is_err() {
-                break;
-            }
-        }
-        Ok(())
-    }
-}
+use lines::{Cut, position_line, state_name};
+pub use lines::{Live, PreviewBox, ScreenView, TextLine};
 
 /// The screen for the current menu and machine state.
 pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> ScreenView {
@@ -253,50 +188,6 @@ where
     D: DrawTarget<Color = BinaryColor>,
 {
     render(&view(menu, status, settings, live), menu.plan().map(|p| &p.path), live.drawn, target)
-}
-
-fn state_name(status: &Status) -> &'static str {
-    match status.state {
-        RunState::Idle => "IDLE",
-        RunState::Run => "RUN",
-        RunState::Hold if status.door => "DOOR",
-        RunState::Hold => "HOLD",
-        RunState::Jog => "JOG",
-        RunState::Alarm => "ALARM",
-        RunState::Check => "CHECK",
-        RunState::Sleep => "SLEEP",
-        RunState::Home => "HOME",
-    }
-}
-
-/// The pen's position in work coordinates (`offset_mm` the work offset), or in machine
-/// coordinates with no offset, `width` characters a value at most.
-fn position_line(status: &Status, settings: &Settings, offset_mm: [f32; 2]) -> TextLine {
-    position_in(status, settings, offset_mm, "", POSITION_CHARS)
-}
-
-/// [`position_line`] after `prefix`, each value at most `width` characters.
-fn position_in(status: &Status, settings: &Settings, offset_mm: [f32; 2], prefix: &str, width: usize) -> TextLine {
-    let x = mm_text(settings.steps_to_mm(Axis::X, status.position.x) - offset_mm[0], width);
-    let y = mm_text(settings.steps_to_mm(Axis::Y, status.position.y) - offset_mm[1], width);
-    // Inverted while the position may be wrong: until homed.
-    let line = format_args!("{prefix}X{:>w$} Y{:>w$}", x.as_str(), y.as_str(), w = width);
-    TextLine::new(line, status.position_lost)
-}
-
-/// `mm` with 3 decimals, or fewer when it would not fit `width` characters
-/// ([`POSITION_CHARS`] at most).
-fn mm_text(mm: f32, width: usize) -> String<POSITION_CHARS> {
-    let mut s = String::new();
-    for decimals in [3, 1, 0] {
-        s.clear();
-        if crate::decimal::write_fixed(&mut s, mm, decimals).is_ok() && s.len() <= width {
-            return s;
-        }
-    }
-    s.clear();
-    let _ = s.push_str("-----");
-    s
 }
 
 fn settings_line(i: usize, s: &Settings) -> TextLine {

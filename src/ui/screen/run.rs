@@ -22,7 +22,7 @@ use core::fmt;
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::primitives::Rectangle;
 
-use super::{Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
+use super::lines::{Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
 use crate::decimal::{Int, write_digits};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
