@@ -271,25 +271,17 @@ impl Drawing {
     /// Walks the lattice path again (`settings` as it was built with) and hands `at` its start,
     /// every `every`-th point and its end.
     pub fn sample_path(&self, settings: &Settings, every: u64, at: &mut dyn FnMut(Point)) {
-        let Ok(mut copy) = Curve::new(&self.shape, self.start, settings) else { return };
-        let (mut p, mut n) = (self.start, 0u64);
-        at(p);
-        let mut buf = [Step::new(0, 0); TRACE_BATCH_STEPS];
-        loop {
-            let Filled { steps, end, .. } = copy.fill(&mut buf);
-            for step in &buf[..steps] {
-                p = p.stepped(*step);
-                n += 1;
-                if n % every == 0 && n != self.steps {
-                    at(p);
-                }
+        let Ok(copy) = Curve::new(&self.shape, self.start, settings) else { return };
+        at(self.start);
+        let mut n = 0u64;
+        let walked = walk(copy, self.start, |p| {
+            n += 1;
+            if n.is_multiple_of(every) && n != self.steps {
+                at(p);
             }
-            if end.is_some() {
-                break;
-            }
-        }
+        });
         if n > 0 {
-            at(p);
+            at(walked.unwrap_or_else(|(p, _)| p));
         }
     }
 }
@@ -417,22 +409,31 @@ fn follows(bounds: &Bounds, ideal: &IdealBox) -> bool {
 
 /// Walks `copy`, a curve from `start`, to its end: the end, the box and the number of steps,
 /// or where it fails and why.
-fn trace(mut copy: Curve, start: Point) -> Result<(Point, Bounds, u64), (Point, CurveError)> {
-    let mut at = start;
+fn trace(copy: Curve, start: Point) -> Result<(Point, Bounds, u64), (Point, CurveError)> {
     let mut bounds = Bounds::at(start);
     let mut steps = 0u64;
+    let end = walk(copy, start, |p| {
+        bounds.add(p);
+        steps += 1;
+    })?;
+    Ok((end, bounds, steps))
+}
+
+/// Walks `copy`, a curve from `start`, handing `at` every lattice point after the start: where
+/// it ends, or where it fails and why.
+fn walk(mut copy: Curve, start: Point, mut at: impl FnMut(Point)) -> Result<Point, (Point, CurveError)> {
+    let mut p = start;
     let mut buf = [Step::new(0, 0); TRACE_BATCH_STEPS];
     loop {
-        let Filled { steps: n, end, .. } = copy.fill(&mut buf);
-        for step in &buf[..n] {
-            at = at.stepped(*step);
-            bounds.add(at);
+        let Filled { steps, end, .. } = copy.fill(&mut buf);
+        for step in &buf[..steps] {
+            p = p.stepped(*step);
+            at(p);
         }
-        steps += n as u64;
         match end {
             None => {}
-            Some(Ok(())) => return Ok((at, bounds, steps)),
-            Some(Err(e)) => return Err((at, e)),
+            Some(Ok(())) => return Ok(p),
+            Some(Err(e)) => return Err((p, e)),
         }
     }
 }

@@ -96,6 +96,11 @@ impl PenLift {
             _ => PenLift::Auto,
         }
     }
+
+    /// True when the pen, at `pen`, draws: always without a pen lift.
+    pub fn draws(self, pen: Pen) -> bool {
+        self == PenLift::None || pen == Pen::Down
+    }
 }
 
 /// The servo pulse that holds `pen`, µs.

@@ -16,10 +16,10 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::SpiDevice;
 
 use crate::machine::Machine;
-use crate::pen::{Pen, PenLift};
+use crate::pen::PenLift;
 use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+use crate::ui::run::RunPath;
 use crate::ui::screen::{self, Live};
-use crate::ui::trail::Trail;
 
 /// Shortest time between two frames (10 Hz at most).
 pub const LCD_FRAME_MIN_MS: u64 = 100;
@@ -90,38 +90,25 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
     lcd.init();
     let mut shown = None;
     let mut last_frame_ms = 0u32;
-    // The path of the run that started at `run_started_ms`.
-    let mut drawn = Trail::new();
-    let mut run_started_ms = None;
+    let mut drawn = RunPath::default();
     loop {
         let now_ms = Instant::now().as_millis() as u32;
         let status = machine.status();
         let settings = machine.settings();
         let menu = machine.menu();
-        let run = menu.run();
-        if run.map(|r| r.started_ms) != run_started_ms {
-            run_started_ms = run.map(|r| r.started_ms);
-            drawn.clear();
-        }
-        // Sampled from the run's start, once more at its end.
-        if run.is_some_and(|r| r.started_ms.is_some()) {
-            // With a pen lift, the way travelled with the pen up is not drawn.
-            let pen_down = PenLift::of(&settings) == PenLift::None || machine.pen() == Pen::Down;
-            drawn.sample(status.position, pen_down);
-        }
+        let running = drawn.follow(menu.run(), status.position, PenLift::of(&settings).draws(machine.pen()));
         let live = Live {
             now_ms,
             speed_mm_per_min: machine.speed_mm_per_min(&settings),
             work_offset_mm: machine.work_offset_mm(),
-            drawn: Some(&drawn),
+            drawn: Some(&drawn.path),
         };
         let view = screen::view(&menu, &status, &settings, &live);
         let since_frame_ms = now_ms.wrapping_sub(last_frame_ms);
-        let running = run.is_some_and(|r| r.ended_ms.is_none());
         let mut wait_ms = if running { PREVIEW_SAMPLE_MS } else { LCD_POLL_MS };
         if shown.as_ref() != Some(&view) {
             if u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none() {
-                let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn), &mut lcd);
+                let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn.path), &mut lcd);
                 lcd.show();
                 shown = Some(view);
                 last_frame_ms = now_ms;

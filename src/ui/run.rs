@@ -13,7 +13,7 @@
 use heapless::String;
 
 use crate::drawing::Drawing;
-use crate::geom::Axis;
+use crate::geom::{Axis, Point};
 use crate::job::Feed;
 use crate::planner::Limits;
 use crate::settings::Settings;
@@ -110,6 +110,31 @@ impl Run {
     }
 }
 
+/// The path drawn in the run the menu shows: cleared when another run starts, sampled from the
+/// run's start, and once more when it has ended (the pen's last point).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunPath {
+    /// The start of the run `path` belongs to (`None`: no run).
+    run_started_ms: Option<Option<u32>>,
+    pub path: Trail,
+}
+
+impl RunPath {
+    /// Follows `run` with the pen at `at`, `drawn` when it draws there. Returns true while the
+    /// run is under way: the pen should be looked at again soon.
+    pub fn follow(&mut self, run: Option<&Run>, at: Point, drawn: bool) -> bool {
+        let started_ms = run.map(|r| r.started_ms);
+        if started_ms != self.run_started_ms {
+            self.run_started_ms = started_ms;
+            self.path.clear();
+        }
+        if run.is_some_and(|r| r.started_ms.is_some()) {
+            self.path.sample(at, drawn);
+        }
+        run.is_some_and(|r| r.ended_ms.is_none())
+    }
+}
+
 /// The pages of the run screen, in the order `#` steps through them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -175,6 +200,26 @@ mod tests {
         let run = Run { plan: None, started_ms: Some(100), ended_ms: Some(3100) };
         assert_eq!((run.percent(7), run.left_ms(7, 100, 0)), (None, None));
         assert_eq!(run.elapsed_ms(99_999), 3000, "once ended, the plot time stays");
+    }
+
+    #[test]
+    fn the_path_follows_one_run_and_starts_afresh_with_the_next() {
+        let mut follow = RunPath::default();
+        let at = |x| Point::new(x, 0);
+        assert!(!follow.follow(None, at(5), true), "no run: nothing to follow");
+        assert!(follow.path.points().is_empty());
+        let mut run = Run { plan: None, started_ms: None, ended_ms: None };
+        assert!(follow.follow(Some(&run), at(0), true), "confirmed, not started: under way");
+        assert!(follow.path.points().is_empty(), "the clock has not started");
+        run.started_ms = Some(10);
+        follow.follow(Some(&run), at(0), true);
+        follow.follow(Some(&run), at(7), true);
+        run.ended_ms = Some(20);
+        assert!(!follow.follow(Some(&run), at(9), true), "ended");
+        assert_eq!(follow.path.points(), [at(0), at(7), at(9)], "the last point once ended too");
+        let next = Run { plan: None, started_ms: Some(30), ended_ms: None };
+        follow.follow(Some(&next), at(9), true);
+        assert_eq!(follow.path.points(), [at(9)], "a new run starts a new path");
     }
 
     #[test]
