@@ -122,7 +122,10 @@ impl NumberEntry {
         if !any_digit {
             return Err(EntryError::NotANumber);
         }
-        let magnitude = mantissa as f32 / crate::math::pow(10.0, decimals as f32);
+        // 10^decimals is exact in f32 for every count an entry can hold, so the quotient is the
+        // f32 nearest the typed number.
+        let scale = (0..decimals).fold(1.0f32, |scale, _| scale * 10.0);
+        let magnitude = mantissa as f32 / scale;
         Ok(Some(if self.negative { -magnitude } else { magnitude }))
     }
 }
