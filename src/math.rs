@@ -4,9 +4,9 @@
 //! of times slower, so the firmware has none. Square roots are the FPU's own instruction. The
 //! elementary functions are computed in `f32` throughout: our own where `libm` computes in
 //! `f64` inside (`sinf`, `cosf`, `tanf` and `asinf` do, `acosf` uses a software square root),
-//! `libm`'s `f32` functions where they stay in `f32` (exp, ln, log10, atan, atan2, floor,
-//! ceil, round, trunc), and the power from exp and ln. `min` and `max` are plain comparisons: `f32::min` is a library call on
-//! this FPU.
+//! `libm`'s `f32` functions where they stay in `f32` (exp, ln, atan, atan2, floor, ceil,
+//! round, trunc), and the decimal logarithm and the power from exp and ln. `min` and `max` are
+//! plain comparisons: `f32::min` is a library call on this FPU.
 //!
 //! Owns no state. Everything here is a pure function of its arguments.
 
@@ -206,9 +206,9 @@ pub fn ln(x: f32) -> f32 {
     libm::logf(x)
 }
 
-/// Decimal logarithm.
+/// Decimal logarithm, ln x · log10 e: within 2 ulp, in no code of its own.
 pub fn log10(x: f32) -> f32 {
-    libm::log10f(x)
+    ln(x) * core::f32::consts::LOG10_E
 }
 
 /// Integer exponents up to this magnitude are powers by repeated squaring in [`pow`].

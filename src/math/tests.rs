@@ -150,14 +150,14 @@ fn asin_and_acos_are_within_2_5_ulp() {
 }
 
 #[test]
-fn the_libm_functions_kept_are_within_1_ulp_and_pow_within_its_bound() {
+fn the_elementary_functions_are_within_their_bounds() {
     for i in 0..=1_000_000u32 {
         let u = f64::from(i) / 1e6;
         let x = (-80.0 + 160.0 * u) as f32;
         assert!(ulps(exp(x), f64::from(x).exp()) <= 1.0, "exp {x}");
         let p = (1e-30 * 1e60f64.powf(u)) as f32;
         assert!(ulps(ln(p), f64::from(p).ln()) <= 1.0, "ln {p}");
-        assert!(ulps(log10(p), f64::from(p).log10()) <= 1.0, "log10 {p}");
+        assert!(ulps(log10(p), f64::from(p).log10()) <= 2.0, "log10 {p}");
         let a = (-1e4 + 2e4 * u) as f32;
         assert!(ulps(atan(a), f64::from(a).atan()) <= 1.0, "atan {a}");
         let (y, x) = ((-3.0 + 6.0 * u) as f32, (2.0 - 5.0 * u * u) as f32);
