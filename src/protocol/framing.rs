@@ -15,6 +15,8 @@
 //! `$F` expression its parentheses. Leading spaces go from every line. Beyond that the assembler
 //! owns only framing (line ends, which bytes may stand in a line); the parsers read the words.
 
+use heapless::String;
+
 use super::GrblError;
 use crate::overrides::OverrideCommand;
 
@@ -97,8 +99,8 @@ impl LineEvent<'_> {
 /// (0x18) drops the partial line, as GRBL's reset flushes its receive buffer.
 #[derive(Clone, Debug)]
 pub struct LineAssembler {
-    buf: [u8; LINE_MAX_BYTES],
-    len: usize,
+    /// The kept bytes: printable ASCII and tab only, so a `String` without validation.
+    line: String<LINE_MAX_BYTES>,
     kind: Kind,
     comment: Comment,
     overflow: bool,
@@ -139,8 +141,7 @@ impl Default for LineAssembler {
 impl LineAssembler {
     pub const fn new() -> Self {
         LineAssembler {
-            buf: [0; LINE_MAX_BYTES],
-            len: 0,
+            line: String::new(),
             kind: Kind::Start,
             comment: Comment::None,
             overflow: false,
@@ -156,7 +157,7 @@ impl LineAssembler {
     }
 
     fn start_line(&mut self) {
-        self.len = 0;
+        self.line.clear();
         self.kind = Kind::Start;
         self.comment = Comment::None;
         self.overflow = false;
@@ -223,10 +224,7 @@ impl LineAssembler {
     }
 
     fn keep(&mut self, byte: u8) {
-        if self.len < LINE_MAX_BYTES {
-            self.buf[self.len] = byte;
-            self.len += 1;
-        } else {
+        if self.line.push(char::from(byte)).is_err() {
             self.overflow = true;
         }
     }
@@ -237,11 +235,7 @@ impl LineAssembler {
         } else if let Some(b) = self.bad_byte {
             LineEvent::BadByte(b)
         } else {
-            // Only printable ASCII and tab are ever stored, so this is always valid UTF-8.
-            match core::str::from_utf8(&self.buf[..self.len]) {
-                Ok(line) => LineEvent::Line(line),
-                Err(_) => LineEvent::BadByte(0),
-            }
+            LineEvent::Line(self.line.as_str())
         }
     }
 }

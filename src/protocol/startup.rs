@@ -15,6 +15,19 @@ pub const STARTUP_LINE_MAX_BYTES: usize = 80;
 /// One stored startup block, or the build info line: as long as GRBL's.
 pub type StartupLine = String<STARTUP_LINE_MAX_BYTES>;
 
+/// `bytes` as a line: `None` unless every byte is ASCII and they fit in a line. (Built char by
+/// char: ASCII needs no UTF-8 validation.)
+pub fn ascii_line(bytes: &[u8]) -> Option<StartupLine> {
+    let mut line = StartupLine::new();
+    for &byte in bytes {
+        if !byte.is_ascii() {
+            return None;
+        }
+        line.push(char::from(byte)).ok()?;
+    }
+    Some(line)
+}
+
 /// The stored startup blocks, empty ones included.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StartupLines {

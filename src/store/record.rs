@@ -7,7 +7,7 @@
 //! by a firmware with other settings does not read back as this one's.
 
 use crate::protocol::gcode::{KEPT_OFFSETS, Offsets};
-use crate::protocol::startup::{STARTUP_LINE_MAX_BYTES, STARTUP_LINES, StartupLine, StartupLines};
+use crate::protocol::startup::{STARTUP_LINE_MAX_BYTES, STARTUP_LINES, StartupLine, StartupLines, ascii_line};
 use crate::settings::{SETTING_INFO, Settings};
 
 /// Bumped whenever the layout changes in a way the tag would not see.
@@ -130,8 +130,7 @@ impl Reader<'_> {
         let [len] = self.take()?;
         let (text, rest) = self.bytes.split_at_checked(usize::from(len)).ok_or(BadRecord::Invalid)?;
         self.bytes = rest;
-        let text = core::str::from_utf8(text).map_err(|_| BadRecord::Invalid)?;
-        StartupLine::try_from(text).map_err(|_| BadRecord::Invalid)
+        ascii_line(text).ok_or(BadRecord::Invalid)
     }
 }
 

@@ -7,7 +7,7 @@ use super::{Command, Commands, GcodeState, Report};
 use crate::drawing::{self, Request};
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
-use crate::protocol::startup::{STARTUP_LINES, StartupLine};
+use crate::protocol::startup::{STARTUP_LINES, ascii_line};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
 
@@ -32,10 +32,8 @@ impl GcodeState {
                 if state != RunState::Idle {
                     return Err(GrblError::NotIdle);
                 }
-                let mut line = StartupLine::new();
-                // Compacted text is ASCII.
-                let text = core::str::from_utf8(body).map_err(|_| GrblError::InvalidStatement)?;
-                line.push_str(text).map_err(|_| GrblError::LineLengthExceeded)?;
+                // Compacted text is ASCII: only its length can refuse it.
+                let line = ascii_line(body).ok_or(GrblError::LineLengthExceeded)?;
                 Ok(Commands::one(Command::StoreBuildInfo(line)))
             }
             b"X" => Ok(Commands::one(Command::Unlock)),
@@ -114,10 +112,9 @@ impl GcodeState {
         if usize::from(index) >= STARTUP_LINES {
             return Err(GrblError::InvalidStatement);
         }
-        // Compacted text is ASCII.
-        let text = core::str::from_utf8(body).map_err(|_| GrblError::InvalidStatement)?;
-        let mut line = StartupLine::new();
-        line.push_str(text).map_err(|_| GrblError::LineLengthExceeded)?;
+        // Compacted text is ASCII: only its length can refuse it.
+        let line = ascii_line(body).ok_or(GrblError::LineLengthExceeded)?;
+        let text = line.as_str();
         if !text.is_empty() {
             if text.starts_with('$') {
                 return Err(GrblError::InvalidStatement);
