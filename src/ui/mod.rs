@@ -6,6 +6,7 @@
 //! clock, no pins, no waiting.
 
 pub mod entry;
+pub mod glyphs;
 pub mod layout;
 pub mod menu;
 pub mod presets;

@@ -22,14 +22,10 @@
 
 use core::fmt::{self, Write};
 
-use embedded_graphics::Drawable;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::{Point, Size};
-use embedded_graphics::mono_font::MonoTextStyle;
-use embedded_graphics::mono_font::ascii::FONT_5X7;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::primitives::Rectangle;
-use embedded_graphics::text::{Baseline, Text};
 use heapless::String;
 
 use crate::decimal::{Int, Num};
@@ -43,6 +39,7 @@ use crate::overrides::OVERRIDE_NONE_PERCENT;
 use crate::settings::Settings;
 use crate::status::{MotionFault, RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
+use crate::ui::glyphs;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
 use crate::ui::trail::{self, Trail};
@@ -171,10 +168,8 @@ where
         let top = (i as u32 * SCREEN_LINE_HEIGHT_PX) as i32;
         let area = Rectangle::new(Point::new(0, top), Size::new(SCREEN_WIDTH_PX, SCREEN_LINE_HEIGHT_PX));
         target.fill_solid(&area, bg)?;
-        let style = MonoTextStyle::new(&FONT_5X7, fg);
         // The 7-pixel glyphs sit on the line's last row: a row apart from the line above.
-        let at = Point::new(SCREEN_MARGIN_PX as i32, top + 1);
-        Text::with_baseline(&line.text, at, style, Baseline::Top).draw(target)?;
+        glyphs::draw(target, &line.text, Point::new(SCREEN_MARGIN_PX as i32, top + 1), fg)?;
     }
     if let Some(p) = &view.preview {
         trail::draw(target, p.area, plan.filter(|_| p.plan), drawn, p.pen)?;

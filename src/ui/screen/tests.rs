@@ -7,8 +7,12 @@ use crate::keypad::{Key, KeyEvent};
 use crate::overrides::Overrides;
 use crate::ui::layout::SCREEN_HEIGHT_PX;
 use core::convert::Infallible;
+use embedded_graphics::Drawable;
 use embedded_graphics::Pixel;
 use embedded_graphics::geometry::OriginDimensions;
+use embedded_graphics::mono_font::MonoTextStyle;
+use embedded_graphics::mono_font::ascii::FONT_5X7;
+use embedded_graphics::text::{Baseline, Text};
 
 /// The screen at rest, nothing drawn, with no work offset.
 fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
@@ -221,7 +225,7 @@ fn title_bar_is_drawn_and_text_lines_have_glyphs() {
     for line in 1..SCREEN_LINES {
         assert!(f.lit_in_rows(line * 8..line * 8 + 8) > 0, "line {line} is blank\n{f:?}");
     }
-    // The title's first glyph ('C') is where the 5x7 font puts it.
+    // The title's first glyph ('C') is where embedded-graphics' own text renderer puts it.
     let mut reference = Frame::filled(true);
     Text::with_baseline("C", Point::new(1, 1), MonoTextStyle::new(&FONT_5X7, BinaryColor::Off), Baseline::Top)
         .draw(&mut reference)
