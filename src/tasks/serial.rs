@@ -161,7 +161,7 @@ impl Host<'_> {
 
     /// Waits until nothing is queued or moving.
     fn machine_at_rest(&self) -> Until<'_> {
-        Until { machine: self.machine, done: Machine::is_idle, timer: None, then_pen: None }
+        Until { machine: self.machine, line_of: None, done: Machine::is_idle, then_pen: None, then_ms: 0, timer: None }
     }
 
     /// Once nothing is queued or moving, sends the pen to `pen` and waits for it to settle.
@@ -169,51 +169,72 @@ impl Host<'_> {
         Until { then_pen: Some(pen), ..self.machine_at_rest() }
     }
 
-    /// Waits `ms` milliseconds: an [`Until`] whose first look waits out the time, so every wait
-    /// of the line loop shares one future type.
+    /// Once nothing is queued or moving, waits `ms` milliseconds (G4).
     fn dwell(&self, ms: u32) -> Until<'_> {
-        let timer = Some(Timer::after(Duration::from_millis(u64::from(ms))));
-        Until { machine: self.machine, done: |_| true, timer, then_pen: None }
+        Until { then_ms: ms, ..self.machine_at_rest() }
     }
 
     /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
     /// runs: the position is final.
     fn machine_stopped(&self) -> Until<'_> {
-        Until { machine: self.machine, done: Machine::at_standstill, timer: None, then_pen: None }
+        Until { done: Machine::at_standstill, ..self.machine_at_rest() }
     }
 }
 
-/// Waits until `done` holds for the machine, looking again every `SERIAL_IDLE_POLL_MS`. One
-/// type, its poll out of line, serves every such wait of the serial task.
+/// Waits until `done` holds for the machine, then for the pen and the time it is given,
+/// looking again every `SERIAL_IDLE_POLL_MS`. A wait for a line of a link ([`Until::for_line`])
+/// gives up when a reset comes on that link. One type, its poll out of line, serves every wait
+/// of the line loop for the machine.
 struct Until<'m> {
     machine: &'m Machine,
+    /// The link whose line waits: a reset there ends the wait with [`Unfinished::Reset`].
+    line_of: Option<&'m Link>,
     done: fn(&Machine) -> bool,
-    timer: Option<Timer>,
     /// Once `done` holds: send the pen here, then wait until it has settled.
     then_pen: Option<Pen>,
+    /// Then wait this long.
+    then_ms: u32,
+    timer: Option<Timer>,
+}
+
+impl<'m> Until<'m> {
+    /// The wait of a line of `link`: a reset on `link` ends it.
+    fn for_line(self, link: &'m Link) -> Self {
+        Until { line_of: Some(link), ..self }
+    }
 }
 
 impl Future for Until<'_> {
-    type Output = ();
+    type Output = Result<(), Unfinished>;
 
     #[inline(never)]
-    fn poll(mut self: core::pin::Pin<&mut Self>, cx: &mut core::task::Context<'_>) -> core::task::Poll<()> {
+    fn poll(mut self: core::pin::Pin<&mut Self>, cx: &mut core::task::Context<'_>) -> core::task::Poll<Self::Output> {
+        use core::task::Poll;
         loop {
+            if self.line_of.is_some_and(Link::resetting) {
+                return Poll::Ready(Err(Unfinished::Reset));
+            }
             if let Some(timer) = &mut self.timer {
                 if core::pin::Pin::new(timer).poll(cx).is_pending() {
-                    return core::task::Poll::Pending;
+                    return Poll::Pending;
                 }
                 self.timer = None;
             }
-            if (self.done)(self.machine) {
-                let Some(pen) = self.then_pen.take() else {
-                    return core::task::Poll::Ready(());
-                };
+            let wait_ms = if !(self.done)(self.machine) {
+                SERIAL_IDLE_POLL_MS
+            } else if let Some(pen) = self.then_pen.take() {
                 self.machine.set_pen(pen);
                 self.done = Machine::pen_settled;
                 continue;
-            }
-            self.timer = Some(Timer::after(Duration::from_millis(SERIAL_IDLE_POLL_MS)));
+            } else if self.then_ms > 0 {
+                // In slices, so that a reset is seen as soon as in the other waits.
+                let slice = self.then_ms.min(SERIAL_IDLE_POLL_MS as u32);
+                self.then_ms -= slice;
+                u64::from(slice)
+            } else {
+                return Poll::Ready(Ok(()));
+            };
+            self.timer = Some(Timer::after(Duration::from_millis(wait_ms)));
         }
     }
 }
@@ -334,7 +355,8 @@ impl<F: NorFlash> Parser<'_, '_, F> {
     /// A reset on `link`: once the machine has stopped, the parser starts over from where the
     /// pen is and the link gets the banner; the other links are told.
     async fn reset(&mut self, link: &Link) {
-        self.host.machine_stopped().await;
+        // Not the wait of a line: the reset under way does not end it.
+        let _stopped = self.host.machine_stopped().await;
         link.reset_met();
         self.restart(link).await;
         // A link resetting too (after an e-stop, all are) hears of its own reset.
@@ -392,7 +414,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             return Ok(());
         }
         let record = Record::of(&settings, self.gcode.offsets(), &self.host.startup.borrow());
-        unless_reset(link, self.host.machine_stopped()).await?;
+        self.host.machine_stopped().for_line(link).await?;
         if let Err(e) = self.store.save(&record) {
             link.send(Reply::Message(e.message())).await;
         }
@@ -405,7 +427,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         if machine.plan_epoch() != self.epoch {
             // An abort (keypad, jog cancel, a curve stopped part way, a reset on another link)
             // dropped what was planned: plan on from where the pen stops.
-            unless_reset(link, self.host.machine_stopped()).await?;
+            self.host.machine_stopped().for_line(link).await?;
             self.epoch = machine.plan_epoch();
             self.gcode.sync_position(machine.position(), &machine.settings());
         }
@@ -432,19 +454,18 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         match command {
             Command::Job(job) => self.queue(link, job).await?,
             Command::Dwell { ms } => {
-                unless_reset(link, host.machine_at_rest()).await?;
-                unless_reset(link, host.dwell(ms)).await?;
+                host.dwell(ms).for_line(link).await?;
             }
             Command::Pause => {
-                unless_reset(link, host.machine_at_rest()).await?;
+                host.machine_at_rest().for_line(link).await?;
                 machine.request(Control::Hold);
             }
-            Command::Pen(pen) => unless_reset(link, host.pen_to(pen)).await?,
+            Command::Pen(pen) => host.pen_to(pen).for_line(link).await?,
             Command::ProgramEnd => {
-                unless_reset(link, host.machine_at_rest()).await?;
+                host.machine_at_rest().for_line(link).await?;
                 // M2/M30 turn the spindle off: a pen lift raises the pen.
                 if PenLift::of(settings) != PenLift::None {
-                    unless_reset(link, host.pen_to(Pen::Up)).await?;
+                    host.pen_to(Pen::Up).for_line(link).await?;
                 }
                 link.send(Reply::Message("Pgm End")).await;
             }
@@ -499,9 +520,9 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 return Err(Unfinished::Error(GrblError::Locked));
             }
             Command::Home => {
-                unless_reset(link, host.machine_stopped()).await?;
+                host.machine_stopped().for_line(link).await?;
                 machine.request_homing();
-                unless_reset(link, host.machine_stopped()).await?;
+                host.machine_stopped().for_line(link).await?;
                 // A failed cycle pushed its alarm.
                 if machine.run_state() == RunState::Alarm {
                     return Err(Unfinished::Error(GrblError::Locked));
@@ -510,7 +531,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             Command::Unlock => {
                 if machine.halted() {
                     // The motion task drops what a trip cut short before the pulses may go on.
-                    unless_reset(link, host.machine_stopped()).await?;
+                    host.machine_stopped().for_line(link).await?;
                 }
                 machine.unlock();
                 link.send(Reply::Message("Caution: Unlocked")).await;
@@ -524,15 +545,11 @@ impl<F: NorFlash> Parser<'_, '_, F> {
     /// silently (the banner follows); an abort before it is queued drops it with `error:9`,
     /// since it was planned from a point the pen will not reach.
     async fn queue(&self, link: &Link, job: Job) -> Result<(), Unfinished> {
-        unless_reset(link, self.host.machine.submit(job, self.epoch))
-            .await?
+        link.unless_reset(self.host.machine.submit(job, self.epoch))
+            .await
+            .ok_or(Unfinished::Reset)?
             .map_err(|Stale| Unfinished::Error(GrblError::Locked))
     }
-}
-
-/// Runs `work` for a line of `link` unless a reset on that link comes first.
-async fn unless_reset<T>(link: &Link, work: impl Future<Output = T>) -> Result<T, Unfinished> {
-    link.unless_reset(work).await.ok_or(Unfinished::Reset)
 }
 
 /// Pushes an alarm to every link when a curve stops part way or an input trips the machine. The
