@@ -10,6 +10,9 @@ fn main() {
         std::fs::copy("memory.x", out.join("memory.x")).expect("memory.x is readable");
         println!("cargo:rustc-link-search={}", out.display());
         println!("cargo:rustc-link-arg-bins=--nmagic");
+        // Identical functions (generic copies that compile to the same code) are kept once. No
+        // code here compares function addresses.
+        println!("cargo:rustc-link-arg-bins=--icf=all");
         println!("cargo:rustc-link-arg-bins=-Tlink.x");
         println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
     }
