@@ -38,6 +38,7 @@ pub mod status;
 pub mod store;
 pub mod tasks;
 pub mod ui;
+pub mod unit;
 pub mod watchdog;
 
 #[cfg(not(target_os = "none"))]

@@ -24,6 +24,8 @@
 //! Everything here is shared across priorities: every lock is a critical section that only
 //! copies a value in or out, and every counter has a single writer.
 
+mod settings_and_menu;
+
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
 
@@ -135,6 +137,8 @@ pub struct Machine {
     /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
     drawing: AtomicU8,
     settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
+    /// Wakes the serial task, which keeps the settings in flash, after they changed.
+    settings_changed: Signal<CriticalSectionRawMutex, ()>,
     fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
     /// An input tripped: the pulse engine stops at once and starts nothing until the alarm is
     /// cleared. Set by [`trip`](Self::trip), cleared by [`unlock`](Self::unlock).
@@ -199,6 +203,7 @@ impl Machine {
             underruns: AtomicU32::new(0),
             drawing: AtomicU8::new(0),
             settings: Mutex::new(RefCell::new(settings)),
+            settings_changed: Signal::new(),
             fault: Mutex::new(Cell::new(None)),
             halted: AtomicBool::new(false),
             trip: Mutex::new(Cell::new(None)),
@@ -661,18 +666,6 @@ impl Machine {
         }
     }
 
-    /// A copy of the current settings.
-    pub fn settings(&self) -> Settings {
-        self.settings.lock(|s| *s.borrow())
-    }
-
-    /// Changes the settings through `f`; the planner picks them up for the next job.
-    pub fn update_settings<R>(&self, f: impl FnOnce(&mut Settings) -> R) -> R {
-        let r = self.settings.lock(|s| f(&mut s.borrow_mut()));
-        self.changed.signal(());
-        r
-    }
-
     pub fn set_fault(&self, fault: Option<MotionFault>) {
         self.fault.lock(|f| f.set(fault));
         if let Some(f) = fault {
@@ -684,24 +677,6 @@ impl Machine {
     /// The fault that ended the last job early, if any.
     pub fn fault(&self) -> Option<MotionFault> {
         self.fault.lock(|f| f.get())
-    }
-
-    /// A copy of the keypad menu (the keypad task changes it, the LCD task draws it). Work on
-    /// the menu happens on the copy, never inside the lock.
-    pub fn menu(&self) -> Menu {
-        self.menu.lock(|m| m.borrow().clone())
-    }
-
-    pub fn set_menu(&self, menu: Menu) {
-        self.menu.lock(|m| *m.borrow_mut() = menu);
-        self.changed.signal(());
-    }
-
-    /// Changes the menu in place through `f`, inside the lock; tells displays if `f` says so.
-    pub fn update_menu(&self, f: impl FnOnce(&mut Menu) -> bool) {
-        if self.menu.lock(|m| f(&mut m.borrow_mut())) {
-            self.changed.signal(());
-        }
     }
 
     /// The epoch positions are planned in now: until the next abort, a job planned from the

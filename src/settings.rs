@@ -4,7 +4,10 @@
 //! senders show them correctly; the plotter's own settings use numbers GRBL leaves free.
 //! A value outside its range is refused with [`SettingError`] and changes nothing.
 
+pub mod presets;
+
 use crate::method::Method;
+use crate::unit::Unit;
 
 /// Why a setting was not changed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,14 +19,19 @@ pub enum SettingError {
     OutOfRange,
 }
 
-/// Identifies one setting: its `$` number and range (in the unit the comment beside it in
-/// [`SETTING_INFO`] names).
+/// Identifies one setting: its `$` number, its name and unit on the LCD, and its range.
 #[derive(Clone, Copy, Debug)]
 pub struct SettingInfo {
     pub id: u16,
+    /// At most [`SETTING_NAME_MAX_CHARS`] characters: it follows the number on an LCD line.
+    pub name: &'static str,
+    pub unit: Unit,
     pub min: f32,
     pub max: f32,
 }
+
+/// Longest setting name: "$205 " and the name fill the LCD's 20 columns.
+pub const SETTING_NAME_MAX_CHARS: usize = 15;
 
 /// Highest pulse rate the firmware drives: the drivers' own limit (EP3L class, open collector:
 /// 200 kpps, a period of at least 5 µs).
@@ -63,84 +71,59 @@ enum Field<'a> {
     Method(&'a mut Method),
 }
 
-/// Every setting, in `$$` listing order.
+/// Every setting, in `$$` listing order. On/off settings are 0 or 1.
 pub const SETTING_INFO: &[SettingInfo] = &[
-    // pulse width, us
-    SettingInfo { id: 0, min: 2.5, max: 100.0 },
-    // servo idle off delay (255 always on), ms
-    SettingInfo { id: 1, min: 0.0, max: 255.0 },
-    // direction invert mask, mask
-    SettingInfo { id: 3, min: 0.0, max: 3.0 },
-    // limit pins invert (0 normally open, 1 normally closed), bool
-    SettingInfo { id: 5, min: 0.0, max: 1.0 },
-    // status report (1 machine position, +2 buffer state), mask
-    SettingInfo { id: 10, min: 0.0, max: 3.0 },
-    // junction deviation, mm
-    SettingInfo { id: 11, min: 0.0, max: 5.0 },
-    // soft limits, bool
-    SettingInfo { id: 20, min: 0.0, max: 1.0 },
-    // hard limits, bool
-    SettingInfo { id: 21, min: 0.0, max: 1.0 },
-    // homing cycle, bool
-    SettingInfo { id: 22, min: 0.0, max: 1.0 },
-    // homing direction mask (set: towards min), mask
-    SettingInfo { id: 23, min: 0.0, max: 3.0 },
-    // homing locate feed, mm/min
-    SettingInfo { id: 24, min: 1.0, max: 60_000.0 },
-    // homing seek feed, mm/min
-    SettingInfo { id: 25, min: 1.0, max: 60_000.0 },
-    // homing debounce, ms
-    SettingInfo { id: 26, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
-    // homing pull-off, mm
-    SettingInfo { id: 27, min: 0.1, max: 20.0 },
-    // x steps per mm, step/mm
-    SettingInfo { id: 100, min: 1.0, max: 200.0 },
-    // y steps per mm, step/mm
-    SettingInfo { id: 101, min: 1.0, max: 200.0 },
-    // x max rate, mm/min
-    SettingInfo { id: 110, min: 1.0, max: 60_000.0 },
-    // y max rate, mm/min
-    SettingInfo { id: 111, min: 1.0, max: 60_000.0 },
-    // x acceleration, mm/s^2
-    SettingInfo { id: 120, min: 1.0, max: 10_000.0 },
-    // y acceleration, mm/s^2
-    SettingInfo { id: 121, min: 1.0, max: 10_000.0 },
-    // x max travel, mm
-    SettingInfo { id: 130, min: 1.0, max: 500.0 },
-    // y max travel, mm
-    SettingInfo { id: 131, min: 1.0, max: 500.0 },
-    // direction setup, us
-    SettingInfo { id: 200, min: 5.0, max: 100.0 },
-    // start rate, mm/min
-    SettingInfo { id: 201, min: 1.0, max: 60_000.0 },
-    // interpolation (0 classic, 1 diagonal), method
-    SettingInfo { id: 202, min: 0.0, max: 1.0 },
-    // default feed rate, mm/min
-    SettingInfo { id: 203, min: 1.0, max: 60_000.0 },
-    // max function jump, mm
-    SettingInfo { id: 204, min: 0.01, max: 500.0 },
-    // max pulse rate, Hz
-    SettingInfo { id: 205, min: 100.0, max: MAX_PULSE_RATE_HZ },
-    // input debounce, ms
-    SettingInfo { id: 206, min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
-    // driver alarm inputs, bool
-    SettingInfo { id: 207, min: 0.0, max: 1.0 },
-    // emergency stop input, bool
-    SettingInfo { id: 208, min: 0.0, max: 1.0 },
-    // servo enable delay, ms
-    SettingInfo { id: 209, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
-    // pen up, RC servo pulse in us
-    SettingInfo { id: 210, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
-    // pen down, RC servo pulse in us
-    SettingInfo { id: 211, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
-    // pen settle time, ms
-    SettingInfo { id: 212, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
-    // pen lift (0 none, 1 M3/M5, 2 also by itself: up for G0, down for drawing)
-    SettingInfo { id: 213, min: 0.0, max: 2.0 },
-    // run LED, bool
-    SettingInfo { id: 214, min: 0.0, max: 1.0 },
-    // buzzer, bool
-    SettingInfo { id: 215, min: 0.0, max: 1.0 },
+    SettingInfo { id: 0, name: "Pulse width", unit: Unit::Us, min: 2.5, max: 100.0 },
+    // 255 always on
+    SettingInfo { id: 1, name: "Servo idle off", unit: Unit::Ms, min: 0.0, max: 255.0 },
+    // bit 0 X, bit 1 Y
+    SettingInfo { id: 3, name: "Invert SIGN", unit: Unit::Plain, min: 0.0, max: 3.0 },
+    // 0 normally open, 1 normally closed
+    SettingInfo { id: 5, name: "Limits invert", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    // 1 machine position, +2 buffer state
+    SettingInfo { id: 10, name: "Status report", unit: Unit::Plain, min: 0.0, max: 3.0 },
+    SettingInfo { id: 11, name: "Junction dev", unit: Unit::Mm, min: 0.0, max: 5.0 },
+    SettingInfo { id: 20, name: "Soft limits", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 21, name: "Hard limits", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 22, name: "Homing", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    // bit set: towards the min switch
+    SettingInfo { id: 23, name: "Homing dir", unit: Unit::Plain, min: 0.0, max: 3.0 },
+    SettingInfo { id: 24, name: "Home locate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 25, name: "Home seek", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 26, name: "Home debounce", unit: Unit::Ms, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
+    SettingInfo { id: 27, name: "Home pull-off", unit: Unit::Mm, min: 0.1, max: 20.0 },
+    SettingInfo { id: 100, name: "X steps", unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
+    SettingInfo { id: 101, name: "Y steps", unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
+    SettingInfo { id: 110, name: "X max rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 111, name: "Y max rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 120, name: "X accel", unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
+    SettingInfo { id: 121, name: "Y accel", unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
+    SettingInfo { id: 130, name: "X travel", unit: Unit::Mm, min: 1.0, max: 500.0 },
+    SettingInfo { id: 131, name: "Y travel", unit: Unit::Mm, min: 1.0, max: 500.0 },
+    SettingInfo { id: 200, name: "Dir setup", unit: Unit::Us, min: 5.0, max: 100.0 },
+    SettingInfo { id: 201, name: "Start rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    // 0 classic, 1 diagonal
+    SettingInfo { id: 202, name: "Diagonal steps", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 203, name: "Default feed", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 204, name: "Max f(x) jump", unit: Unit::Mm, min: 0.01, max: 500.0 },
+    SettingInfo { id: 205, name: "Max pulse rate", unit: Unit::Hz, min: 100.0, max: MAX_PULSE_RATE_HZ },
+    SettingInfo { id: 206, name: "Input debounce", unit: Unit::Ms, min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
+    SettingInfo { id: 207, name: "Driver alarms", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 208, name: "E-stop input", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 209, name: "Servo on delay", unit: Unit::Ms, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
+    SettingInfo { id: 210, name: "Pen up", unit: Unit::Us, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
+    SettingInfo {
+        id: 211,
+        name: "Pen down",
+        unit: Unit::Us,
+        min: PEN_PULSE_MIN_US as f32,
+        max: PEN_PULSE_MAX_US as f32,
+    },
+    SettingInfo { id: 212, name: "Pen settle", unit: Unit::Ms, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
+    // 0 none, 1 M3/M5, 2 also by itself: up for G0, down for drawing
+    SettingInfo { id: 213, name: "Pen lift", unit: Unit::Plain, min: 0.0, max: 2.0 },
+    SettingInfo { id: 214, name: "Run LED", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 215, name: "Buzzer", unit: Unit::Plain, min: 0.0, max: 1.0 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -335,8 +318,16 @@ impl Settings {
 
     /// Sets setting `id` to `value`; out of range, unknown or not finite changes nothing.
     pub fn set(&mut self, id: u16, value: f32) -> Result<(), SettingError> {
+        self.set_all(&[(id, value)])
+    }
+
+    /// Sets every `(id, value)` of `changes`, or, if one is refused or they leave the settings
+    /// disagreeing, none.
+    pub fn set_all(&mut self, changes: &[(u16, f32)]) -> Result<(), SettingError> {
         let mut next = *self;
-        next.assign(id, value)?;
+        for &(id, value) in changes {
+            next.assign(id, value)?;
+        }
         next.check()?;
         *self = next;
         Ok(())
@@ -426,6 +417,23 @@ impl Settings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_name_fits_its_lcd_line() {
+        for info in SETTING_INFO {
+            assert!(info.name.len() <= SETTING_NAME_MAX_CHARS, "${} {}", info.id, info.name);
+        }
+    }
+
+    #[test]
+    fn set_all_changes_everything_or_nothing() {
+        let mut s = Settings::default();
+        // $201 above the new $110 leaves them disagreeing: nothing changes.
+        assert_eq!(s.set_all(&[(203, 1000.0), (110, 200.0)]), Err(SettingError::OutOfRange));
+        assert_eq!(s, Settings::default());
+        assert_eq!(s.set_all(&[(203, 1000.0), (110, 4000.0)]), Ok(()));
+        assert_eq!((s.default_feed_mm_per_min, s.max_rate_mm_per_min), (1000.0, [4000.0, 6000.0]));
+    }
 
     #[test]
     fn every_listed_setting_reads_back_what_was_set() {

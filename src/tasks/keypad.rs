@@ -76,6 +76,16 @@ fn act(machine: &Machine, action: MenuAction) {
         MenuAction::Home => {
             machine.request_homing();
         }
+        MenuAction::SetSetting { id, value } => change_settings(machine, &[(id, value)]),
+        MenuAction::Preset(preset) => change_settings(machine, &preset.changes()),
+    }
+}
+
+/// Changes settings as one: all of `changes`, or, if they would leave the settings disagreeing,
+/// none, and the menu says so. The serial task keeps them in flash.
+fn change_settings(machine: &Machine, changes: &[(u16, f32)]) {
+    if machine.update_settings(|s| s.set_all(changes)).is_err() {
+        refuse(machine, UiError::Clash);
     }
 }
 
@@ -89,7 +99,7 @@ fn queue(machine: &Machine, job: Job) {
     }
 }
 
-/// Shows on the menu why the job just confirmed did not start.
+/// Shows on the menu why what was just confirmed did not happen.
 fn refuse(machine: &Machine, why: UiError) {
     let mut menu = machine.menu();
     menu.refuse(why);

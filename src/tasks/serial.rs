@@ -43,7 +43,7 @@ use core::cell::RefCell;
 use core::future::Future;
 
 use embassy_futures::join::{join, join3};
-use embassy_futures::select::select_array;
+use embassy_futures::select::{Either, select, select_array};
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
@@ -282,11 +282,21 @@ async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(),
     loop {
         let [buf0, buf1] = &mut bufs;
         let [link0, link1] = &host.links;
-        let (intake, k) = if first == 0 {
-            select_array([link0.intake(buf0), link1.intake(buf1)]).await
-        } else {
-            let (intake, i) = select_array([link1.intake(buf1), link0.intake(buf0)]).await;
-            (intake, 1 - i)
+        let intakes = async {
+            if first == 0 {
+                select_array([link0.intake(buf0), link1.intake(buf1)]).await
+            } else {
+                let (intake, i) = select_array([link1.intake(buf1), link0.intake(buf0)]).await;
+                (intake, 1 - i)
+            }
+        };
+        let (intake, k) = match select(intakes, host.machine.settings_changed()).await {
+            Either::First(intake) => intake,
+            Either::Second(()) => {
+                // Changed on the keypad (a line's changes are kept before its answer).
+                parser.keep_changed(&links).await;
+                continue;
+            }
         };
         first = 1 - k;
         let (link, assembler) = (&host.links[k], &mut assemblers[k]);
@@ -409,16 +419,36 @@ impl<F: NorFlash> Parser<'_, '_, F> {
     /// stopped (a flash write stalls the pulses), so the line's `ok` means it is kept. A store
     /// that fails is reported; the line stands.
     async fn keep(&mut self, link: &Link) -> Result<(), Unfinished> {
-        let settings = self.host.machine.settings();
-        if self.store.holds(&settings, self.gcode.offsets(), &self.host.startup.borrow()) {
-            return Ok(());
-        }
-        let record = Record::of(&settings, self.gcode.offsets(), &self.host.startup.borrow());
-        self.host.machine_stopped().for_line(link).await?;
-        if let Err(e) = self.store.save(&record) {
-            link.send(Reply::Message(e.message())).await;
+        if !self.kept() {
+            self.host.machine_stopped().for_line(link).await?;
+            self.save(&[link]).await;
         }
         Ok(())
+    }
+
+    /// After the settings changed outside a line (on the keypad): as [`Parser::keep`], a
+    /// failure told on every link.
+    async fn keep_changed(&mut self, links: &[&Link]) {
+        if !self.kept() {
+            // Not the wait of a line: no reset ends it.
+            let _stopped = self.host.machine_stopped().await;
+            self.save(links).await;
+        }
+    }
+
+    /// Whether the flash holds what a power cycle keeps.
+    fn kept(&self) -> bool {
+        self.store.holds(&self.host.machine.settings(), self.gcode.offsets(), &self.host.startup.borrow())
+    }
+
+    /// Saves what a power cycle keeps; a store that fails is reported on `links`.
+    async fn save(&mut self, links: &[&Link]) {
+        let record = Record::of(&self.host.machine.settings(), self.gcode.offsets(), &self.host.startup.borrow());
+        if let Err(e) = self.store.save(&record) {
+            for link in links {
+                link.send(Reply::Message(e.message())).await;
+            }
+        }
     }
 
     /// Parses one line of `link` and carries it out.

@@ -7,6 +7,8 @@
 
 use heapless::String;
 
+use crate::keypad::Key;
+
 /// Most characters (digits and the decimal point, not the sign) a field holds:
 /// enough for `1000.000` and `-500.000`.
 pub const ENTRY_MAX_CHARS: usize = 8;
@@ -94,6 +96,20 @@ impl NumberEntry {
         } else {
             false
         }
+    }
+
+    /// Takes a key of the number keys: digits, `*`, `A` (sign), `B` (delete), `C` (clear).
+    /// Returns false for `B` on an empty entry (nothing to delete), true otherwise.
+    pub fn press(&mut self, key: Key) -> Result<bool, EntryError> {
+        match key {
+            Key::Digit(d) => self.push_digit(d)?,
+            Key::Star => self.push_point()?,
+            Key::A => self.toggle_sign(),
+            Key::B => return Ok(self.backspace()),
+            Key::C => self.clear(),
+            Key::D | Key::Hash => {}
+        }
+        Ok(true)
     }
 
     /// The typed value; `Ok(None)` when the field is empty.

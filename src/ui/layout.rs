@@ -1,8 +1,5 @@
-//! The LCD's geometry: its visible size, the text grid the 5x7 font makes of it, and how the
-//! settings view scrolls in that grid.
-//!
-//! The menu keeps the settings view's scroll position and the screen draws it; both take the
-//! sizes from here, so neither has to know the other's code.
+//! The LCD's geometry: its visible size, the text grid the 5x7 font makes of it, and where the
+//! previews sit in it.
 
 /// Visible width of the LCD.
 pub const SCREEN_WIDTH_PX: u32 = 122;
@@ -18,10 +15,6 @@ pub const SCREEN_MARGIN_PX: u32 = 1;
 pub const SCREEN_LINES: usize = (SCREEN_HEIGHT_PX / SCREEN_LINE_HEIGHT_PX) as usize;
 /// Characters per line.
 pub const SCREEN_COLUMNS: usize = ((SCREEN_WIDTH_PX - SCREEN_MARGIN_PX) / SCREEN_CHAR_WIDTH_PX) as usize;
-/// Lines of the settings view.
-pub const SETTINGS_VIEW_LINES: usize = 7;
-/// Settings lines visible at once (under the title).
-pub const SETTINGS_VISIBLE_LINES: usize = SCREEN_LINES - 1;
 /// Width of the preview beside the run screen's numbers, at the right edge.
 pub const PREVIEW_BESIDE_WIDTH_PX: u32 = 28;
 /// Width of the preview of a drawing before it starts, at the right edge.

@@ -6,7 +6,7 @@
 //!
 //! Keys:
 //!
-//! - Mode list: `1`..`7` enter a mode; `A`/`B` move the cursor up/down (they repeat when held,
+//! - Mode list: `1`..`9` enter a mode; `A`/`B` move the cursor up/down (they repeat when held,
 //!   stopping at the ends); `#` enters the mode under the cursor.
 //! - Everywhere: `D` goes back to the mode list; while the machine moves (run, hold, jog) `D`
 //!   aborts instead, and while a keypad jog is held it stops the jog. `C` holds a running job
@@ -22,6 +22,10 @@
 //!   does nothing else.
 //! - Jog: hold `1`-`4`, `6`-`9` to move (see [`JOG_KEYS`]); releasing the key stops.
 //! - Home (`8`): runs the homing cycle at once when homing is on (`$22`); `D` aborts it.
+//! - Settings (`7`): one `$` setting at a time ([`SettingPage`]): `A`/`B` step through them; a
+//!   number key or `#` types a new value (keys as in number fields), `#` sets it, `D` drops it.
+//! - Speed presets (`9`): `1`..`3` or `A`/`B` pick one, `#` writes it into the settings
+//!   ([`SpeedPreset`]).
 //!
 //! Every keypad drawing starts at the pen and is typed relative to it: a line is typed as its
 //! offset (dX, dY) from the pen; curves are placed as described in [`crate::drawing`]. So
@@ -35,18 +39,19 @@ use crate::geom::Step;
 use crate::job::Control;
 use crate::keypad::{Key, KeyEvent};
 use crate::settings::Settings;
+use crate::settings::presets::SpeedPreset;
 use crate::status::{RunState, Status};
-use crate::ui::layout::{SETTINGS_VIEW_LINES, SETTINGS_VISIBLE_LINES};
 use crate::ui::run::{Plan, Run, RunPage};
 
 mod action;
 mod error;
 mod form;
 mod mode;
+mod setting_page;
 #[cfg(test)]
 mod tests;
-mod unit;
 
+pub use crate::unit::Unit;
 pub use action::MenuAction;
 pub use error::UiError;
 pub use form::{
@@ -55,7 +60,7 @@ pub use form::{
     SINE_PERIOD_RANGE_MM, SINE_PHASE_RANGE_DEG,
 };
 pub use mode::Mode;
-pub use unit::Unit;
+pub use setting_page::{SETTING_EDIT_HINT, SettingPage};
 
 /// The eight jog keys, around `5` as they sit on the keypad (`2` is above `5`): `2` is +Y, `8`
 /// −Y, `4` −X, `6` +X, and `1`, `3`, `7`, `9` the diagonals.
@@ -99,10 +104,10 @@ pub enum Screen {
         form: Form,
         plan: Plan,
     },
-    /// Read-only list of the main settings, scrolled to `first_line`.
-    Settings {
-        first_line: usize,
-    },
+    /// The `$` settings, one at a time.
+    Settings(SettingPage),
+    /// The speed presets, the cursor on one.
+    Presets(SpeedPreset),
 }
 
 /// The keypad menu; see the module documentation.
@@ -175,8 +180,8 @@ impl Menu {
         self.run_page
     }
 
-    /// Shows why the job just confirmed could not start (the job queue was full, the curve
-    /// could not be built).
+    /// Shows why what was just confirmed did not happen: a job that could not start (the job
+    /// queue was full, the curve could not be built), settings that clash.
     pub fn refuse(&mut self, why: UiError) {
         self.message = Some(why);
         self.run = None;
@@ -251,7 +256,9 @@ impl Menu {
             return false;
         }
         match &self.screen {
-            Screen::Modes | Screen::Settings { .. } => matches!(key, Key::A | Key::B),
+            Screen::Modes | Screen::Presets(_) => matches!(key, Key::A | Key::B),
+            Screen::Settings(page) if page.edit().is_some() => key == Key::B,
+            Screen::Settings(_) => matches!(key, Key::A | Key::B),
             Screen::Form(form) => match form.field() {
                 Some(Field::Preset) => matches!(key, Key::A | Key::B),
                 Some(Field::Number(_)) => key == Key::B,
@@ -278,9 +285,14 @@ impl Menu {
                 self.message = Some(UiError::Aborted);
                 return MenuAction::Control(Control::Abort);
             }
-            self.screen = match &self.screen {
+            self.screen = match &mut self.screen {
                 // Back from the preview to the form, as typed.
                 Screen::Preview { form, .. } => Screen::Form(form.clone()),
+                // Back from a value being typed to the setting.
+                Screen::Settings(page) if page.edit().is_some() => {
+                    page.cancel();
+                    return MenuAction::None;
+                }
                 _ => Screen::Modes,
             };
             return MenuAction::None;
@@ -297,11 +309,18 @@ impl Menu {
         }
         let result = match &mut self.screen {
             Screen::Modes => self.press_modes(key, settings),
-            Screen::Settings { first_line } => {
-                let last = SETTINGS_VIEW_LINES.saturating_sub(SETTINGS_VISIBLE_LINES);
+            Screen::Settings(page) => page.press(key, repeated, settings),
+            Screen::Presets(preset) => {
+                let last = SpeedPreset::ALL.len() - 1;
                 match key {
-                    Key::A => *first_line = first_line.saturating_sub(1),
-                    Key::B => *first_line = (*first_line + 1).min(last),
+                    Key::A => *preset = SpeedPreset::ALL[preset.index().saturating_sub(1)],
+                    Key::B => *preset = SpeedPreset::ALL[(preset.index() + 1).min(last)],
+                    Key::Digit(d) => {
+                        if let Some(&p) = (d as usize).checked_sub(1).and_then(|i| SpeedPreset::ALL.get(i)) {
+                            *preset = p;
+                        }
+                    }
+                    Key::Hash => return MenuAction::Preset(*preset),
                     _ => {}
                 }
                 Ok(MenuAction::None)
@@ -363,7 +382,8 @@ impl Menu {
         self.selected = mode;
         self.screen = match mode {
             Mode::Jog => Screen::Jog,
-            Mode::Settings => Screen::Settings { first_line: 0 },
+            Mode::Settings => Screen::Settings(SettingPage::new()),
+            Mode::Presets => Screen::Presets(SpeedPreset::FinePen),
             Mode::Home if !settings.homing => return Err(UiError::HomingOff),
             Mode::Home => return Ok(MenuAction::Home),
             _ => Screen::Form(Form::new(mode)),

@@ -33,15 +33,16 @@ use crate::drawing::DrawError;
 use crate::geom::Step;
 use crate::homing::HomingFail;
 use crate::inputs::Trip;
-use crate::interp::{CurveError, Method};
-use crate::job::JOG_FEED_MM_PER_MIN;
+use crate::interp::CurveError;
 use crate::overrides::OVERRIDE_NONE_PERCENT;
+use crate::settings::SETTING_INFO;
 use crate::settings::Settings;
+use crate::settings::presets::SpeedPreset;
 use crate::status::{MotionFault, RunState, Status};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
 use crate::ui::glyphs;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
-use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
+use crate::ui::menu::{Field, Menu, Mode, SETTING_EDIT_HINT, Screen, UiError};
 use crate::ui::trail::{self, Trail};
 
 mod lines;
@@ -72,9 +73,16 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
     let mut title_text: String<SCREEN_COLUMNS> = String::new();
     let _ = match menu.screen() {
         Screen::Modes => Cut(&mut title_text).write_str("SERVOPLOT"),
-        Screen::Jog | Screen::Settings { .. } | Screen::Preview { .. } => {
+        Screen::Jog | Screen::Presets(_) | Screen::Preview { .. } => {
             Cut(&mut title_text).write_str(menu.selected().title())
         }
+        Screen::Settings(page) => write!(
+            Cut(&mut title_text),
+            "{} {}/{}",
+            Mode::Settings.title(),
+            Int::from(page.index() + 1),
+            Int::from(SETTING_INFO.len())
+        ),
         Screen::Form(form) => {
             write!(
                 Cut(&mut title_text),
@@ -126,15 +134,40 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             }
             None => {}
         },
-        Screen::Settings { first_line } => {
-            for (line, i) in [l1, l2, l3].into_iter().zip(*first_line..) {
-                *line = settings_line(i, settings);
+        Screen::Settings(page) => {
+            let info = page.info();
+            let unit = info.unit.symbol();
+            let gap = if unit.is_empty() { "" } else { " " };
+            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), info.name), false);
+            match page.edit() {
+                Some(entry) => {
+                    let sign = if entry.is_negative() { "-" } else { "" };
+                    *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", entry.digits()), false);
+                    *l3 = TextLine::new(format_args!("{SETTING_EDIT_HINT}"), false);
+                }
+                None => {
+                    let value = settings.get(info.id).unwrap_or(0.0);
+                    *l2 = TextLine::new(format_args!("{}{gap}{unit}", Num(value)), false);
+                    *l3 = TextLine::new(format_args!("{}..{} # edit", Num(info.min), Num(info.max)), false);
+                }
+            }
+        }
+        Screen::Presets(selected) => {
+            let (feed, rate, accel) = selected.speeds();
+            *l1 = TextLine::new(format_args!("F{} R{} A{}", Num(feed), Num(rate), Num(accel)), false);
+            let first = selected.index().min(SpeedPreset::ALL.len() - 2);
+            for (line, i) in [l2, l3].into_iter().zip(first..) {
+                let preset = SpeedPreset::ALL[i];
+                let marker = if preset == *selected { ">" } else { " " };
+                let set = if preset.is_set(settings) { " *" } else { "" };
+                *line = TextLine::new(format_args!("{marker}{} {}{set}", Int::from(i + 1), preset.name()), false);
             }
         }
         Screen::Preview { .. } => {}
     }
 
-    if menu.is_busy(status) && !matches!(menu.screen(), Screen::Settings { .. }) {
+    // The settings stay in view while the machine works (their keys wait for it).
+    if menu.is_busy(status) && !matches!(menu.screen(), Screen::Settings(_)) {
         let (doing, keys) = match status.state {
             RunState::Hold => ("Held", "C resume  D abort"),
             RunState::Jog => ("Jogging", "D abort"),
@@ -185,26 +218,6 @@ where
     render(&view(menu, status, settings, live), menu.plan().map(|p| &p.path), live.drawn, target)
 }
 
-fn settings_line(i: usize, s: &Settings) -> TextLine {
-    let line = |args| TextLine::new(args, false);
-    match i {
-        0 => line(format_args!("Steps/mm X{} Y{}", Num(s.steps_per_mm[0]), Num(s.steps_per_mm[1]))),
-        1 => line(format_args!("Travel mm X{} Y{}", Num(s.max_travel_mm[0]), Num(s.max_travel_mm[1]))),
-        2 => line(format_args!("Feed {} mm/min", Num(s.default_feed_mm_per_min))),
-        3 => line(format_args!("Start {} mm/min", Num(s.start_rate_mm_per_min))),
-        4 => line(format_args!("Jog {} mm/min", Num(JOG_FEED_MM_PER_MIN))),
-        5 => line(format_args!("Pulse max {} Hz", Num(s.max_pulse_rate_hz))),
-        6 => line(format_args!(
-            "Interpolation {}",
-            match s.method {
-                Method::Classic => "classic",
-                Method::Diagonal => "diagonal",
-            }
-        )),
-        _ => TextLine::default(),
-    }
-}
-
 /// A jog direction as `+X`, `-Y`, `+X+Y`, ...
 struct Direction(Step);
 
@@ -243,6 +256,8 @@ impl fmt::Display for ErrorText {
             UiError::Alarm => f.write_str("Alarm: motion locked"),
             UiError::HomingOff => f.write_str("Homing off: $22=1"),
             UiError::Aborted => f.write_str("Aborted"),
+            UiError::NotWhole => f.write_str("Whole numbers only"),
+            UiError::Clash => f.write_str("Clashes with $201 or $0"),
         }
     }
 }

@@ -2,6 +2,7 @@
 
 use crate::geom::Step;
 use crate::job::{Control, Job};
+use crate::settings::presets::SpeedPreset;
 
 /// What the menu asks the machine to do.
 // A started job carries its curve by value (no heap).
@@ -19,4 +20,11 @@ pub enum MenuAction {
     JogStop,
     /// Run the homing cycle.
     Home,
+    /// Set setting `$id` to `value` (checked against its range).
+    SetSetting {
+        id: u16,
+        value: f32,
+    },
+    /// Write a speed preset into the settings.
+    Preset(SpeedPreset),
 }

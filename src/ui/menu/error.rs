@@ -1,8 +1,8 @@
 //! Why the menu refused a key or a job: the [`UiError`] it shows until the next key.
 
-use super::unit::Unit;
 use crate::drawing::DrawError;
 use crate::ui::entry::EntryError;
+use crate::unit::Unit;
 
 /// Why the menu refused a key or a job; shown until the next key.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,4 +31,9 @@ pub enum UiError {
     HomingOff,
     /// `D` aborted the motion.
     Aborted,
+    /// A fraction typed for a setting that takes whole numbers.
+    NotWhole,
+    /// The new settings would disagree with the others (a start rate above a top speed, a
+    /// pulse too wide for the pulse rate): nothing changed.
+    Clash,
 }

@@ -11,7 +11,6 @@ use heapless::String;
 use super::action::MenuAction;
 use super::error::UiError;
 use super::mode::Mode;
-use super::unit::Unit;
 use crate::decimal::Num;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
 use crate::geom::{Axis, Point};
@@ -22,6 +21,7 @@ use crate::status::{RunState, Status};
 use crate::ui::entry::NumberEntry;
 use crate::ui::presets::FunctionPreset;
 use crate::ui::run::{JOB_NAME_CHARS, Plan};
+use crate::unit::Unit;
 
 /// Line: offset of the end point from the pen, per axis.
 pub const LINE_DELTA_RANGE_MM: RangeInclusive<f32> = -1000.0..=1000.0;
@@ -131,7 +131,7 @@ impl Mode {
             Mode::Ellipse => ELLIPSE_FIELDS,
             Mode::Sine => SINE_FIELDS,
             Mode::Function => FUNCTION_FIELDS,
-            Mode::Jog | Mode::Settings | Mode::Home => &[],
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => &[],
         }
     }
 }
@@ -207,17 +207,13 @@ impl Form {
             (Field::Preset, Key::B) => {
                 self.preset = FunctionPreset::ALL[(self.preset.index() + 1).min(FunctionPreset::ALL.len() - 1)]
             }
-            (Field::Number(_), Key::Digit(d)) => entry.push_digit(d).map_err(UiError::Entry)?,
-            (Field::Number(_), Key::Star) => entry.push_point().map_err(UiError::Entry)?,
-            (Field::Number(_), Key::A) => entry.toggle_sign(),
-            (Field::Number(_), Key::B) => {
-                let deleted = entry.backspace();
+            (Field::Number(_), key) => {
+                let deleted = entry.press(key).map_err(UiError::Entry)?;
                 // An empty field gives way to the previous one, on a fresh press only.
                 if !deleted && !repeated && self.field > 0 {
                     self.field -= 1;
                 }
             }
-            (Field::Number(_), Key::C) => entry.clear(),
             _ => {}
         }
         Ok(None)
@@ -292,7 +288,7 @@ impl Form {
                 let expr = crate::expr::parse(self.preset.expression()).map_err(|_| UiError::Empty)?;
                 Request::Function { expr, x0_mm, x1_mm }
             }
-            Mode::Jog | Mode::Settings | Mode::Home => return Err(UiError::Empty),
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => return Err(UiError::Empty),
         })
     }
 
@@ -317,7 +313,9 @@ impl Form {
             Mode::Ellipse => write!(name, "Ellipse {}x{}", n(0), n(1)),
             Mode::Sine => write!(name, "Sine A{} P{}", n(0), n(1)),
             Mode::Function => write!(name, "y={}", self.preset.expression()),
-            Mode::Jog | Mode::Settings | Mode::Home => name.push_str(self.mode.label()).map_err(|_| core::fmt::Error),
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => {
+                name.push_str(self.mode.label()).map_err(|_| core::fmt::Error)
+            }
         };
         name
     }

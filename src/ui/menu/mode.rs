@@ -12,14 +12,25 @@ pub enum Mode {
     Sine,
     Function,
     Settings,
+    /// Speed presets for the pen in use.
+    Presets,
     /// Runs the homing cycle (`$H`) at once.
     Home,
 }
 
 impl Mode {
     /// Every mode, in menu order: `1` picks the first.
-    pub const ALL: [Mode; 8] =
-        [Mode::Jog, Mode::Line, Mode::Circle, Mode::Ellipse, Mode::Sine, Mode::Function, Mode::Settings, Mode::Home];
+    pub const ALL: [Mode; 9] = [
+        Mode::Jog,
+        Mode::Line,
+        Mode::Circle,
+        Mode::Ellipse,
+        Mode::Sine,
+        Mode::Function,
+        Mode::Settings,
+        Mode::Home,
+        Mode::Presets,
+    ];
 
     /// Screen title.
     pub const fn title(self) -> &'static str {
@@ -31,6 +42,7 @@ impl Mode {
             Mode::Sine => "SINE",
             Mode::Function => "FUNCTION",
             Mode::Settings => "SETTINGS",
+            Mode::Presets => "PRESETS",
             Mode::Home => "HOME",
         }
     }
@@ -45,6 +57,7 @@ impl Mode {
             Mode::Sine => "Sine wave",
             Mode::Function => "Function y=f(x)",
             Mode::Settings => "Settings",
+            Mode::Presets => "Speed presets",
             Mode::Home => "Home ($H)",
         }
     }

@@ -228,15 +228,53 @@ fn mode_list_by_digit_and_by_navigation() {
     for _ in 0..20 {
         m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
     }
-    assert_eq!(m.selected(), Mode::Home, "stops at the bottom, no wrap");
-    m.handle(KeyEvent::Press(Key::A), &idle(), &s);
-    m.handle(KeyEvent::Press(Key::A), &idle(), &s);
+    assert_eq!(m.selected(), Mode::Presets, "stops at the bottom, no wrap");
+    for _ in 0..3 {
+        m.handle(KeyEvent::Press(Key::A), &idle(), &s);
+    }
     m.handle(KeyEvent::Press(Key::Hash), &idle(), &s);
     assert_eq!(form(&m).mode(), Mode::Function);
     type_keys(&mut m, "D 4", &idle());
     assert_eq!(form(&m).mode(), Mode::Ellipse);
     type_keys(&mut m, "D 7", &idle());
-    assert_eq!(*m.screen(), Screen::Settings { first_line: 0 });
+    assert_eq!(*m.screen(), Screen::Settings(SettingPage::new()));
+    type_keys(&mut m, "D 9", &idle());
+    assert_eq!(*m.screen(), Screen::Presets(SpeedPreset::FinePen));
+}
+
+#[test]
+fn a_setting_is_typed_checked_and_handed_on() {
+    let mut m = Menu::new();
+    // $0, then down the list to $110 (the 17th).
+    type_keys(&mut m, "7", &idle());
+    let Screen::Settings(page) = m.screen() else { panic!("{:?}", m.screen()) };
+    assert_eq!(page.info().id, 0);
+    type_keys(&mut m, &"B".repeat(16), &idle());
+    let Screen::Settings(page) = m.screen() else { panic!("{:?}", m.screen()) };
+    assert_eq!(page.info().id, 110);
+    // Out of range (1..60000): said, and the value stays to be corrected.
+    assert_eq!(type_keys(&mut m, "7 0 0 0 0 #", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::OutOfRange { min: 1.0, max: 60_000.0, unit: Unit::MmPerMin }));
+    assert_eq!(type_keys(&mut m, "B #", &idle()), [MenuAction::SetSetting { id: 110, value: 7000.0 }]);
+    // A whole-number setting ($1) refuses a fraction; D drops the value, then leaves.
+    type_keys(&mut m, &"A".repeat(15), &idle());
+    assert_eq!(type_keys(&mut m, "2 * 5 #", &idle()), []);
+    assert_eq!(m.message(), Some(UiError::NotWhole));
+    type_keys(&mut m, "D", &idle());
+    let Screen::Settings(page) = m.screen() else { panic!("{:?}", m.screen()) };
+    assert_eq!((page.info().id, page.edit()), (1, None));
+    type_keys(&mut m, "D", &idle());
+    assert_eq!(*m.screen(), Screen::Modes);
+}
+
+#[test]
+fn a_speed_preset_is_picked_and_handed_on() {
+    let mut m = Menu::new();
+    assert_eq!(type_keys(&mut m, "9 B B B #", &idle()), [MenuAction::Preset(SpeedPreset::FastDraft)]);
+    assert_eq!(type_keys(&mut m, "2 #", &idle()), [MenuAction::Preset(SpeedPreset::FeltTip)]);
+    // Not while the machine draws.
+    let drawing = Status { state: RunState::Run, ..Status::default() };
+    assert_eq!(type_keys(&mut m, "1 #", &drawing), []);
 }
 
 /// The shape (in steps) and start of the drawing an action starts.

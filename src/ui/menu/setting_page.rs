@@ -1,0 +1,84 @@
+//! The settings on the keypad: one `$` setting at a time, with its name, value, unit and range.
+//! A number key or `#` starts typing a new value; `#` checks it against the setting's range and
+//! hands it on as a [`MenuAction::SetSetting`], which the keypad task applies (the serial task
+//! then keeps it in flash).
+
+use super::action::MenuAction;
+use super::error::UiError;
+use crate::keypad::Key;
+use crate::settings::{SETTING_INFO, SettingInfo, Settings};
+use crate::ui::entry::NumberEntry;
+
+/// The keys while a value is typed, shown under it.
+pub const SETTING_EDIT_HINT: &str = "#set *. Bdel Dback";
+
+/// The settings screen: the setting shown, and the new value being typed, if any.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SettingPage {
+    /// Into [`SETTING_INFO`].
+    index: usize,
+    edit: Option<NumberEntry>,
+}
+
+impl SettingPage {
+    /// The first setting, shown.
+    pub const fn new() -> Self {
+        SettingPage { index: 0, edit: None }
+    }
+
+    /// The setting shown.
+    pub fn info(&self) -> &'static SettingInfo {
+        &SETTING_INFO[self.index.min(SETTING_INFO.len() - 1)]
+    }
+
+    /// Its position in [`SETTING_INFO`].
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The new value being typed, if any.
+    pub fn edit(&self) -> Option<&NumberEntry> {
+        self.edit.as_ref()
+    }
+
+    /// Drops the value being typed.
+    pub(super) fn cancel(&mut self) {
+        self.edit = None;
+    }
+
+    /// Takes a key. Showing a setting: `A`/`B` step through the list, a number key or `#`
+    /// starts a new value. Typing one: the number keys edit it ([`NumberEntry::press`]), `B` on
+    /// an empty value goes back, `#` gives it, checked.
+    pub(super) fn press(&mut self, key: Key, repeated: bool, settings: &Settings) -> Result<MenuAction, UiError> {
+        let info = self.info();
+        let Some(entry) = &mut self.edit else {
+            match key {
+                Key::A => self.index = self.index.saturating_sub(1),
+                Key::B => self.index = (self.index + 1).min(SETTING_INFO.len() - 1),
+                Key::Hash => self.edit = Some(NumberEntry::new()),
+                Key::Digit(_) | Key::Star => {
+                    let mut entry = NumberEntry::new();
+                    entry.press(key).map_err(UiError::Entry)?;
+                    self.edit = Some(entry);
+                }
+                Key::C | Key::D => {}
+            }
+            return Ok(MenuAction::None);
+        };
+        if key != Key::Hash {
+            if !entry.press(key).map_err(UiError::Entry)? && !repeated {
+                self.edit = None;
+            }
+            return Ok(MenuAction::None);
+        }
+        let value = entry.value().map_err(UiError::Entry)?.ok_or(UiError::Empty)?;
+        if !(info.min..=info.max).contains(&value) {
+            return Err(UiError::OutOfRange { min: info.min, max: info.max, unit: info.unit });
+        }
+        if settings.is_whole(info.id) && value != crate::math::floor(value) {
+            return Err(UiError::NotWhole);
+        }
+        self.edit = None;
+        Ok(MenuAction::SetSetting { id: info.id, value })
+    }
+}

@@ -1,0 +1,66 @@
+//! Settings changed on the machine's own keypad, on the simulated board: the settings screen and
+//! the speed presets write the settings the host link reads, the flash keeps them across a power
+//! cycle, and a change that clashes with the other settings changes nothing and says why.
+
+use servoplot::settings::Settings;
+use servoplot::settings::presets::SpeedPreset;
+use servoplot::sim::flash::SimFlash;
+use servoplot::sim::keys::KeyScript;
+use servoplot::sim::serial::SimSerial;
+use servoplot::sim::{self, SimConfig, SimReport};
+
+mod support;
+
+use support::text;
+
+/// Powers the board on with `flash`, types `keys`, then sends `serial` on the UART link.
+fn power_on(flash: SimFlash, keys: &str, serial: &str) -> SimReport {
+    sim::run(SimConfig {
+        flash,
+        keys: KeyScript::parse(keys).unwrap(),
+        serial: SimSerial::with_input(serial.as_bytes()),
+        keys_start: sim::KeysStart::AtOnce,
+        ..SimConfig::default()
+    })
+}
+
+/// The settings screen (7), down the list to the `n`th setting (`$0` is the first).
+fn settings_screen_at(n: usize) -> String {
+    format!("7 {}", "B ".repeat(n - 1))
+}
+
+#[test]
+fn a_setting_typed_on_the_keypad_is_used_reported_and_kept_across_a_power_cycle() {
+    let first = power_on(SimFlash::default(), &format!("{} 4 5 0 0 # wait:500", settings_screen_at(17)), "");
+    assert_eq!(first.settings.max_rate_mm_per_min, [4500.0, 6000.0]);
+    let (_, last) = first.frames.last().unwrap();
+    assert_eq!((text(last, 1, 24), text(last, 2, 24)), ("$110 X max rate".into(), "4500 mm/min".into()));
+
+    let second = power_on(first.flash.clone(), "", "$$\n");
+    assert_eq!(second.loaded, Ok(()));
+    assert!(second.answers().lines().any(|l| l == "$110=4500.000"), "{}", second.answers());
+}
+
+#[test]
+fn a_speed_preset_writes_its_speeds_and_they_are_kept() {
+    let first = power_on(SimFlash::default(), "9 1 # wait:500", "");
+    let (feed, rate, accel) = SpeedPreset::FinePen.speeds();
+    let s = &first.settings;
+    assert_eq!((s.default_feed_mm_per_min, s.max_rate_mm_per_min, s.accel_mm_per_s2), (feed, [rate; 2], [accel; 2]));
+    let (_, last) = first.frames.last().unwrap();
+    assert_eq!(text(last, 2, 24), ">1 Fine pen *", "the preset in force is marked");
+
+    let second = power_on(first.flash.clone(), "", "$$\n");
+    assert!(SpeedPreset::FinePen.is_set(&second.settings), "{}", second.answers());
+}
+
+#[test]
+fn a_clashing_setting_changes_nothing_and_says_why() {
+    // $201, the start rate, above the axes' top speed of 6000 mm/min.
+    let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(24)), "");
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!(text(last, 1, 24), "$201 Start rate");
+    assert_eq!(text(last, 3, 24), "Clashes with $201 or $0");
+    assert_eq!(report.settings, Settings::default());
+    assert_eq!(report.flash.bytes_changed(), 0);
+}
