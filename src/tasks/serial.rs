@@ -478,45 +478,70 @@ impl<F: NorFlash> Parser<'_, '_, F> {
         Ok(())
     }
 
-    /// Carries out one command of a line of `link`.
+    /// Carries out one command of a line of `link`: waits for what it waits for (the machine at
+    /// rest or stopped, the pen, a dwell), acts, and sends its answer if it has one.
     async fn carry_out(&mut self, link: &Link, settings: &Settings, command: Command) -> Result<(), Unfinished> {
         let (host, machine) = (self.host, self.host.machine);
-        match command {
-            Command::Job(job) => self.queue(link, job).await?,
-            Command::Dwell { ms } => {
-                host.dwell(ms).for_line(link).await?;
-            }
+        if let Command::Job(job) = command {
+            return self.queue(link, job).await;
+        }
+        if matches!(command, Command::Unlock | Command::Home)
+            && InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0
+        {
+            // A driver alarm or the e-stop still raised would trip again at once.
+            link.send(Reply::Message("Driver alarm or e-stop still active")).await;
+            return Err(Unfinished::Error(GrblError::Locked));
+        }
+        // One wait for every command that waits before it acts.
+        let wait = match command {
+            Command::Dwell { ms } => Some(host.dwell(ms)),
+            Command::Pen(pen) => Some(host.pen_to(pen)),
+            // M2/M30 turn the spindle off: a pen lift raises the pen.
+            Command::ProgramEnd if PenLift::of(settings) != PenLift::None => Some(host.pen_to(Pen::Up)),
+            Command::Pause | Command::ProgramEnd => Some(host.machine_at_rest()),
+            Command::Home => Some(host.machine_stopped()),
+            // The motion task drops what a trip cut short before the pulses may go on.
+            Command::Unlock if machine.halted() => Some(host.machine_stopped()),
+            _ => None,
+        };
+        if let Some(wait) = wait {
+            wait.for_line(link).await?;
+        }
+        // The startup blocks may change while a report waits for room: a copy.
+        let startup;
+        let reply = match command {
+            // Queued, or done waiting, above.
+            Command::Job(_) | Command::Dwell { .. } | Command::Pen(_) => None,
             Command::Pause => {
-                host.machine_at_rest().for_line(link).await?;
                 machine.request(Control::Hold);
+                None
             }
-            Command::Pen(pen) => host.pen_to(pen).for_line(link).await?,
-            Command::ProgramEnd => {
-                host.machine_at_rest().for_line(link).await?;
-                // M2/M30 turn the spindle off: a pen lift raises the pen.
-                if PenLift::of(settings) != PenLift::None {
-                    host.pen_to(Pen::Up).for_line(link).await?;
-                }
-                link.send(Reply::Message("Pgm End")).await;
-            }
+            Command::ProgramEnd => Some(Reply::Message("Pgm End")),
             Command::SetSetting { id, value } => {
                 machine
                     .update_settings(|s| s.set(id, value))
                     .map_err(|_| Unfinished::Error(GrblError::InvalidStatement))?;
+                None
             }
             Command::RestoreSettings { startup_lines } => {
                 machine.update_settings(|s| *s = Settings::default());
                 if startup_lines {
                     host.startup.borrow_mut().clear();
                 }
+                None
             }
-            Command::StoreStartupLine { index, line } => host.startup.borrow_mut().set(usize::from(index), line),
-            Command::StoreBuildInfo(line) => host.startup.borrow_mut().build_info = line,
+            Command::StoreStartupLine { index, line } => {
+                host.startup.borrow_mut().set(usize::from(index), line);
+                None
+            }
+            Command::StoreBuildInfo(line) => {
+                host.startup.borrow_mut().build_info = line;
+                None
+            }
             Command::Report(kind) => {
-                // The startup blocks may change while the answer waits for room: a copy.
-                let startup = host.startup.borrow().clone();
+                startup = host.startup.borrow().clone();
                 let gcode = &self.gcode;
-                let reply = match kind {
+                Some(match kind {
                     Report::Help => Reply::Help,
                     Report::Settings => Reply::Settings(settings),
                     Report::ParserState => Reply::ParserState(gcode, settings),
@@ -527,45 +552,36 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                         rx_buffer_bytes: SERIAL_RX_WINDOW_BYTES,
                     },
                     Report::StartupLines => Reply::StartupLines(&startup),
-                };
-                link.send(reply).await
+                })
             }
             Command::Sleep => {
                 machine.sleep();
-                link.send(Reply::Message("Sleeping")).await;
+                Some(Reply::Message("Sleeping"))
             }
             Command::CheckMode { on: true } => {
                 machine.set_check_mode(true);
-                link.send(Reply::Message("Enabled")).await;
+                Some(Reply::Message("Enabled"))
             }
             Command::CheckMode { on: false } => {
-                link.send(Reply::Message("Disabled")).await;
                 self.restart_after_answer = true;
-            }
-            Command::Unlock | Command::Home
-                if InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0 =>
-            {
-                // A driver alarm or the e-stop still raised would trip again at once.
-                link.send(Reply::Message("Driver alarm or e-stop still active")).await;
-                return Err(Unfinished::Error(GrblError::Locked));
+                Some(Reply::Message("Disabled"))
             }
             Command::Home => {
-                host.machine_stopped().for_line(link).await?;
                 machine.request_homing();
                 host.machine_stopped().for_line(link).await?;
                 // A failed cycle pushed its alarm.
                 if machine.run_state() == RunState::Alarm {
                     return Err(Unfinished::Error(GrblError::Locked));
                 }
+                None
             }
             Command::Unlock => {
-                if machine.halted() {
-                    // The motion task drops what a trip cut short before the pulses may go on.
-                    host.machine_stopped().for_line(link).await?;
-                }
                 machine.unlock();
-                link.send(Reply::Message("Caution: Unlocked")).await;
+                Some(Reply::Message("Caution: Unlocked"))
             }
+        };
+        if let Some(reply) = reply {
+            link.send(reply).await;
         }
         Ok(())
     }
