@@ -37,6 +37,7 @@ pub mod son;
 pub mod status;
 pub mod store;
 pub mod tasks;
+pub mod text;
 pub mod ui;
 pub mod unit;
 pub mod watchdog;

@@ -21,6 +21,7 @@ use crate::interp::CurveError;
 use crate::protocol::startup::StartupLines;
 use crate::settings::{SETTING_INFO, Settings};
 use crate::status::{MotionFault, RunState, Status};
+use crate::text::Text;
 
 /// The GRBL version the plotter speaks; senders look for "Grbl 1.1".
 pub const GRBL_VERSION: &str = "1.1h";
@@ -91,12 +92,12 @@ pub fn ok(out: &mut impl Write) -> fmt::Result {
 pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
     match error {
         GrblError::Expression { column, kind } => {
-            write!(out, "[MSG:Expression error at column {}: {}]\r\n", Int::from(column), kind.message())?;
+            write!(out, "[MSG:Expression error at column {}: {}]\r\n", Int::from(column), Text(kind.message()))?;
         }
         GrblError::FunctionUndefined { x_mm, error } => {
             out.write_str("[MSG:Function undefined at x=")?;
             mm(out, x_mm)?;
-            write!(out, ": {}]\r\n", error.message())?;
+            write!(out, ": {}]\r\n", Text(error.message()))?;
         }
         GrblError::Drawing(e) => drawing_refused(out, e)?,
         _ => {}
@@ -114,11 +115,11 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
         DrawError::TooSteep => out.write_str("Sine steeper than the max function jump ($204)")?,
         DrawError::TooFine => out.write_str("Curve finer than the step lattice can draw")?,
         DrawError::Fails { x_mm, error } => {
-            let why = match error {
+            let why = Text(match error {
                 CurveError::Jump => "jumps more than $204",
                 CurveError::Travel => "leaves the travel",
                 _ => "is undefined",
-            };
+            });
             write!(out, "Function {why} after x=")?;
             mm(out, x_mm)?;
         }
@@ -128,7 +129,7 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
 
 /// The banner after power-up and every soft reset; in an alarm, GRBL's hint how to leave it.
 pub fn welcome(out: &mut impl Write, state: RunState) -> fmt::Result {
-    write!(out, "\r\nGrbl {GRBL_VERSION} ['$' for help]\r\n")?;
+    write!(out, "\r\nGrbl {} ['$' for help]\r\n", Text(GRBL_VERSION))?;
     if state == RunState::Alarm {
         message(out, "'$H'|'$X' to unlock")?;
     }
@@ -160,13 +161,13 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
         MotionFault::Homing(fail) => return homing_failed(out, fail),
     };
     let code = if e == CurveError::Travel { ALARM_SOFT_LIMIT } else { ALARM_CURVE_STOPPED };
-    let why = match e {
+    let why = Text(match e {
         CurveError::Domain => "function undefined",
         CurveError::DivisionByZero => "division by zero",
         CurveError::Overflow => "value too large",
         CurveError::Jump => "jump over $204",
         CurveError::Travel => "travel limit",
-    };
+    });
     write!(out, "ALARM:{}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n", Int::from(code))
 }
 
@@ -177,7 +178,7 @@ fn homing_failed(out: &mut impl Write, fail: HomingFail) -> fmt::Result {
         HomingFail::PullOff(axis) => (ALARM_HOMING_PULL_OFF, axis.name(), " switch still pressed after the pull-off"),
         HomingFail::Approach(axis) => (ALARM_HOMING_APPROACH, axis.name(), " switch not found"),
     };
-    write!(out, "ALARM:{}\r\n[MSG:Homing failed: {axis}{why}. '$H' or '$X']\r\n", Int::from(code))
+    write!(out, "ALARM:{}\r\n[MSG:Homing failed: {}{}. '$H' or '$X']\r\n", Int::from(code), Text(axis), Text(why))
 }
 
 /// The alarm of a trip: `ALARM:N`, what tripped, and what clears it.
@@ -187,19 +188,19 @@ fn tripped(out: &mut impl Write, trip: Trip) -> fmt::Result {
         Trip::DriverAlarm(_) => (ALARM_DRIVER, "Driver alarm", "servos off; clear the driver's fault, then '$X'"),
         Trip::EStop => (ALARM_ESTOP, "Emergency stop", "release it, then '$X'"),
     };
-    write!(out, "ALARM:{}\r\n[MSG:{what}", Int::from(code))?;
+    write!(out, "ALARM:{}\r\n[MSG:{}", Int::from(code), Text(what))?;
     match trip {
-        Trip::Limit { axis, max } => write!(out, " {}{}", axis.name(), if max { "+" } else { "-" })?,
-        Trip::DriverAlarm(axis) => write!(out, " {}", axis.name())?,
+        Trip::Limit { axis, max } => write!(out, " {}{}", Text(axis.name()), Text(if max { "+" } else { "-" }))?,
+        Trip::DriverAlarm(axis) => write!(out, " {}", Text(axis.name()))?,
         Trip::EStop => {}
     }
-    write!(out, ": {then}]\r\n")
+    write!(out, ": {}]\r\n", Text(then))
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
 #[inline(never)]
 pub fn message(out: &mut impl Write, text: &str) -> fmt::Result {
-    write!(out, "[MSG:{text}]\r\n")
+    write!(out, "[MSG:{}]\r\n", Text(text))
 }
 
 /// What a status report shows beyond the machine's own [`Status`].
@@ -236,7 +237,7 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
         RunState::Home => "Home",
     };
     let machine = settings.status_report_mask & 1 != 0;
-    write!(out, "<{state}|{}:", if machine { "MPos" } else { "WPos" })?;
+    write!(out, "<{}|{}:", Text(state), Text(if machine { "MPos" } else { "WPos" }))?;
     let [ox, oy] = if machine { [0.0; 2] } else { fields.work_offset_mm };
     let x = settings.steps_to_mm(Axis::X, status.position.x) - ox;
     let y = settings.steps_to_mm(Axis::Y, status.position.y) - oy;
@@ -313,6 +314,8 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
     let system = gcode.work_system().gcode();
     let tool = gcode.tool();
     let (system, tool, feed, speed) = (Int::from(system), Int::from(tool), Int::from(feed), Int::from(speed));
+    let (motion, units, distance, spindle, coolant) =
+        (Text(motion), Text(units), Text(distance), Text(spindle), Text(coolant));
     write!(out, "[GC:{motion} G{system} G17 {units} {distance} G94 {spindle} {coolant} T{tool} F{feed} S{speed}]\r\n")
 }
 
@@ -327,7 +330,7 @@ pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
         xyz_line_end(out, offsets.system_mm(system))?;
     }
     for (name, which) in [("G28", StoredPosition::G28), ("G30", StoredPosition::G30)] {
-        write!(out, "[{name}:")?;
+        write!(out, "[{}:", Text(name))?;
         xyz_line_end(out, offsets.stored_mm(which))?;
     }
     out.write_str("[G92:")?;
@@ -345,7 +348,7 @@ fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
 /// window from `rx_buffer_bytes`, so it must be the serial task's real receive buffer.
 pub fn build_info(out: &mut impl Write, info: &str, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
     let (blocks, rx) = (Int::from(planner_blocks), Int::from(rx_buffer_bytes));
-    write!(out, "[VER:{GRBL_VERSION}.{BUILD_NAME}:{info}]\r\n[OPT:,{blocks},{rx}]\r\n")
+    write!(out, "[VER:{}.{}:{}]\r\n[OPT:,{blocks},{rx}]\r\n", Text(GRBL_VERSION), Text(BUILD_NAME), Text(info))
 }
 
 /// `$`: the commands the plotter understands.
@@ -356,14 +359,14 @@ pub fn help(out: &mut impl Write) -> fmt::Result {
 /// `$N`: every startup block, `$Nn=line` per line, empty ones included.
 pub fn startup_lines(out: &mut impl Write, lines: &StartupLines) -> fmt::Result {
     for (n, line) in lines.all().enumerate() {
-        write!(out, "$N{}={line}\r\n", Int::from(n))?;
+        write!(out, "$N{}={}\r\n", Int::from(n), Text(line))?;
     }
     Ok(())
 }
 
 /// What running a startup block after a reset gave: `>line:ok` or `>line:error:N`.
 pub fn startup_result(out: &mut impl Write, line: &str, result: Result<(), GrblError>) -> fmt::Result {
-    write!(out, ">{line}:")?;
+    write!(out, ">{}:", Text(line))?;
     match result {
         Ok(()) => ok(out),
         Err(e) => write!(out, "error:{}\r\n", Int::from(e.code())),

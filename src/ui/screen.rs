@@ -39,6 +39,7 @@ use crate::settings::SETTING_INFO;
 use crate::settings::Settings;
 use crate::settings::presets::SpeedPreset;
 use crate::status::{MotionFault, RunState, Status};
+use crate::text::{Padded, Text};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
 use crate::ui::glyphs;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
@@ -79,7 +80,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         Screen::Settings(page) => write!(
             Cut(&mut title_text),
             "{} {}/{}",
-            Mode::Settings.title(),
+            Text(Mode::Settings.title()),
             Int::from(page.index() + 1),
             Int::from(SETTING_INFO.len())
         ),
@@ -87,7 +88,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             write!(
                 Cut(&mut title_text),
                 "{} {}/{}",
-                form.mode().title(),
+                Text(form.mode().title()),
                 Int::from(form.field_index() + 1),
                 Int::from(form.mode().fields().len())
             )
@@ -95,7 +96,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
     };
     let state = state_name(status);
     let pad = SCREEN_COLUMNS.saturating_sub(state.len());
-    *title = TextLine::new(format_args!("{:<pad$}{}", title_text.as_str(), state), true);
+    *title = TextLine::new(format_args!("{}{}", Padded::left(&title_text, pad), Text(state)), true);
     *l1 = position_line(status, settings, live.work_offset_mm);
 
     match menu.screen() {
@@ -103,8 +104,8 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             let first = menu.selected().index().min(Mode::ALL.len() - 2);
             for (line, i) in [l2, l3].into_iter().zip(first..) {
                 let mode = Mode::ALL[i];
-                let marker = if mode == menu.selected() { ">" } else { " " };
-                *line = TextLine::new(format_args!("{marker}{} {}", Int::from(i + 1), mode.label()), false);
+                let marker = Text(if mode == menu.selected() { ">" } else { " " });
+                *line = TextLine::new(format_args!("{marker}{} {}", Int::from(i + 1), Text(mode.label())), false);
             }
         }
         Screen::Jog => match menu.jog() {
@@ -120,30 +121,30 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         Screen::Form(form) => match form.field() {
             Some(Field::Number(spec)) => {
                 let entry = form.entry();
-                let sign = if entry.is_negative() { "-" } else { "" };
+                let sign = Text(if entry.is_negative() { "-" } else { "" });
                 *l2 = TextLine::new(
-                    format_args!("{} {}: {sign}{}_", spec.label, spec.unit.symbol(), entry.digits()),
+                    format_args!("{} {}: {sign}{}_", Text(spec.label), Text(spec.unit.symbol()), Text(entry.digits())),
                     false,
                 );
-                *l3 = TextLine::new(format_args!("{}", spec.hint), false);
+                *l3 = TextLine::new(format_args!("{}", Text(spec.hint)), false);
             }
             Some(Field::Preset) => {
                 let p = form.preset();
-                *l2 = TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), p.expression()), false);
+                *l2 = TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
                 *l3 = TextLine::new(format_args!("1-5 or A/B pick, # ok"), false);
             }
             None => {}
         },
         Screen::Settings(page) => {
             let info = page.info();
-            let unit = info.unit.symbol();
-            let gap = if unit.is_empty() { "" } else { " " };
-            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), info.name), false);
+            let unit = Text(info.unit.symbol());
+            let gap = Text(if unit.0.is_empty() { "" } else { " " });
+            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), Text(info.name)), false);
             match page.edit() {
                 Some(entry) => {
-                    let sign = if entry.is_negative() { "-" } else { "" };
-                    *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", entry.digits()), false);
-                    *l3 = TextLine::new(format_args!("{SETTING_EDIT_HINT}"), false);
+                    let sign = Text(if entry.is_negative() { "-" } else { "" });
+                    *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", Text(entry.digits())), false);
+                    *l3 = TextLine::new(format_args!("{}", Text(SETTING_EDIT_HINT)), false);
                 }
                 None => {
                     let value = settings.get(info.id).unwrap_or(0.0);
@@ -158,9 +159,9 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             let first = selected.index().min(SpeedPreset::ALL.len() - 2);
             for (line, i) in [l2, l3].into_iter().zip(first..) {
                 let preset = SpeedPreset::ALL[i];
-                let marker = if preset == *selected { ">" } else { " " };
-                let set = if preset.is_set(settings) { " *" } else { "" };
-                *line = TextLine::new(format_args!("{marker}{} {}{set}", Int::from(i + 1), preset.name()), false);
+                let marker = Text(if preset == *selected { ">" } else { " " });
+                let set = Text(if preset.is_set(settings) { " *" } else { "" });
+                *line = TextLine::new(format_args!("{marker}{} {}{set}", Int::from(i + 1), Text(preset.name())), false);
             }
         }
         Screen::Preview { .. } => {}
@@ -177,14 +178,16 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         let feed = status.overrides.feed_percent;
         let mut what: String<SCREEN_COLUMNS> = String::new();
         let _ = match status.state {
-            RunState::Run if feed != OVERRIDE_NONE_PERCENT => write!(Cut(&mut what), "{doing} F{}%", Int::from(feed)),
+            RunState::Run if feed != OVERRIDE_NONE_PERCENT => {
+                write!(Cut(&mut what), "{} F{}%", Text(doing), Int::from(feed))
+            }
             _ => Cut(&mut what).write_str(doing),
         };
         lines[2] = match status.queued_jobs {
-            0 => TextLine::new(format_args!("{what}"), false),
-            n => TextLine::new(format_args!("{what}, {} queued", Int::from(n)), false),
+            0 => TextLine::new(format_args!("{}", Text(&what)), false),
+            n => TextLine::new(format_args!("{}, {} queued", Text(&what), Int::from(n)), false),
         };
-        lines[3] = TextLine::new(format_args!("{keys}"), false);
+        lines[3] = TextLine::new(format_args!("{}", Text(keys)), false);
     }
     ScreenView { lines, preview: None }
 }
@@ -223,12 +226,14 @@ struct Direction(Step);
 
 impl fmt::Display for Direction {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (v, axis) in [(self.0.x, "X"), (self.0.y, "Y")] {
-            match v {
-                1.. => write!(f, "+{axis}")?,
-                ..0 => write!(f, "-{axis}")?,
-                0 => {}
-            }
+        for (v, axis) in [(self.0.x, 'X'), (self.0.y, 'Y')] {
+            let sign = match v {
+                1.. => '+',
+                ..0 => '-',
+                0 => continue,
+            };
+            f.write_char(sign)?;
+            f.write_char(axis)?;
         }
         Ok(())
     }
@@ -242,7 +247,9 @@ impl fmt::Display for ErrorText {
             UiError::Entry(EntryError::TooLong) => write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
             UiError::Entry(EntryError::NotANumber) => f.write_str("Not a number"),
             UiError::Empty => f.write_str("Type a value"),
-            UiError::OutOfRange { min, max, unit } => write!(f, "Range {}..{} {}", Num(min), Num(max), unit.symbol()),
+            UiError::OutOfRange { min, max, unit } => {
+                write!(f, "Range {}..{} {}", Num(min), Num(max), Text(unit.symbol()))
+            }
             UiError::Zero => f.write_str("Must not be 0"),
             UiError::SameEnds => f.write_str("x1 must differ from x0"),
             UiError::Drawing(DrawError::Travel) => f.write_str("Beyond travel limits"),
@@ -269,13 +276,13 @@ impl fmt::Display for FaultText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let why = match self.0 {
             MotionFault::Tripped(Trip::Limit { axis, max }) => {
-                return write!(f, "Limit {}{}: $X", axis.name(), if max { "+" } else { "-" });
+                return write!(f, "Limit {}{}: $X", Text(axis.name()), Text(if max { "+" } else { "-" }));
             }
-            MotionFault::Tripped(Trip::DriverAlarm(axis)) => return write!(f, "{} driver alarm", axis.name()),
+            MotionFault::Tripped(Trip::DriverAlarm(axis)) => return write!(f, "{} driver alarm", Text(axis.name())),
             MotionFault::Tripped(Trip::EStop) => "E-stop",
             MotionFault::Homing(HomingFail::Aborted) => return f.write_str("Homing aborted"),
             MotionFault::Homing(HomingFail::PullOff(axis) | HomingFail::Approach(axis)) => {
-                return write!(f, "Homing {} failed", axis.name());
+                return write!(f, "Homing {} failed", Text(axis.name()));
             }
             MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
             MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
@@ -283,7 +290,7 @@ impl fmt::Display for FaultText {
             MotionFault::Curve(CurveError::Jump) => "jump too large",
             MotionFault::Curve(CurveError::Travel) => "travel limit",
         };
-        write!(f, "Stopped: {why}")
+        write!(f, "Stopped: {}", Text(why))
     }
 }
 

@@ -18,6 +18,7 @@ use crate::job::{Feed, Job};
 use crate::keypad::Key;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
+use crate::text::Text;
 use crate::ui::entry::NumberEntry;
 use crate::ui::presets::FunctionPreset;
 use crate::ui::run::{JOB_NAME_CHARS, Plan};
@@ -312,7 +313,7 @@ impl Form {
             Mode::Circle => write!(name, "Arc r{} {}deg", n(0), n(2)),
             Mode::Ellipse => write!(name, "Ellipse {}x{}", n(0), n(1)),
             Mode::Sine => write!(name, "Sine A{} P{}", n(0), n(1)),
-            Mode::Function => write!(name, "y={}", self.preset.expression()),
+            Mode::Function => write!(name, "y={}", Text(self.preset.expression())),
             Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => {
                 name.push_str(self.mode.label()).map_err(|_| core::fmt::Error)
             }

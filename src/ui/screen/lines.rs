@@ -9,6 +9,7 @@ use heapless::String;
 use crate::geom::{self, Axis};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
+use crate::text::{Padded, Text};
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINES};
 use crate::ui::trail::Trail;
 
@@ -112,7 +113,7 @@ pub(super) fn position_in(
     let x = mm_text(settings.steps_to_mm(Axis::X, status.position.x) - offset_mm[0], width);
     let y = mm_text(settings.steps_to_mm(Axis::Y, status.position.y) - offset_mm[1], width);
     // Inverted while the position may be wrong: until homed.
-    let line = format_args!("{prefix}X{:>w$} Y{:>w$}", x.as_str(), y.as_str(), w = width);
+    let line = format_args!("{}X{} Y{}", Text(prefix), Padded::right(&x, width), Padded::right(&y, width));
     TextLine::new(line, status.position_lost)
 }
 

@@ -26,6 +26,7 @@ use super::lines::{Live, PreviewBox, ScreenView, TextLine, position_in, state_na
 use crate::decimal::{Int, write_digits};
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
+use crate::text::{Padded, Text};
 use crate::ui::layout::{
     PREVIEW_BESIDE_WIDTH_PX, PREVIEW_CONFIRM_WIDTH_PX, SCREEN_CHAR_WIDTH_PX, SCREEN_COLUMNS, SCREEN_HEIGHT_PX,
     SCREEN_MARGIN_PX, SCREEN_WIDTH_PX,
@@ -64,7 +65,7 @@ pub(super) fn preview_view(plan: &Plan, status: &Status) -> ScreenView {
     let w = columns_beside(PREVIEW_CONFIRM_WIDTH_PX);
     ScreenView {
         lines: [
-            TextLine::new(format_args!("{:<w$.w$}", plan.name.as_str()), true),
+            TextLine::new(format_args!("{}", Padded::left(&plan.name, w)), true),
             line(format_args!("Time ~{}", Clock(plan.estimate_ms))),
             line(format_args!("# draw")),
             line(format_args!("D back")),
@@ -108,10 +109,10 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             let w = SCREEN_COLUMNS - state.len();
             ScreenView {
                 lines: [
-                    TextLine::new(format_args!("{:<w$.w$}{state}", name), true),
+                    TextLine::new(format_args!("{}{}", Padded::left(name, w), Text(state)), true),
                     position_in(status, settings, live.work_offset_mm, "W ", 9),
                     position_in(status, settings, [0.0; 2], "M ", 9),
-                    line(format_args!("{}", if done { "Any key: back" } else { "C hold D abort # page" })),
+                    line(format_args!("{}", Text(if done { "Any key: back" } else { "C hold D abort # page" }))),
                 ],
                 preview: None,
             }
@@ -132,7 +133,7 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             let speed = if done { 0 } else { (live.speed_mm_per_min + 0.5) as i32 };
             ScreenView {
                 lines: [
-                    TextLine::new(format_args!("{:<w$.w$} {state}", name), true),
+                    TextLine::new(format_args!("{} {}", Padded::left(name, w), Text(state)), true),
                     position_in(status, settings, live.work_offset_mm, "", 7),
                     progress,
                     line(format_args!("F{} mm/min {}%", Int::from(speed), Int::from(status.overrides.feed_percent))),
