@@ -68,7 +68,7 @@ impl NumberEntry {
 
     /// Appends the decimal point (a second one is ignored); a leading point becomes `0.`.
     pub fn push_point(&mut self) -> Result<(), EntryError> {
-        if self.text.contains('.') {
+        if self.text.bytes().any(|b| b == b'.') {
             return Ok(());
         }
         let needed = if self.text.is_empty() { 2 } else { 1 };

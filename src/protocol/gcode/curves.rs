@@ -113,7 +113,10 @@ impl GcodeState {
         });
         let (y_at, expr_at) =
             found.ok_or(if seen_y { GrblError::BadNumberFormat } else { GrblError::ValueWordMissing })?;
-        let expr_text = rest.get(expr_at..).unwrap_or("").split(';').next().unwrap_or("");
+        // Up to a `;` comment.
+        let expr_text = rest.get(expr_at..).unwrap_or("");
+        let comment_at = expr_text.bytes().position(|b| b == b';').unwrap_or(expr_text.len());
+        let expr_text = expr_text.get(..comment_at).unwrap_or(expr_text);
         let head = compact(rest.get(..y_at).unwrap_or(""), true)?;
         // `head` starts with the command letter F.
         let (mut words, feed) = self.curve_words(head.get(1..).unwrap_or(&[]), settings)?;
