@@ -85,8 +85,8 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
     let done = run.ended_ms.is_some();
     let state = match status.state {
         _ if done => "DONE",
-        // Confirmed, waiting for the servos or the pen.
-        RunState::Idle => "START",
+        // Confirmed, waiting for the servos or the pen (short, so the name keeps its figures).
+        RunState::Idle => "GO",
         _ => state_name(status),
     };
     let name = match &run.plan {
