@@ -46,6 +46,7 @@ use crate::ui::run::{Plan, Run, RunPage};
 mod action;
 mod error;
 mod form;
+mod list;
 mod mode;
 mod setting_page;
 #[cfg(test)]
@@ -311,18 +312,10 @@ impl Menu {
             Screen::Modes => self.press_modes(key, settings),
             Screen::Settings(page) => page.press(key, repeated, settings),
             Screen::Presets(preset) => {
-                let last = SpeedPreset::ALL.len() - 1;
-                match key {
-                    Key::A => *preset = SpeedPreset::ALL[preset.index().saturating_sub(1)],
-                    Key::B => *preset = SpeedPreset::ALL[(preset.index() + 1).min(last)],
-                    Key::Digit(d) => {
-                        if let Some(&p) = (d as usize).checked_sub(1).and_then(|i| SpeedPreset::ALL.get(i)) {
-                            *preset = p;
-                        }
-                    }
-                    Key::Hash => return MenuAction::Preset(*preset),
-                    _ => {}
+                if key == Key::Hash {
+                    return MenuAction::Preset(*preset);
                 }
+                *preset = SpeedPreset::ALL[list::moved(preset.index(), SpeedPreset::ALL.len(), key)];
                 Ok(MenuAction::None)
             }
             Screen::Jog => match jog_step(key) {
@@ -361,20 +354,15 @@ impl Menu {
         })
     }
 
+    /// The mode list: a digit enters its mode at once.
     fn press_modes(&mut self, key: Key, settings: &Settings) -> Result<MenuAction, UiError> {
-        let last = Mode::ALL.len() - 1;
+        let at = list::moved(self.selected.index(), Mode::ALL.len(), key);
+        self.selected = Mode::ALL[at];
         match key {
-            Key::Digit(d) => {
-                if let Some(&mode) = (d as usize).checked_sub(1).and_then(|i| Mode::ALL.get(i)) {
-                    return self.enter(mode, settings);
-                }
-            }
-            Key::A => self.selected = Mode::ALL[self.selected.index().saturating_sub(1)],
-            Key::B => self.selected = Mode::ALL[(self.selected.index() + 1).min(last)],
-            Key::Hash => return self.enter(self.selected, settings),
-            _ => {}
+            Key::Hash => self.enter(self.selected, settings),
+            Key::Digit(d) if usize::from(d) == at + 1 => self.enter(self.selected, settings),
+            _ => Ok(MenuAction::None),
         }
-        Ok(MenuAction::None)
     }
 
     /// Enters `mode`'s screen; homing starts at once, from the mode list.

@@ -10,6 +10,7 @@ use heapless::String;
 
 use super::action::MenuAction;
 use super::error::UiError;
+use super::list;
 use super::mode::Mode;
 use crate::decimal::Num;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
@@ -199,14 +200,8 @@ impl Form {
         let entry = &mut self.entries[self.field.min(FORM_MAX_FIELDS - 1)];
         match (field, key) {
             (_, Key::Hash) => return self.confirm(status, settings),
-            (Field::Preset, Key::Digit(d)) => {
-                if let Some(&p) = (d as usize).checked_sub(1).and_then(|i| FunctionPreset::ALL.get(i)) {
-                    self.preset = p;
-                }
-            }
-            (Field::Preset, Key::A) => self.preset = FunctionPreset::ALL[self.preset.index().saturating_sub(1)],
-            (Field::Preset, Key::B) => {
-                self.preset = FunctionPreset::ALL[(self.preset.index() + 1).min(FunctionPreset::ALL.len() - 1)]
+            (Field::Preset, key) => {
+                self.preset = FunctionPreset::ALL[list::moved(self.preset.index(), FunctionPreset::ALL.len(), key)]
             }
             (Field::Number(_), key) => {
                 let deleted = entry.press(key).map_err(UiError::Entry)?;
@@ -215,7 +210,6 @@ impl Form {
                     self.field -= 1;
                 }
             }
-            _ => {}
         }
         Ok(None)
     }

@@ -5,6 +5,7 @@
 
 use super::action::MenuAction;
 use super::error::UiError;
+use super::list;
 use crate::keypad::Key;
 use crate::settings::{SETTING_INFO, SettingInfo, Settings};
 use crate::ui::entry::NumberEntry;
@@ -53,8 +54,7 @@ impl SettingPage {
         let info = self.info();
         let Some(entry) = &mut self.edit else {
             match key {
-                Key::A => self.index = self.index.saturating_sub(1),
-                Key::B => self.index = (self.index + 1).min(SETTING_INFO.len() - 1),
+                Key::A | Key::B => self.index = list::moved(self.index, SETTING_INFO.len(), key),
                 Key::Hash => self.edit = Some(NumberEntry::new()),
                 Key::Digit(_) | Key::Star => {
                     let mut entry = NumberEntry::new();
