@@ -2,7 +2,8 @@
 //!
 //! Settings are numbered like GRBL's `$` settings where GRBL has an equivalent, so existing
 //! senders show them correctly; the plotter's own settings use numbers GRBL leaves free.
-//! A value outside its range is refused with [`SettingError`] and changes nothing.
+//! A value outside its range is refused with [`SettingError`] and changes nothing. [`presets`]
+//! names sets of speeds the keypad writes at once.
 
 pub mod presets;
 

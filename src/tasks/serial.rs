@@ -30,8 +30,9 @@
 //!
 //! The line loop owns the flash store: once a line has changed what a power cycle keeps
 //! (settings, G54–G59, G28/G30, startup blocks, build info), it waits for the machine to stop
-//! and saves before the line's `ok`, as GRBL writes its EEPROM. At power-on the startup blocks
-//! kept there run, answered on every link.
+//! and saves before the line's `ok`, as GRBL writes its EEPROM; settings changed at the keypad
+//! wake it too, and are saved once the machine has stopped. At power-on the startup blocks kept
+//! there run, answered on every link.
 //!
 //! A link whose port can be closed (USB) reports each closing as a read error of kind
 //! `NotConnected`: the line the host was sending when it closed the port is dropped.
