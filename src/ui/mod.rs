@@ -1,9 +1,11 @@
 //! The machine's own user interface: the keypad menu and the LCD screen.
 //!
-//! [`menu`] turns key events (from [`crate::keypad`]) into jobs, controls and jogs; [`entry`]
-//! holds the number being typed; [`presets`] names the functions the keypad offers; [`screen`]
-//! draws it all on the 122x32 LCD, whose sizes are in [`layout`]. Everything here is pure: no
-//! clock, no pins, no waiting.
+//! [`menu`] turns key events (from [`crate::keypad`]) into jobs, controls, jogs and settings;
+//! [`entry`] holds the number being typed; [`presets`] names the functions the keypad offers;
+//! [`run`] follows a drawing (its plan, progress and time) and [`trail`] keeps its path as a
+//! bounded polyline; [`screen`] draws it all on the 122x32 LCD, whose sizes are in [`layout`],
+//! its text glyph by glyph ([`glyphs`]). Everything here is pure: no clock, no pins, no
+//! waiting.
 
 pub mod entry;
 pub mod glyphs;
