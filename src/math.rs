@@ -3,10 +3,11 @@
 //! The Cortex-M4F's FPU works in `f32` only; `f64` arithmetic there is a software library tens
 //! of times slower, so the firmware has none. Square roots are the FPU's own instruction. The
 //! elementary functions are computed in `f32` throughout: our own where `libm` computes in
-//! `f64` inside (`sinf`, `cosf`, `tanf` and `asinf` do, `acosf` uses a software square root),
-//! `libm`'s `f32` functions where they stay in `f32` (exp, ln, atan, atan2, floor, ceil,
-//! round, trunc), and the decimal logarithm and the power from exp and ln. `min` and `max` are
-//! plain comparisons: `f32::min` is a library call on this FPU.
+//! `f64` inside (`sinf`, `cosf`, `tanf` and `asinf` do, `acosf` uses a software square root)
+//! or where a little less accuracy takes much less code (atan and atan2), `libm`'s `f32`
+//! functions where they stay in `f32` (exp, ln, floor, ceil, round, trunc), and the decimal
+//! logarithm and the power from exp and ln. `min` and `max` are plain comparisons: `f32::min`
+//! is a library call on this FPU.
 //!
 //! Owns no state. Everything here is a pure function of its arguments.
 
@@ -171,6 +172,62 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 }
 
 // ----- inverse functions ----------------------------------------------------------------------
+//
+// The angle of (x, y) is k·π/2 + atan t with k = 0, 1 or 2 and |t| ≤ 1: for |y| ≤ |x| it is
+// atan(|y|/x), plus π if x < 0; for |y| > |x| it is π/2 + atan(-x/|y|); y's sign is the
+// result's. One division, then atan t ≈ t + t·z·(A0 + z·(A1 + … + z·A7)) with z = t², minimax
+// (Remez exchange, relative error) on [0, 1]: within 1.9e-8 of atan t relatively with the
+// coefficients rounded to f32, a third of an ulp. The rest is the f32 arithmetic: near |t| = 1
+// the term t·z·(…) is a quarter of the result and its roundings add up to most of an ulp, and
+// the quotient's rounding (half an ulp of t) is up to 0.8 ulp of the angle where t's ulp is
+// twice the angle's. Checked on the host: atan over every f32 within 1.42 ulp, atan2 over 10⁹
+// random pairs within 1.77 ulp. One function for both saves the 600 bytes of `libm`'s, which
+// are within 1 ulp and 1.5 ulp through breakpoints and tables.
+
+const A0: f32 = -3.333_315_3e-1;
+const A1: f32 = 1.999_377_3e-1;
+const A2: f32 = -1.421_105_6e-1;
+const A3: f32 = 1.066_600_4e-1;
+const A4: f32 = -7.552_213e-2;
+const A5: f32 = 4.321_185e-2;
+const A6: f32 = -1.636_792_3e-2;
+const A7: f32 = 2.920_691_2e-3;
+
+/// π/2 minus its f32, `FRAC_PI_2`: k·π/2 is `k·FRAC_PI_2 + k·FRAC_PI_2_REST` to 4e-15.
+const FRAC_PI_2_REST: f32 = -4.371_139e-8;
+
+/// atan x (radians, in [-π/2, π/2]) as the angle of (1, x): within 1.5 ulp. ±0 → ±0, ±∞ →
+/// ±π/2, NaN → NaN.
+pub fn atan(x: f32) -> f32 {
+    atan2(x, 1.0)
+}
+
+/// The angle of (x, y) (radians, in [-π, π]): within 2 ulp. Zeros and infinities as IEEE 754
+/// has them, the sign always y's: atan2(±0, +0) = ±0, atan2(±0, -0) = ±π, atan2(±∞, +∞) =
+/// ±π/4, atan2(±∞, -∞) = ±3π/4. NaN if either is NaN.
+pub fn atan2(y: f32, x: f32) -> f32 {
+    let (a, b) = (x.abs(), y.abs());
+    let steep = b > a;
+    let k = if steep {
+        1.0
+    } else if x.is_sign_negative() {
+        2.0
+    } else {
+        0.0
+    };
+    let t = if steep {
+        -x / b
+    } else if a == b {
+        // Here too (0, 0) and (∞, ∞), whose quotients would be NaN.
+        if a == 0.0 { 0.0 } else { 1.0f32.copysign(x) }
+    } else {
+        b / x
+    };
+    let z = t * t;
+    let c = t * z * (A0 + z * (A1 + z * (A2 + z * (A3 + z * (A4 + z * (A5 + z * (A6 + z * A7)))))));
+    let angle = k * core::f32::consts::FRAC_PI_2 + (t + (c + k * FRAC_PI_2_REST));
+    angle.copysign(y)
+}
 
 /// asin x (radians, in [-π/2, π/2]) as atan2(x, √((1-x)(1+x))), with the FPU's square root:
 /// within 2.5 ulp. NaN outside [-1, 1].
@@ -184,17 +241,7 @@ pub fn acos(x: f32) -> f32 {
     atan2(sqrt((1.0 - x) * (1.0 + x)), x)
 }
 
-// ----- libm's f32 functions that stay in f32 (each checked within 1 ulp, atan2 1.5 ulp) --------
-
-/// atan x (radians, in [-π/2, π/2]).
-pub fn atan(x: f32) -> f32 {
-    libm::atanf(x)
-}
-
-/// The angle of (x, y) (radians, in [-π, π]).
-pub fn atan2(y: f32, x: f32) -> f32 {
-    libm::atan2f(y, x)
-}
+// ----- libm's f32 functions that stay in f32 (each checked within 1 ulp) ----------------------
 
 /// e^x.
 pub fn exp(x: f32) -> f32 {
