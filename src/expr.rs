@@ -103,17 +103,18 @@ pub enum ParseErrorKind {
 }
 
 impl ParseErrorKind {
-    /// A short English description, for the serial link and the display.
+    /// A short English description, for the serial link and the display (with the column,
+    /// it fits one LCD line).
     pub const fn message(self) -> &'static str {
         match self {
-            ParseErrorKind::UnexpectedChar => "unexpected character",
+            ParseErrorKind::UnexpectedChar => "not expected here",
             ParseErrorKind::UnexpectedEnd => "unexpected end",
             ParseErrorKind::UnknownName => "unknown name",
-            ParseErrorKind::MismatchedParen => "mismatched parenthesis",
-            ParseErrorKind::TooLong => "expression too long",
-            ParseErrorKind::TooComplex => "expression too complex",
-            ParseErrorKind::WrongArgCount => "wrong number of arguments",
-            ParseErrorKind::NumberOutOfRange => "number out of range",
+            ParseErrorKind::MismatchedParen => "unmatched ( or )",
+            ParseErrorKind::TooLong => "too long",
+            ParseErrorKind::TooComplex => "too complex",
+            ParseErrorKind::WrongArgCount => "argument count",
+            ParseErrorKind::NumberOutOfRange => "number too large",
         }
     }
 }
@@ -148,7 +149,8 @@ pub enum EvalError {
 }
 
 impl EvalError {
-    /// A short English description, for the serial link and the display.
+    /// A short English description, for the serial link and the display (with the column,
+    /// it fits one LCD line).
     pub const fn message(self) -> &'static str {
         match self {
             EvalError::SqrtOfNegative => "sqrt of a negative number",

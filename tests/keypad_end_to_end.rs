@@ -82,3 +82,14 @@ fn the_lcd_redraws_at_most_ten_times_a_second_and_only_on_change() {
     assert!(report.frames.windows(2).all(|w| w[0].1 != w[1].1), "a frame was sent that changed nothing");
     assert!(report.frames.len() > 10, "the position was redrawn while moving");
 }
+
+#[test]
+fn a_function_typed_on_the_keypad_draws_what_the_host_link_draws() {
+    // Function mode (6), C to type from the first preset (x^2/20), B B B leaves x^2, then A
+    // turns the wheel to / and C puts it, 4 0 divides by 40: x^2/40 from x0 = 0 to x1 = 20 mm.
+    let keys = sim::run_keys("6 C B B B A A A A A A C 4 0 # 0 # 2 0 # #").unwrap();
+    let serial = sim::run_serial("$F X0 U20 Y=x^2/40\n");
+    assert!(serial.answers().contains("ok"), "{}", serial.answers());
+    assert_eq!(keys.path(), serial.path(), "same steps in the same order");
+    assert_eq!(keys.position, Point::new(2000, 1000));
+}

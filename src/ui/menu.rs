@@ -289,9 +289,13 @@ impl Menu {
             self.screen = match &mut self.screen {
                 // Back from the preview to the form, as typed.
                 Screen::Preview { form, .. } => Screen::Form(form.clone()),
-                // Back from a value being typed to the setting.
+                // Back from a value being typed to the setting, from a function to the presets.
                 Screen::Settings(page) if page.edit().is_some() => {
                     page.cancel();
+                    return MenuAction::None;
+                }
+                Screen::Form(form) if form.typing() => {
+                    form.stop_typing();
                     return MenuAction::None;
                 }
                 _ => Screen::Modes,

@@ -8,6 +8,7 @@
 //! waiting.
 
 pub mod entry;
+pub mod expr_entry;
 pub mod glyphs;
 pub mod layout;
 pub mod menu;

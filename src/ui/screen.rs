@@ -128,11 +128,21 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                 );
                 *l3 = TextLine::new(format_args!("{}", Text(spec.hint)), false);
             }
-            Some(Field::Preset) => {
-                let p = form.preset();
-                *l2 = TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
-                *l3 = TextLine::new(format_args!("1-5 or A/B pick, # ok"), false);
-            }
+            Some(Field::Preset) => match form.typed() {
+                Some(typed) => {
+                    // The end of the text, where it is typed.
+                    let text = typed.text();
+                    let shown = text.get(text.len().saturating_sub(SCREEN_COLUMNS - 3)..).unwrap_or(text);
+                    *l2 = TextLine::new(format_args!("y={}_", Text(shown)), false);
+                    *l3 = TextLine::new(format_args!("A>{} C put B del #", Text(typed.token())), false);
+                }
+                None => {
+                    let p = form.preset();
+                    *l2 =
+                        TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
+                    *l3 = TextLine::new(format_args!("1-5/AB pick C type # ok"), false);
+                }
+            },
             None => {}
         },
         Screen::Settings(page) => {
@@ -244,6 +254,7 @@ struct ErrorText(UiError);
 impl fmt::Display for ErrorText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.0 {
+            UiError::Expression(e) => write!(f, "Col {} {}", Int::from(e.pos + 1), Text(e.kind.message())),
             UiError::Entry(EntryError::TooLong) => write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
             UiError::Entry(EntryError::NotANumber) => f.write_str("Not a number"),
             UiError::Empty => f.write_str("Type a value"),

@@ -1,6 +1,7 @@
 //! Why the menu refused a key or a job: the [`UiError`] it shows until the next key.
 
 use crate::drawing::DrawError;
+use crate::expr::ParseError;
 use crate::ui::entry::EntryError;
 use crate::unit::Unit;
 
@@ -9,6 +10,8 @@ use crate::unit::Unit;
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum UiError {
     Entry(EntryError),
+    /// The typed function does not parse: why, and where.
+    Expression(ParseError),
     /// `#` on an empty field that has no default.
     Empty,
     OutOfRange {

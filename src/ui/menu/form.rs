@@ -14,6 +14,7 @@ use super::list;
 use super::mode::Mode;
 use crate::decimal::Num;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
+use crate::expr::Expr;
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job};
 use crate::keypad::Key;
@@ -21,6 +22,7 @@ use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::Text;
 use crate::ui::entry::NumberEntry;
+use crate::ui::expr_entry::ExprEntry;
 use crate::ui::presets::FunctionPreset;
 use crate::ui::run::{JOB_NAME_CHARS, Plan};
 use crate::unit::Unit;
@@ -144,6 +146,8 @@ pub struct Form {
     field: usize,
     entries: [NumberEntry; FORM_MAX_FIELDS],
     preset: FunctionPreset,
+    /// A function typed instead of a preset (`C` on the function field).
+    typed: Option<ExprEntry>,
     /// The form started its drawing: it stays as typed (no empty form flashes up before the
     /// drawing shows) until the next key starts a new one.
     started: bool,
@@ -156,6 +160,7 @@ impl Form {
             field: 0,
             entries: [const { NumberEntry::new() }; FORM_MAX_FIELDS],
             preset: FunctionPreset::Parabola,
+            typed: None,
             started: false,
         }
     }
@@ -184,6 +189,21 @@ impl Form {
         self.preset
     }
 
+    /// The function being typed or typed (function mode), if one is.
+    pub fn typed(&self) -> Option<&ExprEntry> {
+        self.typed.as_ref()
+    }
+
+    /// True while a function is typed on the function field.
+    pub fn typing(&self) -> bool {
+        self.typed.is_some() && self.field() == Some(&Field::Preset)
+    }
+
+    /// `D` while a function is typed: back to the presets.
+    pub(super) fn stop_typing(&mut self) {
+        self.typed = None;
+    }
+
     /// Takes a key; `#` on the last field builds the drawing and gives its plan, for the
     /// preview.
     pub(super) fn press(
@@ -194,15 +214,24 @@ impl Form {
         settings: &Settings,
     ) -> Result<Option<Plan>, UiError> {
         if self.started {
-            *self = Form { preset: self.preset, ..Form::new(self.mode) };
+            *self = Form { preset: self.preset, typed: self.typed.take(), ..Form::new(self.mode) };
         }
         let Some(field) = self.field() else { return Ok(None) };
         let entry = &mut self.entries[self.field.min(FORM_MAX_FIELDS - 1)];
         match (field, key) {
             (_, Key::Hash) => return self.confirm(status, settings),
-            (Field::Preset, key) => {
-                self.preset = FunctionPreset::ALL[list::moved(self.preset.index(), FunctionPreset::ALL.len(), key)]
-            }
+            (Field::Preset, key) => match &mut self.typed {
+                Some(typed) => {
+                    // An empty text gives way to the presets, on a fresh press only.
+                    if !typed.press(key).map_err(UiError::Expression)? && !repeated {
+                        self.typed = None;
+                    }
+                }
+                None if key == Key::C => self.typed = Some(ExprEntry::new(self.preset.expression())),
+                None => {
+                    self.preset = FunctionPreset::ALL[list::moved(self.preset.index(), FunctionPreset::ALL.len(), key)]
+                }
+            },
             (Field::Number(_), key) => {
                 let deleted = entry.press(key).map_err(UiError::Entry)?;
                 // An empty field gives way to the previous one, on a fresh press only.
@@ -216,8 +245,14 @@ impl Form {
 
     /// `#`: checks the field, then moves on or, after the last one, builds the job.
     fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<Option<Plan>, UiError> {
-        if let Some(Field::Number(spec)) = self.field() {
-            spec.value(self.entry())?;
+        match self.field() {
+            Some(Field::Number(spec)) => {
+                spec.value(self.entry())?;
+            }
+            Some(Field::Preset) => {
+                self.function()?;
+            }
+            None => {}
         }
         if self.field + 1 < self.mode.fields().len() {
             self.field += 1;
@@ -234,6 +269,16 @@ impl Form {
         let job = self.job(status, settings)?;
         self.started = true;
         Ok(MenuAction::Start(job))
+    }
+
+    /// The function's text: typed, or the preset's.
+    fn function_text(&self) -> &str {
+        self.typed.as_ref().map_or(self.preset.expression(), ExprEntry::text)
+    }
+
+    /// The function, parsed. (The presets parse: a unit test checks every one.)
+    fn function(&self) -> Result<Expr, UiError> {
+        crate::expr::parse(self.function_text()).map_err(UiError::Expression)
     }
 
     /// The checked value of number field `i`.
@@ -278,10 +323,7 @@ impl Form {
                 if x0_mm == x1_mm {
                     return Err(UiError::SameEnds);
                 }
-                // The presets are written in the expression language and parse (a unit test
-                // checks every one).
-                let expr = crate::expr::parse(self.preset.expression()).map_err(|_| UiError::Empty)?;
-                Request::Function { expr, x0_mm, x1_mm }
+                Request::Function { expr: self.function()?, x0_mm, x1_mm }
             }
             Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => return Err(UiError::Empty),
         })
@@ -307,7 +349,7 @@ impl Form {
             Mode::Circle => write!(name, "Arc r{} {}deg", n(0), n(2)),
             Mode::Ellipse => write!(name, "Ellipse {}x{}", n(0), n(1)),
             Mode::Sine => write!(name, "Sine A{} P{}", n(0), n(1)),
-            Mode::Function => write!(name, "y={}", Text(self.preset.expression())),
+            Mode::Function => write!(name, "y={}", Text(self.function_text())),
             Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => {
                 name.push_str(self.mode.label()).map_err(|_| core::fmt::Error)
             }

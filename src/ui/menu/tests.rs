@@ -8,6 +8,7 @@ use crate::geom::{Point, Rotation};
 use crate::interp::Shape;
 use crate::job::{Feed, Job};
 use crate::ui::entry::EntryError;
+use crate::ui::expr_entry::ExprEntry;
 use crate::ui::presets::FunctionPreset;
 use std::vec::Vec;
 
@@ -372,4 +373,25 @@ fn home_runs_the_homing_cycle_when_homing_is_on_and_d_aborts_it() {
     let running = Status { state: RunState::Home, ..Status::default() };
     assert_eq!(m.handle(KeyEvent::Press(Key::Digit(2)), &running, &homing), MenuAction::None, "busy");
     assert_eq!(m.handle(KeyEvent::Press(Key::D), &running, &homing), MenuAction::Control(Control::Abort));
+}
+
+#[test]
+fn a_typed_function_is_drawn_and_its_errors_say_the_column() {
+    let mut m = Menu::new();
+    // C on the function field starts from the preset (x^2/20); three B leave x^2.
+    type_keys(&mut m, "6 C B B B", &idle());
+    assert_eq!(form(&m).typed().map(ExprEntry::text), Some("x^2"));
+    let a = type_keys(&mut m, "# 0# 10#", &idle());
+    let square = Shape::Function { expr: crate::expr::parse("x^2").unwrap(), x0_mm: 0.0, x1_mm: 10.0 };
+    assert_eq!(curve(&a[0]), (square, Point::ORIGIN));
+    // A new form starts from the preset again; x^ does not parse: column 3, the end.
+    type_keys(&mut m, "D 6 C B B B B", &idle());
+    assert_eq!(type_keys(&mut m, "#", &idle()), []);
+    let end = crate::expr::ParseError { kind: crate::expr::ParseErrorKind::UnexpectedEnd, pos: 2 };
+    assert_eq!(m.message(), Some(UiError::Expression(end)));
+    // D goes back to the presets, then to the mode list.
+    type_keys(&mut m, "D", &idle());
+    assert_eq!((form(&m).typed(), form(&m).preset()), (None, FunctionPreset::Parabola));
+    type_keys(&mut m, "D", &idle());
+    assert_eq!(*m.screen(), Screen::Modes);
 }

@@ -314,3 +314,19 @@ fn a_curve_stopped_part_way_is_shown_until_the_next_job() {
     let running = Status { state: RunState::Run, ..stopped };
     assert_ne!(view(&m, &running, &s).lines[3].text.as_str(), "Stopped: f(x) undefined");
 }
+
+#[test]
+fn a_typed_function_shows_its_end_the_wheel_and_its_error() {
+    let mut m = Menu::new();
+    let idle = Status::default();
+    let s = Settings::default();
+    press(&mut m, "6", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["f1 y=x^2/20", "1-5/AB pick C type # ok"]);
+    press(&mut m, "C A A", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["y=x^2/20_", "A>) C put B del #"]);
+    // A long text shows its end, where it is typed.
+    press(&mut m, "C C C C C C C C C C C C C C C C C C C C", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2], "y=0))))))))))))))))))))_");
+    press(&mut m, "#", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[3], "Col 7 unmatched ( or )");
+}
