@@ -111,11 +111,11 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         Screen::Jog => match menu.jog() {
             Some(jog) => {
                 *l2 = TextLine::new(format_args!("Moving {}", Direction(jog.step)), false);
-                *l3 = TextLine::new(format_args!("Release to stop"), false);
+                *l3 = TextLine::plain("Release to stop");
             }
             None => {
-                *l2 = TextLine::new(format_args!("2 +Y 8 -Y 4 -X 6 +X"), false);
-                *l3 = TextLine::new(format_args!("7 9 1 3 diagonal D back"), false);
+                *l2 = TextLine::plain("2 +Y 8 -Y 4 -X 6 +X");
+                *l3 = TextLine::plain("7 9 1 3 diagonal D back");
             }
         },
         Screen::Form(form) => match form.field() {
@@ -126,7 +126,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     format_args!("{} {}: {sign}{}_", Text(spec.label), Text(spec.unit.symbol()), Text(entry.digits())),
                     false,
                 );
-                *l3 = TextLine::new(format_args!("{}", Text(spec.hint)), false);
+                *l3 = TextLine::plain(spec.hint);
             }
             Some(Field::Preset) => match form.typed() {
                 Some(typed) => {
@@ -140,7 +140,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     let p = form.preset();
                     *l2 =
                         TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
-                    *l3 = TextLine::new(format_args!("1-5/AB pick C type # ok"), false);
+                    *l3 = TextLine::plain("1-5/AB pick C type # ok");
                 }
             },
             None => {}
@@ -154,7 +154,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                 Some(entry) => {
                     let sign = Text(if entry.is_negative() { "-" } else { "" });
                     *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", Text(entry.digits())), false);
-                    *l3 = TextLine::new(format_args!("{}", Text(SETTING_EDIT_HINT)), false);
+                    *l3 = TextLine::plain(SETTING_EDIT_HINT);
                 }
                 None => {
                     let value = settings.get(info.id).unwrap_or(0.0);
@@ -194,10 +194,10 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             _ => Cut(&mut what).write_str(doing),
         };
         lines[2] = match status.queued_jobs {
-            0 => TextLine::new(format_args!("{}", Text(&what)), false),
+            0 => TextLine::plain(&what),
             n => TextLine::new(format_args!("{}, {} queued", Text(&what), Int::from(n)), false),
         };
-        lines[3] = TextLine::new(format_args!("{}", Text(keys)), false);
+        lines[3] = TextLine::plain(keys);
     }
     ScreenView { lines, preview: None }
 }
@@ -253,30 +253,31 @@ struct ErrorText(UiError);
 
 impl fmt::Display for ErrorText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.0 {
-            UiError::Expression(e) => write!(f, "Col {} {}", Int::from(e.pos + 1), Text(e.kind.message())),
-            UiError::Entry(EntryError::TooLong) => write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
-            UiError::Entry(EntryError::NotANumber) => f.write_str("Not a number"),
-            UiError::Empty => f.write_str("Type a value"),
+        let text = match self.0 {
+            UiError::Expression(e) => return write!(f, "Col {} {}", Int::from(e.pos + 1), Text(e.kind.message())),
+            UiError::Entry(EntryError::TooLong) => return write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
+            UiError::Entry(EntryError::NotANumber) => "Not a number",
+            UiError::Empty => "Type a value",
             UiError::OutOfRange { min, max, unit } => {
-                write!(f, "Range {}..{} {}", Num(min), Num(max), Text(unit.symbol()))
+                return write!(f, "Range {}..{} {}", Num(min), Num(max), Text(unit.symbol()));
             }
-            UiError::Zero => f.write_str("Must not be 0"),
-            UiError::SameEnds => f.write_str("x1 must differ from x0"),
-            UiError::Drawing(DrawError::Travel) => f.write_str("Beyond travel limits"),
-            UiError::Drawing(DrawError::TooSteep) => f.write_str("too steep: A or 1/P"),
-            UiError::Drawing(DrawError::TooFine) => f.write_str("Finer than a step"),
-            UiError::Drawing(DrawError::BadParameter) => f.write_str("Bad parameter"),
-            UiError::Drawing(DrawError::Setup(_)) => f.write_str("Cannot start here"),
-            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => f.write_str("f(x) jumps too far"),
-            UiError::Drawing(DrawError::Fails { .. }) => f.write_str("f(x) undefined there"),
-            UiError::Busy => f.write_str("Busy: wait, or D abort"),
-            UiError::Alarm => f.write_str("Alarm: motion locked"),
-            UiError::HomingOff => f.write_str("Homing off: $22=1"),
-            UiError::Aborted => f.write_str("Aborted"),
-            UiError::NotWhole => f.write_str("Whole numbers only"),
-            UiError::Clash => f.write_str("Clashes with $201 or $0"),
-        }
+            UiError::Zero => "Must not be 0",
+            UiError::SameEnds => "x1 must differ from x0",
+            UiError::Drawing(DrawError::Travel) => "Beyond travel limits",
+            UiError::Drawing(DrawError::TooSteep) => "too steep: A or 1/P",
+            UiError::Drawing(DrawError::TooFine) => "Finer than a step",
+            UiError::Drawing(DrawError::BadParameter) => "Bad parameter",
+            UiError::Drawing(DrawError::Setup(_)) => "Cannot start here",
+            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => "f(x) jumps too far",
+            UiError::Drawing(DrawError::Fails { .. }) => "f(x) undefined there",
+            UiError::Busy => "Busy: wait, or D abort",
+            UiError::Alarm => "Alarm: motion locked",
+            UiError::HomingOff => "Homing off: $22=1",
+            UiError::Aborted => "Aborted",
+            UiError::NotWhole => "Whole numbers only",
+            UiError::Clash => "Clashes with $201 or $0",
+        };
+        f.write_str(text)
     }
 }
 

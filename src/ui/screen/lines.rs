@@ -30,6 +30,13 @@ impl TextLine {
         let _ = Cut(&mut line.text).write_fmt(args);
         line
     }
+
+    /// `text` as it is, not inverted.
+    pub(super) fn plain(text: &str) -> Self {
+        let mut line = TextLine::default();
+        let _ = Cut(&mut line.text).write_str(text);
+        line
+    }
 }
 
 /// Where a path is shown and what it shows: the plan (the preview's, or the run's), the path

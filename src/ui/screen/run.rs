@@ -67,8 +67,8 @@ pub(super) fn preview_view(plan: &Plan, status: &Status) -> ScreenView {
         lines: [
             TextLine::new(format_args!("{}", Padded::left(&plan.name, w)), true),
             line(format_args!("Time ~{}", Clock(plan.estimate_ms))),
-            line(format_args!("# draw")),
-            line(format_args!("D back")),
+            TextLine::plain("# draw"),
+            TextLine::plain("D back"),
         ],
         preview: Some(PreviewBox {
             area: right_box(PREVIEW_CONFIRM_WIDTH_PX),
@@ -112,7 +112,7 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
                     TextLine::new(format_args!("{}{}", Padded::left(name, w), Text(state)), true),
                     position_in(status, settings, live.work_offset_mm, "W ", 9),
                     position_in(status, settings, [0.0; 2], "M ", 9),
-                    line(format_args!("{}", Text(if done { "Any key: back" } else { "C hold D abort # page" }))),
+                    TextLine::plain(if done { "Any key: back" } else { "C hold D abort # page" }),
                 ],
                 preview: None,
             }
