@@ -325,16 +325,15 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
 /// G30 outlive a power cycle (the flash store keeps them); G92 does not.
 pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
     let offsets = gcode.offsets();
-    for system in WorkSystem::all() {
-        write!(out, "[G{}:", Int::from(system.gcode()))?;
-        xyz_line_end(out, offsets.system_mm(system))?;
+    let stored = [
+        (28, offsets.stored_mm(StoredPosition::G28)),
+        (30, offsets.stored_mm(StoredPosition::G30)),
+        (92, offsets.g92_mm()),
+    ];
+    for (g, xy) in WorkSystem::all().map(|system| (system.gcode(), offsets.system_mm(system))).chain(stored) {
+        write!(out, "[G{}:", Int::from(g))?;
+        xyz_line_end(out, xy)?;
     }
-    for (name, which) in [("G28", StoredPosition::G28), ("G30", StoredPosition::G30)] {
-        write!(out, "[{}:", Text(name))?;
-        xyz_line_end(out, offsets.stored_mm(which))?;
-    }
-    out.write_str("[G92:")?;
-    xyz_line_end(out, offsets.g92_mm())?;
     out.write_str("[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
 }
 
