@@ -153,48 +153,61 @@ pub const ALARM_DRIVER: u8 = 17;
 /// The alarm code for a curve that stopped part way for another reason (not a GRBL code).
 pub const ALARM_CURVE_STOPPED: u8 = 20;
 
-/// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened.
+/// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened and what
+/// clears it.
 pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
-    let e = match fault {
-        MotionFault::Curve(e) => e,
-        MotionFault::Tripped(trip) => return tripped(out, trip),
-        MotionFault::Homing(fail) => return homing_failed(out, fail),
+    let (code, says) = match fault {
+        MotionFault::Curve(e) => curve_stopped(e),
+        MotionFault::Tripped(trip) => tripped(trip),
+        MotionFault::Homing(fail) => homing_failed(fail),
     };
+    let [a, b, c, d] = says.map(Text);
+    write!(out, "ALARM:{}\r\n[MSG:{a}{b}{c}{d}]\r\n", Int::from(code))
+}
+
+/// What an alarm says, in pieces, after its code.
+type AlarmText = (u8, [&'static str; 4]);
+
+/// The alarm of a curve stopped part way.
+fn curve_stopped(e: CurveError) -> AlarmText {
     let code = if e == CurveError::Travel { ALARM_SOFT_LIMIT } else { ALARM_CURVE_STOPPED };
-    let why = Text(match e {
+    let why = match e {
         CurveError::Domain => "function undefined",
         CurveError::DivisionByZero => "division by zero",
         CurveError::Overflow => "value too large",
         CurveError::Jump => "jump over $204",
         CurveError::Travel => "travel limit",
-    });
-    write!(out, "ALARM:{}\r\n[MSG:Curve stopped: {why}; queued lines dropped. '$X' to unlock]\r\n", Int::from(code))
+    };
+    (code, ["Curve stopped: ", why, "; queued lines dropped. '$X' to unlock", ""])
 }
 
-/// The alarm of a failed homing cycle: `ALARM:N` and what failed.
-fn homing_failed(out: &mut impl Write, fail: HomingFail) -> fmt::Result {
+/// The alarm of a failed homing cycle: what failed.
+fn homing_failed(fail: HomingFail) -> AlarmText {
     let (code, axis, why) = match fail {
         HomingFail::Aborted => (ALARM_HOMING_ABORTED, "", "reset or abort during the cycle"),
         HomingFail::PullOff(axis) => (ALARM_HOMING_PULL_OFF, axis.name(), " switch still pressed after the pull-off"),
         HomingFail::Approach(axis) => (ALARM_HOMING_APPROACH, axis.name(), " switch not found"),
     };
-    write!(out, "ALARM:{}\r\n[MSG:Homing failed: {}{}. '$H' or '$X']\r\n", Int::from(code), Text(axis), Text(why))
+    (code, ["Homing failed: ", axis, why, ". '$H' or '$X'"])
 }
 
-/// The alarm of a trip: `ALARM:N`, what tripped, and what clears it.
-fn tripped(out: &mut impl Write, trip: Trip) -> fmt::Result {
-    let (code, what, then) = match trip {
-        Trip::Limit { .. } => (ALARM_HARD_LIMIT, "Hard limit", "position lost; move off the switch after '$X'"),
-        Trip::DriverAlarm(_) => (ALARM_DRIVER, "Driver alarm", "servos off; clear the driver's fault, then '$X'"),
-        Trip::EStop => (ALARM_ESTOP, "Emergency stop", "release it, then '$X'"),
-    };
-    write!(out, "ALARM:{}\r\n[MSG:{}", Int::from(code), Text(what))?;
+/// The alarm of a trip: what tripped (the axis, for a limit its side), and what clears it.
+fn tripped(trip: Trip) -> AlarmText {
     match trip {
-        Trip::Limit { axis, max } => write!(out, " {}{}", Text(axis.name()), Text(if max { "+" } else { "-" }))?,
-        Trip::DriverAlarm(axis) => write!(out, " {}", Text(axis.name()))?,
-        Trip::EStop => {}
+        Trip::Limit { axis, max } => (
+            ALARM_HARD_LIMIT,
+            [
+                "Hard limit ",
+                axis.name(),
+                if max { "+" } else { "-" },
+                ": position lost; move off the switch after '$X'",
+            ],
+        ),
+        Trip::DriverAlarm(axis) => {
+            (ALARM_DRIVER, ["Driver alarm ", axis.name(), "", ": servos off; clear the driver's fault, then '$X'"])
+        }
+        Trip::EStop => (ALARM_ESTOP, ["Emergency stop", "", "", ": release it, then '$X'"]),
     }
-    write!(out, ": {}]\r\n", Text(then))
 }
 
 /// A feedback message, `[MSG:text]` (`Caution: Unlocked`, `Pgm End`, `Reset to continue`...).
