@@ -258,17 +258,19 @@ impl Form {
             self.field += 1;
             return Ok(None);
         }
-        let job = self.job(status, settings)?;
-        Ok(Some(Plan::of(&job.drawing, self.name(), job.feed, settings)))
+        let job = self.job(status, settings);
+        job.map(|job| Some(Plan::of(&job.drawing, self.name(), job.feed, settings)))
     }
 
     /// `#` on the preview: the job, built again from the pen (still where the preview was
     /// built: the machine is at rest), if the machine is still free for it. The form then stays
     /// as typed until the next key.
     pub(super) fn start(&mut self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
-        let job = self.job(status, settings)?;
-        self.started = true;
-        Ok(MenuAction::Start(job))
+        let job = self.job(status, settings);
+        if job.is_ok() {
+            self.started = true;
+        }
+        job.map(MenuAction::Start)
     }
 
     /// The function's text: typed, or the preset's.
