@@ -404,7 +404,10 @@ impl GcodeState {
             // Asleep (`$SLP`), the servos are off: every line waits for a reset.
             return Err(GrblError::Locked);
         }
-        let commands = self.parse_line(line, settings, state)?;
+        // The line runs on a copy, kept only on success: an error line changes nothing.
+        let mut next = *self;
+        let commands = next.parse_line(line, settings, state)?;
+        *self = next;
         // Check mode: the line was parsed and its drawing built and checked; nothing runs.
         Ok(if state == RunState::Check { commands.checked() } else { commands })
     }
@@ -421,11 +424,7 @@ impl GcodeState {
         if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
             return Err(GrblError::Locked);
         }
-        let block = parse_block(&compact)?;
-        let mut next = *self;
-        let commands = next.run_block(block, settings)?;
-        *self = next;
-        Ok(commands)
+        self.run_block(parse_block(&compact)?, settings)
     }
 }
 

@@ -17,7 +17,7 @@ use crate::protocol::GrblError;
 use crate::settings::Settings;
 
 impl GcodeState {
-    /// Executes a parsed block on `self` (a copy the caller keeps only on success).
+    /// Executes a parsed block on `self` (a copy [`GcodeState::execute`] keeps only on success).
     pub(super) fn run_block(&mut self, block: Block, settings: &Settings) -> Result<Commands, GrblError> {
         let mut words = block.words;
         if let Some(n) = words.take(b'N')

@@ -56,19 +56,13 @@ impl GcodeState {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                let mut next = *self;
-                let commands = next.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings)?;
-                *self = next;
-                Ok(commands)
+                self.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings)
             }
             [b'F', ..] => {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                let mut next = *self;
-                let commands = next.function(line, rest, settings)?;
-                *self = next;
-                Ok(commands)
+                self.function(line, rest, settings)
             }
             _ => Err(GrblError::InvalidStatement),
         }
