@@ -169,7 +169,12 @@ impl Commands {
     }
 
     fn one(command: Command) -> Self {
-        Commands { main: Some(command), ..Commands::default() }
+        Commands::main(Some(command))
+    }
+
+    /// Just `main`, if any.
+    fn main(main: Option<Command>) -> Self {
+        Commands { main, ..Commands::default() }
     }
 }
 

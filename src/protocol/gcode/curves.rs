@@ -44,7 +44,7 @@ impl GcodeState {
                 )?
             }
         };
-        Ok(command.map(Commands::one).unwrap_or_default())
+        Ok(Commands::main(command))
     }
 
     /// The words of a curve command in `body` (compacted, after the command letter) but its F
@@ -131,6 +131,6 @@ impl GcodeState {
         // Undefined at its first point: say why, with the x.
         expr.eval(x0_mm).map_err(|error| GrblError::FunctionUndefined { x_mm: x0_mm, error })?;
         let request = Request::Function { expr, x0_mm, x1_mm };
-        Ok(self.draw(request, feed, JobKind::Draw, None, settings)?.map(Commands::one).unwrap_or_default())
+        Ok(Commands::main(self.draw(request, feed, JobKind::Draw, None, settings)?))
     }
 }

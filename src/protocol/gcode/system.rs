@@ -181,6 +181,6 @@ impl GcodeState {
         let target = self.target_mm(axis.map(|v| v.map(|v| v * units.mm_per_unit())), distance, machine);
         let to = drawing::line_target(target, settings).ok_or(GrblError::TravelExceeded)?;
         let jog = self.draw(Request::Straight { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
-        Ok(jog.map(Commands::one).unwrap_or_default())
+        Ok(Commands::main(jog))
     }
 }
