@@ -21,51 +21,52 @@ impl GcodeState {
         state: RunState,
     ) -> Result<Commands, GrblError> {
         let c = compact(rest, true)?;
-        let report = |r| Ok(Commands::one(Command::Report(r)));
-        match c.as_slice() {
-            b"" => report(Report::Help),
-            b"$" => report(Report::Settings),
-            b"G" => report(Report::ParserState),
-            b"#" => report(Report::Parameters),
-            b"I" => report(Report::BuildInfo),
+        let command = match c.as_slice() {
+            b"" => Command::Report(Report::Help),
+            b"$" => Command::Report(Report::Settings),
+            b"G" => Command::Report(Report::ParserState),
+            b"#" => Command::Report(Report::Parameters),
+            b"I" => Command::Report(Report::BuildInfo),
             [b'I', b'=', body @ ..] => {
                 if state != RunState::Idle {
                     return Err(GrblError::NotIdle);
                 }
                 // Compacted text is ASCII: only its length can refuse it.
-                let line = ascii_line(body).ok_or(GrblError::LineLengthExceeded)?;
-                Ok(Commands::one(Command::StoreBuildInfo(line)))
+                Command::StoreBuildInfo(ascii_line(body).ok_or(GrblError::LineLengthExceeded)?)
             }
-            b"X" => Ok(Commands::one(Command::Unlock)),
+            b"X" => Command::Unlock,
             b"C" => match state {
-                RunState::Check => Ok(Commands::one(Command::CheckMode { on: false })),
-                RunState::Idle => Ok(Commands::one(Command::CheckMode { on: true })),
-                _ => Err(GrblError::NotIdle),
+                RunState::Check => Command::CheckMode { on: false },
+                RunState::Idle => Command::CheckMode { on: true },
+                _ => return Err(GrblError::NotIdle),
             },
-            b"H" if !settings.homing => Err(GrblError::SettingDisabled),
-            b"H" if matches!(state, RunState::Idle | RunState::Alarm) => Ok(Commands::one(Command::Home)),
-            b"H" => Err(GrblError::NotIdle),
-            b"SLP" if matches!(state, RunState::Idle | RunState::Alarm) => Ok(Commands::one(Command::Sleep)),
-            b"SLP" => Err(GrblError::NotIdle),
-            b"N" => report(Report::StartupLines),
-            [b'N', index @ b'0'..=b'9', b'=', body @ ..] => self.startup_line(*index - b'0', body, settings, state),
-            [b'R', b'S', b'T', b'=', what] => self.restore(*what, settings, state),
-            [b'J', b'=', body @ ..] => self.jog(body, settings, state),
-            [b'0'..=b'9', ..] => self.set_setting(&c, settings, state),
+            b"H" if !settings.homing => return Err(GrblError::SettingDisabled),
+            b"H" if matches!(state, RunState::Idle | RunState::Alarm) => Command::Home,
+            b"H" => return Err(GrblError::NotIdle),
+            b"SLP" if matches!(state, RunState::Idle | RunState::Alarm) => Command::Sleep,
+            b"SLP" => return Err(GrblError::NotIdle),
+            b"N" => Command::Report(Report::StartupLines),
+            [b'N', index @ b'0'..=b'9', b'=', body @ ..] => {
+                return self.startup_line(*index - b'0', body, settings, state);
+            }
+            [b'R', b'S', b'T', b'=', what] => return self.restore(*what, settings, state),
+            [b'J', b'=', body @ ..] => return self.jog(body, settings, state),
+            [b'0'..=b'9', ..] => return self.set_setting(&c, settings, state),
             [which @ (b'E' | b'O' | b'S'), ..] => {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                self.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings)
+                return self.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings);
             }
             [b'F', ..] => {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                self.function(line, rest, settings)
+                return self.function(line, rest, settings);
             }
-            _ => Err(GrblError::InvalidStatement),
-        }
+            _ => return Err(GrblError::InvalidStatement),
+        };
+        Ok(Commands::one(command))
     }
 
     /// `$id=value`.
