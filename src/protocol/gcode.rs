@@ -161,11 +161,15 @@ impl Commands {
         self.len() == 0
     }
 
-    /// What of these commands check mode carries out: no motion, no dwell and no pause.
-    fn checked(self) -> Self {
-        let main = self.main.filter(|c| !matches!(c, Command::Job(_)));
-        let stop = self.stop.filter(|s| *s != ProgramStop::Pause);
-        Commands { pen: None, dwell_ms: None, via: None, main, stop }
+    /// Keeps what of these commands check mode carries out: no motion, no dwell and no pause.
+    fn keep_checked(&mut self) {
+        (self.pen, self.dwell_ms, self.via) = (None, None, None);
+        if matches!(self.main, Some(Command::Job(_))) {
+            self.main = None;
+        }
+        if self.stop == Some(ProgramStop::Pause) {
+            self.stop = None;
+        }
     }
 
     fn one(command: Command) -> Self {
@@ -411,10 +415,13 @@ impl GcodeState {
         }
         // The line runs on a copy, kept only on success: an error line changes nothing.
         let mut next = *self;
-        let commands = next.parse_line(line, settings, state)?;
+        let mut commands = next.parse_line(line, settings, state)?;
         *self = next;
-        // Check mode: the line was parsed and its drawing built and checked; nothing runs.
-        Ok(if state == RunState::Check { commands.checked() } else { commands })
+        if state == RunState::Check {
+            // Check mode: the line was parsed and its drawing built and checked; nothing runs.
+            commands.keep_checked();
+        }
+        Ok(commands)
     }
 
     fn parse_line(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
