@@ -67,18 +67,30 @@ pub struct NumberField {
 impl NumberField {
     /// The value of `entry` for this field, checked.
     pub fn value(&self, entry: &NumberEntry) -> Result<f32, UiError> {
-        let v = match entry.value().map_err(UiError::Entry)? {
-            Some(v) => v,
-            None => self.default.ok_or(UiError::Empty)?,
-        };
-        if !v.is_finite() || !self.range.contains(&v) {
-            return Err(UiError::OutOfRange { min: *self.range.start(), max: *self.range.end(), unit: self.unit });
-        }
+        let v = ranged_value(entry, self.default, &self.range, self.unit)?;
         if v == 0.0 && !self.zero_allowed {
             return Err(UiError::Zero);
         }
         Ok(v)
     }
+}
+
+/// The value typed in `entry`, or `default` when it is empty, if it lies in `range` (`unit`
+/// says in what, for the error): the check of every number typed on the keypad.
+pub(super) fn ranged_value(
+    entry: &NumberEntry,
+    default: Option<f32>,
+    range: &RangeInclusive<f32>,
+    unit: Unit,
+) -> Result<f32, UiError> {
+    let v = match entry.value().map_err(UiError::Entry)? {
+        Some(v) => v,
+        None => default.ok_or(UiError::Empty)?,
+    };
+    if !v.is_finite() || !range.contains(&v) {
+        return Err(UiError::OutOfRange { min: *range.start(), max: *range.end(), unit });
+    }
+    Ok(v)
 }
 
 /// One field of a form.

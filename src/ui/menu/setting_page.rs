@@ -5,6 +5,7 @@
 
 use super::action::MenuAction;
 use super::error::UiError;
+use super::form::ranged_value;
 use super::list;
 use crate::keypad::Key;
 use crate::settings::{SETTING_INFO, SettingInfo, Settings};
@@ -71,10 +72,7 @@ impl SettingPage {
             }
             return Ok(MenuAction::None);
         }
-        let value = entry.value().map_err(UiError::Entry)?.ok_or(UiError::Empty)?;
-        if !(info.min..=info.max).contains(&value) {
-            return Err(UiError::OutOfRange { min: info.min, max: info.max, unit: info.unit });
-        }
+        let value = ranged_value(entry, None, &(info.min..=info.max), info.unit)?;
         if settings.is_whole(info.id) && value != crate::math::floor(value) {
             return Err(UiError::NotWhole);
         }
