@@ -38,7 +38,9 @@ impl KeyScript {
                 None => (token, SCRIPT_PRESS_MS),
             };
             if name.eq_ignore_ascii_case("wait") {
+                // The script lasts to the end of the wait: no key is down then.
                 t_ms += hold_ms;
+                events.push((t_ms * 1000, 0));
                 continue;
             }
             let mut chars = name.chars();
@@ -199,6 +201,7 @@ mod tests {
         assert_eq!(s.pressed_at(359_999), 1 << 14);
         assert_eq!(s.pressed_at(360_000), 0);
         assert_eq!(s.pressed_at(490_000), 1 << 15);
+        assert_eq!(KeyScript::parse("1 wait:2000").unwrap().end_us(), 2_160_000, "a wait at the end counts");
         assert!(KeyScript::parse("E").is_err());
         assert!(KeyScript::parse("1:x").is_err());
     }
