@@ -1,5 +1,6 @@
-//! Link scripts for the firmware image (the host build, the simulator, needs none), and the
-//! LCD's glyph table for every build.
+//! Link scripts for the firmware image (the host build, the simulator, needs none), and for
+//! every build the LCD's glyph table and its texts in both languages, with the glyphs of the
+//! Chinese characters they use.
 
 use embedded_graphics::Drawable;
 use embedded_graphics::Pixel;
@@ -9,14 +10,28 @@ use embedded_graphics::mono_font::MonoTextStyle;
 use embedded_graphics::mono_font::ascii::FONT_5X7;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::text::{Baseline, Text};
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use u8g2_fonts::FontRenderer;
+use u8g2_fonts::fonts::u8g2_font_boutique_bitmap_7x7_t_gb2312;
+use u8g2_fonts::types::{FontColor, VerticalPosition};
+
+/// The LCD's texts, `name | English | 中文` a line.
+const TEXTS: &str = "src/ui/texts.txt";
+/// The first of the characters that stand for Chinese glyphs in the texts' tables: the k-th
+/// glyph is `HANZI_FIRST + k`, two bytes in UTF-8 up to U+07FF, as it is two columns wide on the
+/// screen.
+const HANZI_FIRST: u32 = 0x100;
+const HANZI_LAST: u32 = 0x7ff;
 
 fn main() {
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed={TEXTS}");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     write_font(&out);
+    write_texts(&out);
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none") {
         // memory.x sits in the package root, which is on the linker's search path as the
         // build script's output directory is not: copy it there for link.x to include.
@@ -31,14 +46,22 @@ fn main() {
     }
 }
 
-/// One glyph's pixels as embedded-graphics draws them: bit `7 * x + y` set where the pixel x
-/// from the left, y from the top, is lit.
-#[derive(Default)]
-struct Cell(u64);
+/// One glyph's pixels as a font draws them: bit `7 * x + y` set where the pixel x from the
+/// left, y from the top, is lit; `width` pixels wide, 7 high.
+struct Cell {
+    bits: u64,
+    width: i32,
+}
+
+impl Cell {
+    fn new(width: i32) -> Self {
+        Cell { bits: 0, width }
+    }
+}
 
 impl OriginDimensions for Cell {
     fn size(&self) -> Size {
-        Size::new(5, 7)
+        Size::new(self.width as u32, 7)
     }
 }
 
@@ -48,9 +71,9 @@ impl DrawTarget for Cell {
 
     fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
         for Pixel(p, c) in pixels {
-            assert!((0..5).contains(&p.x) && (0..7).contains(&p.y), "a 5x7 glyph's pixel outside its cell");
+            assert!((0..self.width).contains(&p.x) && (0..7).contains(&p.y), "a glyph's pixel outside its cell");
             if c.is_on() {
-                self.0 |= 1 << (7 * p.x + p.y);
+                self.bits |= 1 << (7 * p.x + p.y);
             }
         }
         Ok(())
@@ -65,22 +88,28 @@ fn write_font(out: &Path) {
     let style = MonoTextStyle::new(&FONT_5X7, BinaryColor::On);
     let mut bits = Vec::new();
     for c in ' '..='~' {
-        let mut cell = Cell::default();
+        let mut cell = Cell::new(5);
         let mut buf = [0; 4];
         Text::with_baseline(c.encode_utf8(&mut buf), Point::zero(), style, Baseline::Top)
             .draw(&mut cell)
             .expect("drawing into memory cannot fail");
-        bits.extend((0..35).map(|k| cell.0 >> k & 1 != 0));
+        bits.extend((0..35).map(|k| cell.bits >> k & 1 != 0));
     }
-    let bytes: Vec<u8> =
-        bits.chunks(8).map(|byte| byte.iter().rev().fold(0, |acc, &on| acc << 1 | u8::from(on))).collect();
     let mut src = format!(
         "/// embedded-graphics' `FONT_5X7`, ' '..='~', written by build.rs: 35 bits per character, bit\n\
          /// `35 * (c - ' ') + 7 * x + y` (bit n is bit n % 8 of byte n / 8) set where the pixel x from\n\
          /// the left, y from the top of c's 5x7 cell is lit.\n\
          pub const GLYPHS_5X7: [u8; {}] = [\n",
-        bytes.len()
+        bits.len().div_ceil(8)
     );
+    write_bytes(&mut src, &bits);
+    std::fs::write(out.join("font5x7.rs"), src).expect("OUT_DIR is writable");
+}
+
+/// `bits` as the elements of a byte array (bit n is bit n % 8 of byte n / 8), and its end.
+fn write_bytes(src: &mut String, bits: &[bool]) {
+    let bytes: Vec<u8> =
+        bits.chunks(8).map(|byte| byte.iter().rev().fold(0, |acc, &on| acc << 1 | u8::from(on))).collect();
     for line in bytes.chunks(16) {
         src.push_str("   ");
         for b in line {
@@ -89,5 +118,118 @@ fn write_font(out: &Path) {
         src.push('\n');
     }
     src.push_str("];\n");
-    std::fs::write(out.join("font5x7.rs"), src).expect("OUT_DIR is writable");
+}
+
+/// One line of [`TEXTS`].
+struct Entry {
+    name: String,
+    english: String,
+    chinese: String,
+}
+
+/// `$OUT_DIR/texts.rs`: from [`TEXTS`], the `Msg` enum, each language's texts as one string
+/// and their lengths in it, a Chinese character written as the glyph that stands for
+/// it, and those glyphs: the Chinese characters used, each rendered from u8g2's 7x7 GB2312 font
+/// by its own renderer, 49 bits a glyph in the 5x7 table's order.
+fn write_texts(out: &Path) {
+    let source = std::fs::read_to_string(TEXTS).expect("the texts file is readable");
+    let mut entries = Vec::new();
+    for (n, line) in source.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let parts: Vec<&str> = line.split(" | ").map(str::trim).collect();
+        let [name, english, chinese] = parts[..] else {
+            panic!("{TEXTS}:{}: not `name | English | 中文`", n + 1);
+        };
+        assert!(
+            name.chars().all(|c| c.is_ascii_alphanumeric()) && !english.is_empty() && !chinese.is_empty(),
+            "{TEXTS}:{}: a name of letters and digits, and two texts",
+            n + 1
+        );
+        entries.push(Entry { name: name.into(), english: english.into(), chinese: chinese.into() });
+    }
+    let used: BTreeSet<char> = entries.iter().flat_map(|e| e.english.chars().chain(e.chinese.chars())).collect();
+    let hanzi: Vec<char> = used.iter().copied().filter(|c| !(' '..='~').contains(c)).collect();
+    assert!(HANZI_FIRST + hanzi.len() as u32 <= HANZI_LAST + 1, "too many Chinese characters");
+    let encode = |text: &str| -> String {
+        text.chars()
+            .map(|c| match hanzi.binary_search(&c) {
+                Ok(k) => char::from_u32(HANZI_FIRST + k as u32).expect("in the two-byte range"),
+                Err(_) => c,
+            })
+            .collect()
+    };
+
+    let mut src = String::from(
+        "/// A text of the LCD, in either language: see `src/ui/texts.txt`.\n\
+         #[derive(Clone, Copy, Debug, PartialEq, Eq)]\n\
+         #[cfg_attr(target_os = \"none\", derive(defmt::Format))]\n\
+         pub enum Msg {\n",
+    );
+    for e in &entries {
+        writeln!(src, "    /// {}", e.english).expect("writing to a String");
+        writeln!(src, "    {},", e.name).expect("writing to a String");
+    }
+    src.push_str("}\n\n");
+    for (table, texts) in [
+        ("ENGLISH", entries.iter().map(|e| encode(&e.english)).collect::<Vec<_>>()),
+        ("CHINESE", entries.iter().map(|e| encode(&e.chinese)).collect()),
+    ] {
+        let lengths: Vec<u8> = texts.iter().map(|t| u8::try_from(t.len()).expect("a text fits a line")).collect();
+        writeln!(src, "const {table}: &str = {:?};", texts.concat()).expect("writing to a String");
+        writeln!(src, "const {table}_LENGTHS: [u8; {}] = {lengths:?};", lengths.len()).expect("writing to a String");
+    }
+    src.push_str("\nimpl Msg {\n    /// The name of setting `$id`, if it has one.\n");
+    src.push_str("    pub const fn setting(id: u16) -> Option<Msg> {\n        Some(match id {\n");
+    for e in &entries {
+        if let Some(id) = e.name.strip_prefix("Setting") {
+            writeln!(src, "            {id} => Msg::{},", e.name).expect("writing to a String");
+        }
+    }
+    src.push_str("            _ => return None,\n        })\n    }\n}\n\n");
+    writeln!(
+        src,
+        "#[cfg(not(target_os = \"none\"))]\nimpl Msg {{\n    /// Every text, in the file's order.\n    pub const ALL: [Msg; {}] = [{}];\n}}\n",
+        entries.len(),
+        entries.iter().map(|e| format!("Msg::{}", e.name)).collect::<Vec<_>>().join(", ")
+    )
+    .expect("writing to a String");
+
+    let renderer = FontRenderer::new::<u8g2_font_boutique_bitmap_7x7_t_gb2312>();
+    let mut bits = Vec::new();
+    for &c in &hanzi {
+        let mut cell = Cell::new(7);
+        // The font's glyphs stand one row below the top of its line.
+        renderer
+            .render(c, Point::new(0, -1), VerticalPosition::Top, FontColor::Transparent(BinaryColor::On), &mut cell)
+            .unwrap_or_else(|e| panic!("{c:?} is not in the font: {e:?}"));
+        bits.extend((0..49).map(|k| cell.bits >> k & 1 != 0));
+    }
+    writeln!(
+        src,
+        "/// The first character standing for a Chinese glyph.\npub const HANZI_FIRST: char = {:?};",
+        char::from_u32(HANZI_FIRST).unwrap()
+    )
+    .expect("writing to a String");
+    writeln!(src, "/// How many Chinese glyphs there are.\npub const HANZI_COUNT: usize = {};", hanzi.len())
+        .expect("writing to a String");
+    writeln!(
+        src,
+        "/// The Chinese characters, in glyph order.\n#[cfg(not(target_os = \"none\"))]\npub const HANZI: &str = {:?};",
+        hanzi.iter().collect::<String>()
+    )
+    .expect("writing to a String");
+    write!(
+        src,
+        "/// u8g2's `boutique_bitmap_7x7` glyph of each character in [`HANZI`], written by build.rs:\n\
+         /// 49 bits per glyph, bit `49 * k + 7 * x + y` set where the pixel x from the left, y from the\n\
+         /// top of glyph k's 7x7 cell is lit.\n\
+         pub const GLYPHS_7X7: [u8; {}] = [\n",
+        bits.len().div_ceil(8)
+    )
+    .expect("writing to a String");
+    write_bytes(&mut src, &bits);
+    std::fs::write(out.join("texts.rs"), src).expect("OUT_DIR is writable");
 }

@@ -23,6 +23,7 @@ pub mod inputs;
 pub mod interp;
 pub mod job;
 pub mod keypad;
+pub mod language;
 pub mod machine;
 pub mod math;
 pub mod method;

@@ -7,6 +7,7 @@
 
 pub mod presets;
 
+use crate::language::Language;
 use crate::method::Method;
 use crate::unit::Unit;
 
@@ -20,19 +21,15 @@ pub enum SettingError {
     OutOfRange,
 }
 
-/// Identifies one setting: its `$` number, its name and unit on the LCD, and its range.
+/// Identifies one setting: its `$` number, its unit and its range. Its name on the LCD is the
+/// UI's ([`crate::ui::texts::Msg::setting`]).
 #[derive(Clone, Copy, Debug)]
 pub struct SettingInfo {
     pub id: u16,
-    /// At most [`SETTING_NAME_MAX_CHARS`] characters: it follows the number on an LCD line.
-    pub name: &'static str,
     pub unit: Unit,
     pub min: f32,
     pub max: f32,
 }
-
-/// Longest setting name: "$205 " and the name fill the LCD's 20 columns.
-pub const SETTING_NAME_MAX_CHARS: usize = 15;
 
 /// Highest pulse rate the firmware drives: the drivers' own limit (EP3L class, open collector:
 /// 200 kpps, a period of at least 5 µs).
@@ -59,6 +56,9 @@ pub const PEN_PULSE_MAX_US: u32 = 2_500;
 /// Longest wait for the pen to settle (`$212`).
 pub const PEN_SETTLE_MAX_MS: u32 = 2_000;
 
+/// The language of the LCD (`$216`), which the menu also switches.
+pub const LANGUAGE_SETTING: u16 = 216;
+
 /// Longest pause after each homing move for the switch to settle (`$26`).
 pub const HOMING_DEBOUNCE_MAX_MS: u32 = 1_000;
 
@@ -70,61 +70,58 @@ enum Field<'a> {
     Mask(&'a mut u8),
     Flag(&'a mut bool),
     Method(&'a mut Method),
+    Language(&'a mut Language),
 }
 
-/// Every setting, in `$$` listing order. On/off settings are 0 or 1.
+/// Every setting, in `$$` listing order. On/off settings are 0 or 1. Their names are the
+/// `Setting<id>` lines of `src/ui/texts.txt`.
 pub const SETTING_INFO: &[SettingInfo] = &[
-    SettingInfo { id: 0, name: "Pulse width", unit: Unit::Us, min: 2.5, max: 100.0 },
+    SettingInfo { id: 0, unit: Unit::Us, min: 2.5, max: 100.0 },
     // 255 always on
-    SettingInfo { id: 1, name: "Servo idle off", unit: Unit::Ms, min: 0.0, max: 255.0 },
+    SettingInfo { id: 1, unit: Unit::Ms, min: 0.0, max: 255.0 },
     // bit 0 X, bit 1 Y
-    SettingInfo { id: 3, name: "Invert SIGN", unit: Unit::Plain, min: 0.0, max: 3.0 },
+    SettingInfo { id: 3, unit: Unit::Plain, min: 0.0, max: 3.0 },
     // 0 normally open, 1 normally closed
-    SettingInfo { id: 5, name: "Limits invert", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 5, unit: Unit::Plain, min: 0.0, max: 1.0 },
     // 1 machine position, +2 buffer state
-    SettingInfo { id: 10, name: "Status report", unit: Unit::Plain, min: 0.0, max: 3.0 },
-    SettingInfo { id: 11, name: "Junction dev", unit: Unit::Mm, min: 0.0, max: 5.0 },
-    SettingInfo { id: 20, name: "Soft limits", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 21, name: "Hard limits", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 22, name: "Homing", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 10, unit: Unit::Plain, min: 0.0, max: 3.0 },
+    SettingInfo { id: 11, unit: Unit::Mm, min: 0.0, max: 5.0 },
+    SettingInfo { id: 20, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 21, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 22, unit: Unit::Plain, min: 0.0, max: 1.0 },
     // bit set: towards the min switch
-    SettingInfo { id: 23, name: "Homing dir", unit: Unit::Plain, min: 0.0, max: 3.0 },
-    SettingInfo { id: 24, name: "Home locate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 25, name: "Home seek", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 26, name: "Home debounce", unit: Unit::Ms, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
-    SettingInfo { id: 27, name: "Home pull-off", unit: Unit::Mm, min: 0.1, max: 20.0 },
-    SettingInfo { id: 100, name: "X steps", unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
-    SettingInfo { id: 101, name: "Y steps", unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
-    SettingInfo { id: 110, name: "X max rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 111, name: "Y max rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 120, name: "X accel", unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
-    SettingInfo { id: 121, name: "Y accel", unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
-    SettingInfo { id: 130, name: "X travel", unit: Unit::Mm, min: 1.0, max: 500.0 },
-    SettingInfo { id: 131, name: "Y travel", unit: Unit::Mm, min: 1.0, max: 500.0 },
-    SettingInfo { id: 200, name: "Dir setup", unit: Unit::Us, min: 5.0, max: 100.0 },
-    SettingInfo { id: 201, name: "Start rate", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 23, unit: Unit::Plain, min: 0.0, max: 3.0 },
+    SettingInfo { id: 24, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 25, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 26, unit: Unit::Ms, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
+    SettingInfo { id: 27, unit: Unit::Mm, min: 0.1, max: 20.0 },
+    SettingInfo { id: 100, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
+    SettingInfo { id: 101, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
+    SettingInfo { id: 110, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 111, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 120, unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
+    SettingInfo { id: 121, unit: Unit::MmPerS2, min: 1.0, max: 10_000.0 },
+    SettingInfo { id: 130, unit: Unit::Mm, min: 1.0, max: 500.0 },
+    SettingInfo { id: 131, unit: Unit::Mm, min: 1.0, max: 500.0 },
+    SettingInfo { id: 200, unit: Unit::Us, min: 5.0, max: 100.0 },
+    SettingInfo { id: 201, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
     // 0 classic, 1 diagonal
-    SettingInfo { id: 202, name: "Diagonal steps", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 203, name: "Default feed", unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
-    SettingInfo { id: 204, name: "Max f(x) jump", unit: Unit::Mm, min: 0.01, max: 500.0 },
-    SettingInfo { id: 205, name: "Max pulse rate", unit: Unit::Hz, min: 100.0, max: MAX_PULSE_RATE_HZ },
-    SettingInfo { id: 206, name: "Input debounce", unit: Unit::Ms, min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
-    SettingInfo { id: 207, name: "Driver alarms", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 208, name: "E-stop input", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 209, name: "Servo on delay", unit: Unit::Ms, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
-    SettingInfo { id: 210, name: "Pen up", unit: Unit::Us, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
-    SettingInfo {
-        id: 211,
-        name: "Pen down",
-        unit: Unit::Us,
-        min: PEN_PULSE_MIN_US as f32,
-        max: PEN_PULSE_MAX_US as f32,
-    },
-    SettingInfo { id: 212, name: "Pen settle", unit: Unit::Ms, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
+    SettingInfo { id: 202, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 203, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
+    SettingInfo { id: 204, unit: Unit::Mm, min: 0.01, max: 500.0 },
+    SettingInfo { id: 205, unit: Unit::Hz, min: 100.0, max: MAX_PULSE_RATE_HZ },
+    SettingInfo { id: 206, unit: Unit::Ms, min: 0.0, max: INPUT_DEBOUNCE_MAX_MS as f32 },
+    SettingInfo { id: 207, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 208, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 209, unit: Unit::Ms, min: 0.0, max: SERVO_ENABLE_DELAY_MAX_MS as f32 },
+    SettingInfo { id: 210, unit: Unit::Us, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
+    SettingInfo { id: 211, unit: Unit::Us, min: PEN_PULSE_MIN_US as f32, max: PEN_PULSE_MAX_US as f32 },
+    SettingInfo { id: 212, unit: Unit::Ms, min: 0.0, max: PEN_SETTLE_MAX_MS as f32 },
     // 0 none, 1 M3/M5, 2 also by itself: up for G0, down for drawing
-    SettingInfo { id: 213, name: "Pen lift", unit: Unit::Plain, min: 0.0, max: 2.0 },
-    SettingInfo { id: 214, name: "Run LED", unit: Unit::Plain, min: 0.0, max: 1.0 },
-    SettingInfo { id: 215, name: "Buzzer", unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 213, unit: Unit::Plain, min: 0.0, max: 2.0 },
+    SettingInfo { id: 214, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 215, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    SettingInfo { id: 216, unit: Unit::Plain, min: 0.0, max: 1.0 },
 ];
 
 /// The machine's settings. [`Settings::default`] suits an EP3L-class servo behind PC817
@@ -204,6 +201,8 @@ pub struct Settings {
     pub run_led: bool,
     /// The buzzer beeps at the end of a drawing and on an alarm ($215).
     pub buzzer: bool,
+    /// The language of the LCD: 0 English, 1 中文 ($216).
+    pub language: Language,
 }
 
 /// Equal when every setting has the same value: one comparison through the settings table
@@ -256,6 +255,7 @@ const DEFAULT_SETTINGS: Settings = Settings {
     pen_lift: 0,
     run_led: true,
     buzzer: true,
+    language: Language::English,
 };
 
 impl Settings {
@@ -268,6 +268,8 @@ impl Settings {
             Field::Flag(v) => f32::from(u8::from(*v)),
             Field::Method(Method::Classic) => 0.0,
             Field::Method(Method::Diagonal) => 1.0,
+            Field::Language(Language::English) => 0.0,
+            Field::Language(Language::Chinese) => 1.0,
         })
     }
 
@@ -313,6 +315,7 @@ impl Settings {
             213 => Field::Mask(&mut self.pen_lift),
             214 => Field::Flag(&mut self.run_led),
             215 => Field::Flag(&mut self.buzzer),
+            LANGUAGE_SETTING => Field::Language(&mut self.language),
             _ => return None,
         })
     }
@@ -369,6 +372,7 @@ impl Settings {
             Field::Mask(v) => *v = value as u8,
             Field::Flag(v) => *v = value != 0.0,
             Field::Method(v) => *v = if value == 0.0 { Method::Classic } else { Method::Diagonal },
+            Field::Language(v) => *v = if value == 0.0 { Language::English } else { Language::Chinese },
         }
         Ok(())
     }
@@ -418,13 +422,6 @@ impl Settings {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn every_name_fits_its_lcd_line() {
-        for info in SETTING_INFO {
-            assert!(info.name.len() <= SETTING_NAME_MAX_CHARS, "${} {}", info.id, info.name);
-        }
-    }
 
     #[test]
     fn set_all_changes_everything_or_nothing() {

@@ -1,7 +1,9 @@
-//! Settings changed on the machine's own keypad, on the simulated board: the settings screen and
-//! the speed presets write the settings the host link reads, the flash keeps them across a power
-//! cycle, and a change that clashes with the other settings changes nothing and says why.
+//! Settings changed on the machine's own keypad, on the simulated board: the settings screen,
+//! the speed presets and the language write the settings the host link reads, the flash keeps
+//! them across a power cycle, and a change that clashes with the other settings changes nothing
+//! and says why. The splash greets in the language kept.
 
+use servoplot::language::Language;
 use servoplot::settings::Settings;
 use servoplot::settings::presets::SpeedPreset;
 use servoplot::sim::flash::SimFlash;
@@ -63,4 +65,42 @@ fn a_clashing_setting_changes_nothing_and_says_why() {
     assert_eq!(text(last, 3, 24), "Clashes with $201 or $0");
     assert_eq!(report.settings, Settings::default());
     assert_eq!(report.flash.bytes_changed(), 0);
+}
+
+#[test]
+fn key_0_switches_the_screen_to_chinese_and_a_power_cycle_keeps_it() {
+    let first = power_on(SimFlash::default(), "0 wait:500", "");
+    assert_eq!(first.settings.language, Language::Chinese);
+    let (_, last) = first.frames.last().unwrap();
+    let lines: Vec<String> = (0..4).map(|line| text(last, line, 24)).collect();
+    assert_eq!(lines[0], "SERVOPLOT           空闲");
+    assert_eq!(lines[2..], [" 9 速度预设", ">0 语言 Language"]);
+
+    // The next power-up greets in Chinese, and the host link reads and sets the language.
+    let second = power_on(first.flash.clone(), "wait:2500", "$$\n$216=0\n");
+    assert!(second.answers().lines().any(|l| l == "$216=1"), "{}", second.answers());
+    let (_, splash) = &second.frames[0];
+    assert_eq!((text(splash, 1, 24), text(splash, 2, 24)), ("伺服绘图仪".into(), "0: English".into()));
+    assert_eq!(second.settings.language, Language::English);
+    let (_, last) = second.frames.last().unwrap();
+    assert_eq!((text(last, 0, 24), text(last, 2, 24)), ("SERVOPLOT           IDLE".into(), ">1 Jog".into()));
+}
+
+#[test]
+fn the_splash_shows_at_power_up_until_its_time_is_up() {
+    let report = power_on(SimFlash::default(), "wait:2500", "");
+    let (_, splash) = &report.frames[0];
+    let lines: Vec<String> = (0..4).map(|line| text(splash, line, 24)).collect();
+    assert_eq!(
+        lines,
+        [
+            format!("SERVOPLOT {}", env!("CARGO_PKG_VERSION")),
+            "Servo pen plotter".into(),
+            "0: 中文".into(),
+            "Any key: menu".into()
+        ]
+    );
+    let times: Vec<u64> = report.frames.iter().map(|(t, _)| *t).collect();
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!(text(last, 2, 24), ">1 Jog", "{times:?}");
 }

@@ -20,14 +20,6 @@ impl SpeedPreset {
     /// In menu order: `1` picks the first.
     pub const ALL: [SpeedPreset; 3] = [SpeedPreset::FinePen, SpeedPreset::FeltTip, SpeedPreset::FastDraft];
 
-    pub const fn name(self) -> &'static str {
-        match self {
-            SpeedPreset::FinePen => "Fine pen",
-            SpeedPreset::FeltTip => "Felt tip",
-            SpeedPreset::FastDraft => "Fast draft",
-        }
-    }
-
     /// Default feed ($203), top speed of both axes ($110, $111), in mm/min, and their
     /// acceleration ($120, $121), in mm/s².
     pub const fn speeds(self) -> (f32, f32, f32) {

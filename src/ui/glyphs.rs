@@ -1,13 +1,17 @@
-//! Text on the LCD: each character's glyph from a 5x7 table, its ink in one colour, the rest of
-//! its cell left as it is. Owns no state.
+//! Text on the LCD: each character's glyph from a 5x7 table, or for a Chinese character from the
+//! 7x7 table of [`texts`](crate::ui::texts), its ink in one colour, the rest of its cell left as
+//! it is. Owns no state.
 //!
-//! The screen's lines are one font, one size and no decorations: setting glyphs' pixels is all
-//! the text rendering they need.
+//! The screen's lines are one font a script, one size and no decorations: setting glyphs'
+//! pixels is all the text rendering they need. A Chinese character's cell is two 5x7 cells
+//! wide, as its text is two bytes long: a line's width in columns is its length in bytes.
 
 use embedded_graphics::Pixel;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::Point;
 use embedded_graphics::pixelcolor::BinaryColor;
+
+use crate::ui::texts::{GLYPHS_7X7, HANZI_COUNT, HANZI_FIRST};
 
 // `GLYPHS_5X7`, 35 bits a character: embedded-graphics' `FONT_5X7` (the version this crate
 // depends on), each character rendered by build.rs with embedded-graphics' own text renderer, so
@@ -16,29 +20,33 @@ include!(concat!(env!("OUT_DIR"), "/font5x7.rs"));
 
 /// From one cell to the next: the font's glyphs are 5 pixels wide, their spacing included.
 const ADVANCE: i32 = 5;
+/// A Chinese glyph's cell: two columns; the 7-pixel glyph one pixel in from its left.
+const HANZI_ADVANCE: i32 = 2 * ADVANCE;
 
 /// Draws `text` with its cells' top-left corner at `at`, ink in `ink`. A character outside
-/// the table (' '..='~') is drawn as '?', as embedded-graphics' ASCII fonts draw it (DEL, the
-/// one other glyph they hold, is a copy of '?').
+/// the tables (' '..='~' and the Chinese glyphs) is drawn as '?', as embedded-graphics' ASCII
+/// fonts draw it (DEL, the one other glyph they hold, is a copy of '?').
 pub fn draw<D>(target: &mut D, text: &str, at: Point, ink: BinaryColor) -> Result<(), D::Error>
 where
     D: DrawTarget<Color = BinaryColor>,
 {
-    let pixels = text.chars().zip((at.x..).step_by(ADVANCE as usize)).flat_map(move |(c, left)| {
-        let index = match c {
-            ' '..='~' => c as usize - ' ' as usize,
-            _ => usize::from(b'?' - b' '),
+    let mut left = at.x;
+    for c in text.chars() {
+        let hanzi = (c as u32).wrapping_sub(HANZI_FIRST as u32) as usize;
+        let (table, first, size, x0, advance) = match c {
+            _ if hanzi < HANZI_COUNT => (&GLYPHS_7X7[..], hanzi * 49, 49, left + 1, HANZI_ADVANCE),
+            ' '..='~' => (&GLYPHS_5X7[..], (c as usize - ' ' as usize) * 35, 35, left, ADVANCE),
+            _ => (&GLYPHS_5X7[..], usize::from(b'?' - b' ') * 35, 35, left, ADVANCE),
         };
-        // Bit 7 * x + y of the character's 35 is the pixel x from the left, y from the top.
-        let first = index * 35;
-        (0..35i32)
-            .filter(move |&k| {
-                let bit = first + k as usize;
-                GLYPHS_5X7[bit / 8] >> (bit % 8) & 1 != 0
-            })
-            .map(move |k| Pixel(Point::new(left + k / 7, at.y + k % 7), ink))
-    });
-    target.draw_iter(pixels)
+        // Bit 7 * x + y of the glyph's bits is the pixel x from the left, y from the top.
+        let lit = (0..size).filter(move |&k| {
+            let bit = first + k as usize;
+            table.get(bit / 8).is_some_and(|byte| byte >> (bit % 8) & 1 != 0)
+        });
+        target.draw_iter(lit.map(move |k| Pixel(Point::new(x0 + k / 7, at.y + k % 7), ink)))?;
+        left += advance;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -126,5 +134,35 @@ mod tests {
         let mut other = Canvas::new();
         draw(&mut other, "\u{e9}", Point::new(1, 1), BinaryColor::On).unwrap();
         assert_eq!(question.pixels, other.pixels);
+    }
+
+    /// Every Chinese character the texts use, alone and among ASCII characters: the pixels u8g2's
+    /// own renderer draws, one pixel in from the left of a cell two columns wide.
+    #[test]
+    fn chinese_characters_match_u8g2() {
+        use crate::ui::texts::{HANZI, readable};
+        use u8g2_fonts::FontRenderer;
+        use u8g2_fonts::fonts::u8g2_font_boutique_bitmap_7x7_t_gb2312;
+        use u8g2_fonts::types::{FontColor, VerticalPosition};
+        let font = FontRenderer::new::<u8g2_font_boutique_bitmap_7x7_t_gb2312>();
+        for (k, hanzi) in HANZI.chars().enumerate() {
+            let stand_in = char::from_u32(HANZI_FIRST as u32 + k as u32).unwrap();
+            let text: String = ['a', stand_in, 'b'].into_iter().collect();
+            assert_eq!(readable(&text), std::format!("a{hanzi}b"));
+            let at = Point::new(3, 2);
+            let mut ours = Canvas::new();
+            draw(&mut ours, &text, at, BinaryColor::On).unwrap();
+            let mut theirs = Canvas::new();
+            let style = MonoTextStyle::new(&FONT_5X7, BinaryColor::On);
+            Text::with_baseline("a", at, style, Baseline::Top).draw(&mut theirs).unwrap();
+            // The font's glyphs stand one row below the top of its line.
+            let cell = at + Point::new(ADVANCE + 1, -1);
+            font.render(hanzi, cell, VerticalPosition::Top, FontColor::Transparent(BinaryColor::On), &mut theirs)
+                .unwrap();
+            Text::with_baseline("b", at + Point::new(ADVANCE + HANZI_ADVANCE, 0), style, Baseline::Top)
+                .draw(&mut theirs)
+                .unwrap();
+            assert_eq!(ours.pixels, theirs.pixels, "{hanzi}");
+        }
     }
 }

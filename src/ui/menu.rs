@@ -38,8 +38,8 @@
 use crate::geom::Step;
 use crate::job::Control;
 use crate::keypad::{Key, KeyEvent};
-use crate::settings::Settings;
 use crate::settings::presets::SpeedPreset;
+use crate::settings::{LANGUAGE_SETTING, Settings};
 use crate::status::{RunState, Status};
 use crate::ui::run::{Plan, Run, RunPage};
 
@@ -61,7 +61,7 @@ pub use form::{
     SINE_PERIOD_RANGE_MM, SINE_PHASE_RANGE_DEG,
 };
 pub use mode::Mode;
-pub use setting_page::{SETTING_EDIT_HINT, SettingPage};
+pub use setting_page::SettingPage;
 
 /// The eight jog keys, around `5` as they sit on the keypad (`2` is above `5`): `2` is +Y, `8`
 /// −Y, `4` −X, `6` +X, and `1`, `3`, `7`, `9` the diagonals.
@@ -97,6 +97,9 @@ pub struct ActiveJog {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Screen {
     /// The mode list.
+    /// The mode list as it is at power-up, the splash over it for a while: the first key acts
+    /// on the mode list.
+    Splash,
     Modes,
     Jog,
     Form(Form),
@@ -134,7 +137,7 @@ impl Menu {
     /// The mode list, cursor on the first mode.
     pub const fn new() -> Self {
         Menu {
-            screen: Screen::Modes,
+            screen: Screen::Splash,
             selected: Mode::Jog,
             message: None,
             jog: None,
@@ -257,7 +260,7 @@ impl Menu {
             return false;
         }
         match &self.screen {
-            Screen::Modes | Screen::Presets(_) => matches!(key, Key::A | Key::B),
+            Screen::Splash | Screen::Modes | Screen::Presets(_) => matches!(key, Key::A | Key::B),
             Screen::Settings(page) if page.edit().is_some() => key == Key::B,
             Screen::Settings(_) => matches!(key, Key::A | Key::B),
             Screen::Form(form) => match form.field() {
@@ -313,7 +316,7 @@ impl Menu {
             _ => {}
         }
         let result = match &mut self.screen {
-            Screen::Modes => self.press_modes(key, settings),
+            Screen::Splash | Screen::Modes => self.press_modes(key, settings),
             Screen::Settings(page) => page.press(key, repeated, settings),
             Screen::Presets(preset) => {
                 if key == Key::Hash {
@@ -359,12 +362,15 @@ impl Menu {
     }
 
     /// The mode list: a digit enters its mode at once.
+    const _EVERY_DIGIT_HAS_A_MODE: () = assert!(Mode::ALL.len() == 10);
     fn press_modes(&mut self, key: Key, settings: &Settings) -> Result<MenuAction, UiError> {
+        self.screen = Screen::Modes;
         let at = list::moved(self.selected.index(), Mode::ALL.len(), key);
         self.selected = Mode::ALL[at];
         match key {
             Key::Hash => self.enter(self.selected, settings),
-            Key::Digit(d) if usize::from(d) == at + 1 => self.enter(self.selected, settings),
+            // Every digit has its mode: 1 the first, 0 the tenth.
+            Key::Digit(_) => self.enter(self.selected, settings),
             _ => Ok(MenuAction::None),
         }
     }
@@ -378,6 +384,10 @@ impl Menu {
             Mode::Presets => Screen::Presets(SpeedPreset::FinePen),
             Mode::Home if !settings.homing => return Err(UiError::HomingOff),
             Mode::Home => return Ok(MenuAction::Home),
+            Mode::Language => {
+                let value = f32::from(settings.language.other() as u8);
+                return Ok(MenuAction::SetSetting { id: LANGUAGE_SETTING, value });
+            }
             _ => Screen::Form(Form::new(mode)),
         };
         Ok(MenuAction::None)

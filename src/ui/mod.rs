@@ -4,7 +4,7 @@
 //! [`entry`] holds the number being typed; [`presets`] names the functions the keypad offers;
 //! [`run`] follows a drawing (its plan, progress and time) and [`trail`] keeps its path as a
 //! bounded polyline; [`screen`] draws it all on the 122x32 LCD, whose sizes are in [`layout`],
-//! its text glyph by glyph ([`glyphs`]). Everything here is pure: no clock, no pins, no
+//! its text glyph by glyph ([`glyphs`]) in either language ([`texts`]). Everything here is pure: no clock, no pins, no
 //! waiting.
 
 pub mod entry;
@@ -15,6 +15,7 @@ pub mod menu;
 pub mod presets;
 pub mod run;
 pub mod screen;
+pub mod texts;
 pub mod trail;
 
 pub use layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};

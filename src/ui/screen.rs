@@ -30,10 +30,12 @@ use heapless::String;
 
 use crate::decimal::{Int, Num};
 use crate::drawing::DrawError;
+use crate::expr::ParseErrorKind;
 use crate::geom::Step;
 use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::CurveError;
+use crate::language::Language;
 use crate::overrides::OVERRIDE_NONE_PERCENT;
 use crate::settings::SETTING_INFO;
 use crate::settings::Settings;
@@ -43,7 +45,8 @@ use crate::text::{Padded, Text};
 use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
 use crate::ui::glyphs;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
-use crate::ui::menu::{Field, Menu, Mode, SETTING_EDIT_HINT, Screen, UiError};
+use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
+use crate::ui::texts::{Msg, Say};
 use crate::ui::trail::{self, Trail};
 
 mod lines;
@@ -52,35 +55,55 @@ mod run;
 use lines::{Cut, position_line, state_name};
 pub use lines::{Live, PreviewBox, ScreenView, TextLine};
 
+/// How long the splash stays at power-up, unless a key is pressed first.
+pub const SPLASH_MS: u32 = 2_000;
+
 /// The screen for the current menu and machine state.
 pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> ScreenView {
+    let language = settings.language;
     let mut v = match (menu.run(), menu.screen()) {
         (Some(r), _) => run::run_view(menu, r, status, settings, live),
-        (None, Screen::Preview { plan, .. }) => run::preview_view(plan, status),
+        (None, Screen::Splash) if live.now_ms < SPLASH_MS => splash_view(language),
+        (None, Screen::Preview { plan, .. }) => run::preview_view(plan, status, language),
         (None, _) => menu_view(menu, status, settings, live),
     };
     if let Some(error) = menu.message() {
-        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error)), true);
+        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error, language)), true);
     } else if let (RunState::Idle | RunState::Alarm, Some(fault)) = (status.state, status.fault) {
-        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault)), true);
+        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault, language)), true);
     }
     v
 }
 
+/// At power-up: the name and version, and the key that switches the language.
+fn splash_view(language: Language) -> ScreenView {
+    ScreenView {
+        lines: [
+            TextLine { inverted: true, ..TextLine::plain(concat!("SERVOPLOT ", env!("CARGO_PKG_VERSION"))) },
+            TextLine::plain(Msg::SplashName.text(language)),
+            TextLine::plain(Msg::SplashLanguage.text(language)),
+            TextLine::plain(Msg::SplashKeys.text(language)),
+        ],
+        preview: None,
+    }
+}
+
 /// The mode list, the forms, jog and settings.
 fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> ScreenView {
+    let language = settings.language;
+    let say = |msg| Say(msg, language);
     let mut lines: [TextLine; SCREEN_LINES] = Default::default();
     let [title, l1, l2, l3] = &mut lines;
     let mut title_text: String<SCREEN_COLUMNS> = String::new();
     let _ = match menu.screen() {
-        Screen::Modes => Cut(&mut title_text).write_str("SERVOPLOT"),
+        Screen::Splash | Screen::Modes => Cut(&mut title_text).write_str("SERVOPLOT"),
         Screen::Jog | Screen::Presets(_) | Screen::Preview { .. } => {
-            Cut(&mut title_text).write_str(menu.selected().title())
+            write!(Cut(&mut title_text), "{}", say(menu.selected().title()))
         }
         Screen::Settings(page) => write!(
             Cut(&mut title_text),
             "{} {}/{}",
-            Text(Mode::Settings.title()),
+            say(Mode::Settings.title()),
             Int::from(page.index() + 1),
             Int::from(SETTING_INFO.len())
         ),
@@ -88,34 +111,35 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             write!(
                 Cut(&mut title_text),
                 "{} {}/{}",
-                Text(form.mode().title()),
+                say(form.mode().title()),
                 Int::from(form.field_index() + 1),
                 Int::from(form.mode().fields().len())
             )
         }
     };
-    let state = state_name(status);
+    let state = state_name(status).text(language);
     let pad = SCREEN_COLUMNS.saturating_sub(state.len());
     *title = TextLine::new(format_args!("{}{}", Padded::left(&title_text, pad), Text(state)), true);
     *l1 = position_line(status, settings, live.work_offset_mm);
 
     match menu.screen() {
-        Screen::Modes => {
+        Screen::Splash | Screen::Modes => {
             let first = menu.selected().index().min(Mode::ALL.len() - 2);
             for (line, i) in [l2, l3].into_iter().zip(first..) {
                 let mode = Mode::ALL[i];
                 let marker = Text(if mode == menu.selected() { ">" } else { " " });
-                *line = TextLine::new(format_args!("{marker}{} {}", Int::from(i + 1), Text(mode.label())), false);
+                let digit = Int::from((i + 1) % 10);
+                *line = TextLine::new(format_args!("{marker}{digit} {}", say(mode.label())), false);
             }
         }
         Screen::Jog => match menu.jog() {
             Some(jog) => {
-                *l2 = TextLine::new(format_args!("Moving {}", Direction(jog.step)), false);
-                *l3 = TextLine::plain("Release to stop");
+                *l2 = TextLine::new(format_args!("{} {}", say(Msg::JogMoving), Direction(jog.step)), false);
+                *l3 = TextLine::plain(Msg::JogRelease.text(language));
             }
             None => {
                 *l2 = TextLine::plain("2 +Y 8 -Y 4 -X 6 +X");
-                *l3 = TextLine::plain("7 9 1 3 diagonal D back");
+                *l3 = TextLine::plain(Msg::JogKeys.text(language));
             }
         },
         Screen::Form(form) => match form.field() {
@@ -123,10 +147,10 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                 let entry = form.entry();
                 let sign = Text(if entry.is_negative() { "-" } else { "" });
                 *l2 = TextLine::new(
-                    format_args!("{} {}: {sign}{}_", Text(spec.label), Text(spec.unit.symbol()), Text(entry.digits())),
+                    format_args!("{} {}: {sign}{}_", say(spec.label), Text(spec.unit.symbol()), Text(entry.digits())),
                     false,
                 );
-                *l3 = TextLine::plain(spec.hint);
+                *l3 = TextLine::plain(spec.hint.text(language));
             }
             Some(Field::Preset) => match form.typed() {
                 Some(typed) => {
@@ -134,13 +158,13 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     let text = typed.text();
                     let shown = text.get(text.len().saturating_sub(SCREEN_COLUMNS - 3)..).unwrap_or(text);
                     *l2 = TextLine::new(format_args!("y={}_", Text(shown)), false);
-                    *l3 = TextLine::new(format_args!("A>{} C put B del #", Text(typed.token())), false);
+                    *l3 = TextLine::new(format_args!("A>{} {}", Text(typed.token()), say(Msg::KeysTyping)), false);
                 }
                 None => {
                     let p = form.preset();
                     *l2 =
                         TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
-                    *l3 = TextLine::plain("1-5/AB pick C type # ok");
+                    *l3 = TextLine::plain(Msg::KeysPreset.text(language));
                 }
             },
             None => {}
@@ -149,17 +173,21 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             let info = page.info();
             let unit = Text(info.unit.symbol());
             let gap = Text(if unit.0.is_empty() { "" } else { " " });
-            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), Text(info.name)), false);
+            let name = Msg::setting(info.id).map_or("", |name| name.text(language));
+            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), Text(name)), false);
             match page.edit() {
                 Some(entry) => {
                     let sign = Text(if entry.is_negative() { "-" } else { "" });
                     *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", Text(entry.digits())), false);
-                    *l3 = TextLine::plain(SETTING_EDIT_HINT);
+                    *l3 = TextLine::plain(Msg::KeysSet.text(language));
                 }
                 None => {
                     let value = settings.get(info.id).unwrap_or(0.0);
                     *l2 = TextLine::new(format_args!("{}{gap}{unit}", Num(value)), false);
-                    *l3 = TextLine::new(format_args!("{}..{} # edit", Num(info.min), Num(info.max)), false);
+                    *l3 = TextLine::new(
+                        format_args!("{}..{} {}", Num(info.min), Num(info.max), say(Msg::KeysEdit)),
+                        false,
+                    );
                 }
             }
         }
@@ -171,7 +199,8 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                 let preset = SpeedPreset::ALL[i];
                 let marker = Text(if preset == *selected { ">" } else { " " });
                 let set = Text(if preset.is_set(settings) { " *" } else { "" });
-                *line = TextLine::new(format_args!("{marker}{} {}{set}", Int::from(i + 1), Text(preset.name())), false);
+                let name = say(preset_name(preset));
+                *line = TextLine::new(format_args!("{marker}{} {name}{set}", Int::from(i + 1)), false);
             }
         }
         Screen::Preview { .. } => {}
@@ -180,26 +209,35 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
     // The settings stay in view while the machine works (their keys wait for it).
     if menu.is_busy(status) && !matches!(menu.screen(), Screen::Settings(_)) {
         let (doing, keys) = match status.state {
-            RunState::Hold => ("Held", "C resume  D abort"),
-            RunState::Jog => ("Jogging", "D abort"),
-            _ => ("Drawing", "C hold  D abort"),
+            RunState::Hold => (Msg::BusyHeld, Msg::KeysHeld),
+            RunState::Jog => (Msg::BusyJogging, Msg::KeysAbort),
+            _ => (Msg::BusyDrawing, Msg::KeysDrawing),
         };
         // A drawing at another feed than programmed says so.
         let feed = status.overrides.feed_percent;
         let mut what: String<SCREEN_COLUMNS> = String::new();
         let _ = match status.state {
             RunState::Run if feed != OVERRIDE_NONE_PERCENT => {
-                write!(Cut(&mut what), "{} F{}%", Text(doing), Int::from(feed))
+                write!(Cut(&mut what), "{} F{}%", say(doing), Int::from(feed))
             }
-            _ => Cut(&mut what).write_str(doing),
+            _ => write!(Cut(&mut what), "{}", say(doing)),
         };
         lines[2] = match status.queued_jobs {
             0 => TextLine::plain(&what),
-            n => TextLine::new(format_args!("{}, {} queued", Text(&what), Int::from(n)), false),
+            n => TextLine::new(format_args!("{}, {} {}", Text(&what), Int::from(n), say(Msg::Queued)), false),
         };
-        lines[3] = TextLine::plain(keys);
+        lines[3] = TextLine::plain(keys.text(language));
     }
     ScreenView { lines, preview: None }
+}
+
+/// A speed preset's name on the presets screen.
+const fn preset_name(preset: SpeedPreset) -> Msg {
+    match preset {
+        SpeedPreset::FinePen => Msg::PresetFinePen,
+        SpeedPreset::FeltTip => Msg::PresetFeltTip,
+        SpeedPreset::FastDraft => Msg::PresetFastDraft,
+    }
 }
 
 /// Draws `view` over the whole screen; its preview shows `plan` (the menu's, see
@@ -249,60 +287,84 @@ impl fmt::Display for Direction {
     }
 }
 
-struct ErrorText(UiError);
+struct ErrorText(UiError, Language);
 
 impl fmt::Display for ErrorText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let text = match self.0 {
-            UiError::Expression(e) => return write!(f, "Col {} {}", Int::from(e.pos + 1), Text(e.kind.message())),
-            UiError::Entry(EntryError::TooLong) => return write!(f, "Max {} characters", Int::from(ENTRY_MAX_CHARS)),
-            UiError::Entry(EntryError::NotANumber) => "Not a number",
-            UiError::Empty => "Type a value",
-            UiError::OutOfRange { min, max, unit } => {
-                return write!(f, "Range {}..{} {}", Num(min), Num(max), Text(unit.symbol()));
+        let say = |msg| Say(msg, self.1);
+        let msg = match self.0 {
+            UiError::Expression(e) => {
+                let why = say(expression_error(e.kind));
+                return write!(f, "{} {} {why}", say(Msg::ErrColumn), Int::from(e.pos + 1));
             }
-            UiError::Zero => "Must not be 0",
-            UiError::SameEnds => "x1 must differ from x0",
-            UiError::Drawing(DrawError::Travel) => "Beyond travel limits",
-            UiError::Drawing(DrawError::TooSteep) => "too steep: A or 1/P",
-            UiError::Drawing(DrawError::TooFine) => "Finer than a step",
-            UiError::Drawing(DrawError::BadParameter) => "Bad parameter",
-            UiError::Drawing(DrawError::Setup(_)) => "Cannot start here",
-            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => "f(x) jumps too far",
-            UiError::Drawing(DrawError::Fails { .. }) => "f(x) undefined there",
-            UiError::Busy => "Busy: wait, or D abort",
-            UiError::Alarm => "Alarm: motion locked",
-            UiError::HomingOff => "Homing off: $22=1",
-            UiError::Aborted => "Aborted",
-            UiError::NotWhole => "Whole numbers only",
-            UiError::Clash => "Clashes with $201 or $0",
+            UiError::Entry(EntryError::TooLong) => {
+                return write!(f, "{} {} {}", say(Msg::ErrMax), Int::from(ENTRY_MAX_CHARS), say(Msg::ErrCharacters));
+            }
+            UiError::Entry(EntryError::NotANumber) => Msg::ErrNotNumber,
+            UiError::Empty => Msg::ErrEmpty,
+            UiError::OutOfRange { min, max, unit } => {
+                return write!(f, "{} {}..{} {}", say(Msg::ErrRange), Num(min), Num(max), Text(unit.symbol()));
+            }
+            UiError::Zero => Msg::ErrZero,
+            UiError::SameEnds => Msg::ErrSameEnds,
+            UiError::Drawing(DrawError::Travel) => Msg::ErrTravel,
+            UiError::Drawing(DrawError::TooSteep) => Msg::ErrSteep,
+            UiError::Drawing(DrawError::TooFine) => Msg::ErrFine,
+            UiError::Drawing(DrawError::BadParameter) => Msg::ErrParameter,
+            UiError::Drawing(DrawError::Setup(_)) => Msg::ErrStart,
+            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => Msg::ErrJumps,
+            UiError::Drawing(DrawError::Fails { .. }) => Msg::ErrUndefinedThere,
+            UiError::Busy => Msg::ErrBusy,
+            UiError::Alarm => Msg::ErrAlarm,
+            UiError::HomingOff => Msg::ErrHomingOff,
+            UiError::Aborted => Msg::ErrAborted,
+            UiError::NotWhole => Msg::ErrWhole,
+            UiError::Clash => Msg::ErrClash,
         };
-        f.write_str(text)
+        f.write_str(msg.text(self.1))
+    }
+}
+
+/// Why an expression was refused, after its column.
+const fn expression_error(kind: ParseErrorKind) -> Msg {
+    match kind {
+        ParseErrorKind::UnexpectedChar => Msg::ExprUnexpectedChar,
+        ParseErrorKind::UnexpectedEnd => Msg::ExprUnexpectedEnd,
+        ParseErrorKind::UnknownName => Msg::ExprUnknownName,
+        ParseErrorKind::MismatchedParen => Msg::ExprParen,
+        ParseErrorKind::TooLong => Msg::ExprTooLong,
+        ParseErrorKind::TooComplex => Msg::ExprTooComplex,
+        ParseErrorKind::WrongArgCount => Msg::ExprArgCount,
+        ParseErrorKind::NumberOutOfRange => Msg::ExprNumber,
     }
 }
 
 /// Why the last job stopped early, as the screen says it.
-struct FaultText(MotionFault);
+struct FaultText(MotionFault, Language);
 
 impl fmt::Display for FaultText {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let say = |msg| Say(msg, self.1);
         let why = match self.0 {
             MotionFault::Tripped(Trip::Limit { axis, max }) => {
-                return write!(f, "Limit {}{}: $X", Text(axis.name()), Text(if max { "+" } else { "-" }));
+                let end = Text(if max { "+" } else { "-" });
+                return write!(f, "{} {}{end}: $X", say(Msg::FaultLimit), Text(axis.name()));
             }
-            MotionFault::Tripped(Trip::DriverAlarm(axis)) => return write!(f, "{} driver alarm", Text(axis.name())),
-            MotionFault::Tripped(Trip::EStop) => "E-stop",
-            MotionFault::Homing(HomingFail::Aborted) => return f.write_str("Homing aborted"),
+            MotionFault::Tripped(Trip::DriverAlarm(axis)) => {
+                return write!(f, "{} {}", Text(axis.name()), say(Msg::FaultDriver));
+            }
+            MotionFault::Tripped(Trip::EStop) => Msg::FaultEstop,
+            MotionFault::Homing(HomingFail::Aborted) => return write!(f, "{}", say(Msg::FaultHomingAborted)),
             MotionFault::Homing(HomingFail::PullOff(axis) | HomingFail::Approach(axis)) => {
-                return write!(f, "Homing {} failed", Text(axis.name()));
+                return write!(f, "{} {} {}", say(Msg::FaultHoming), Text(axis.name()), say(Msg::FaultFailed));
             }
-            MotionFault::Curve(CurveError::Domain) => "f(x) undefined",
-            MotionFault::Curve(CurveError::DivisionByZero) => "division by 0",
-            MotionFault::Curve(CurveError::Overflow) => "value too large",
-            MotionFault::Curve(CurveError::Jump) => "jump too large",
-            MotionFault::Curve(CurveError::Travel) => "travel limit",
+            MotionFault::Curve(CurveError::Domain) => Msg::FaultUndefined,
+            MotionFault::Curve(CurveError::DivisionByZero) => Msg::FaultDivision,
+            MotionFault::Curve(CurveError::Overflow) => Msg::FaultOverflow,
+            MotionFault::Curve(CurveError::Jump) => Msg::FaultJump,
+            MotionFault::Curve(CurveError::Travel) => Msg::FaultTravel,
         };
-        write!(f, "Stopped: {}", Text(why))
+        write!(f, "{}: {}", say(Msg::FaultStopped), say(why))
     }
 }
 

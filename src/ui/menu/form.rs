@@ -18,6 +18,7 @@ use crate::expr::Expr;
 use crate::geom::{Axis, Point};
 use crate::job::{Feed, Job};
 use crate::keypad::Key;
+use crate::language::Language;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::Text;
@@ -25,6 +26,7 @@ use crate::ui::entry::NumberEntry;
 use crate::ui::expr_entry::ExprEntry;
 use crate::ui::presets::FunctionPreset;
 use crate::ui::run::{JOB_NAME_CHARS, Plan};
+use crate::ui::texts::{Msg, Say};
 use crate::unit::Unit;
 
 /// Line: offset of the end point from the pen, per axis.
@@ -54,14 +56,14 @@ pub const FORM_MAX_FIELDS: usize = 4;
 /// A number to type: its name, unit, range, and what an empty field means.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NumberField {
-    pub label: &'static str,
+    pub label: Msg,
     pub unit: Unit,
     pub range: RangeInclusive<f32>,
     /// Used when `#` confirms an empty field; `None`: a value is required.
     pub default: Option<f32>,
     pub zero_allowed: bool,
     /// One line of help shown under the field.
-    pub hint: &'static str,
+    pub hint: Msg,
 }
 
 impl NumberField {
@@ -101,41 +103,39 @@ pub enum Field {
     Preset,
 }
 
-const HINT_NUMBER: &str = "#ok *. A- Bdel Dback";
-
-const fn mm(label: &'static str, range: RangeInclusive<f32>, zero_allowed: bool, hint: &'static str) -> Field {
+const fn mm(label: Msg, range: RangeInclusive<f32>, zero_allowed: bool, hint: Msg) -> Field {
     Field::Number(NumberField { label, unit: Unit::Mm, range, default: None, zero_allowed, hint })
 }
 
-const fn deg(label: &'static str, range: RangeInclusive<f32>, hint: &'static str) -> Field {
+const fn deg(label: Msg, range: RangeInclusive<f32>, hint: Msg) -> Field {
     Field::Number(NumberField { label, unit: Unit::Deg, range, default: Some(0.0), zero_allowed: true, hint })
 }
 
 const LINE_FIELDS: &[Field] = &[
-    mm("dX", LINE_DELTA_RANGE_MM, true, "X offset from the pen"),
-    mm("dY", LINE_DELTA_RANGE_MM, true, "Y offset from the pen"),
+    mm(Msg::FieldDx, LINE_DELTA_RANGE_MM, true, Msg::HelpDx),
+    mm(Msg::FieldDy, LINE_DELTA_RANGE_MM, true, Msg::HelpDy),
 ];
 const CIRCLE_FIELDS: &[Field] = &[
-    mm("Radius", CIRCLE_RADIUS_RANGE_MM, false, HINT_NUMBER),
-    deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
-    deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
+    mm(Msg::FieldRadius, CIRCLE_RADIUS_RANGE_MM, false, Msg::KeysNumber),
+    deg(Msg::FieldStart, ARC_START_RANGE_DEG, Msg::HelpStart),
+    deg(Msg::FieldSweep, ARC_SWEEP_RANGE_DEG, Msg::HelpSweep),
 ];
 const ELLIPSE_FIELDS: &[Field] = &[
-    mm("a (X)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along X"),
-    mm("b (Y)", ELLIPSE_SEMI_AXIS_RANGE_MM, false, "Semi-axis along Y"),
-    deg("Start", ARC_START_RANGE_DEG, "Pen angle, empty = 0"),
-    deg("Sweep", ARC_SWEEP_RANGE_DEG, "0/empty = full, -=CW"),
+    mm(Msg::FieldA, ELLIPSE_SEMI_AXIS_RANGE_MM, false, Msg::HelpSemiX),
+    mm(Msg::FieldB, ELLIPSE_SEMI_AXIS_RANGE_MM, false, Msg::HelpSemiY),
+    deg(Msg::FieldStart, ARC_START_RANGE_DEG, Msg::HelpStart),
+    deg(Msg::FieldSweep, ARC_SWEEP_RANGE_DEG, Msg::HelpSweep),
 ];
 const SINE_FIELDS: &[Field] = &[
-    mm("Amplitude", SINE_AMPLITUDE_RANGE_MM, true, HINT_NUMBER),
-    mm("Period", SINE_PERIOD_RANGE_MM, false, "One wave along X"),
-    deg("Phase", SINE_PHASE_RANGE_DEG, "Empty = 0"),
-    mm("Length", SINE_LENGTH_RANGE_MM, false, "Along X, - = leftwards"),
+    mm(Msg::FieldAmplitude, SINE_AMPLITUDE_RANGE_MM, true, Msg::KeysNumber),
+    mm(Msg::FieldPeriod, SINE_PERIOD_RANGE_MM, false, Msg::HelpPeriod),
+    deg(Msg::FieldPhase, SINE_PHASE_RANGE_DEG, Msg::HelpEmptyZero),
+    mm(Msg::FieldLength, SINE_LENGTH_RANGE_MM, false, Msg::HelpLength),
 ];
 const FUNCTION_FIELDS: &[Field] = &[
     Field::Preset,
-    mm("x0", FUNCTION_X_RANGE_MM, true, "Start x (at the pen)"),
-    mm("x1", FUNCTION_X_RANGE_MM, true, "End x"),
+    mm(Msg::FieldX0, FUNCTION_X_RANGE_MM, true, Msg::HelpX0),
+    mm(Msg::FieldX1, FUNCTION_X_RANGE_MM, true, Msg::HelpX1),
 ];
 
 impl Mode {
@@ -147,7 +147,7 @@ impl Mode {
             Mode::Ellipse => ELLIPSE_FIELDS,
             Mode::Sine => SINE_FIELDS,
             Mode::Function => FUNCTION_FIELDS,
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => &[],
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => &[],
         }
     }
 }
@@ -271,7 +271,7 @@ impl Form {
             return Ok(None);
         }
         let job = self.job(status, settings);
-        job.map(|job| Some(Plan::of(&job.drawing, self.name(), job.feed, settings)))
+        job.map(|job| Some(Plan::of(&job.drawing, self.name(settings.language), job.feed, settings)))
     }
 
     /// `#` on the preview: the job, built again from the pen (still where the preview was
@@ -339,7 +339,7 @@ impl Form {
                 }
                 Request::Function { expr: self.function()?, x0_mm, x1_mm }
             }
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => return Err(UiError::Empty),
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => return Err(UiError::Empty),
         })
     }
 
@@ -354,18 +354,21 @@ impl Form {
     }
 
     /// The drawing's name on the run screen: the mode and its main figures.
-    pub fn name(&self) -> String<JOB_NAME_CHARS> {
+    pub fn name(&self, language: Language) -> String<JOB_NAME_CHARS> {
         let mut name = String::new();
         let n = |i: usize| Num(self.number(i).unwrap_or(0.0));
+        let say = |msg| Say(msg, language);
         let _ = match self.mode {
-            Mode::Line => write!(name, "Line {},{}", n(0), n(1)),
-            Mode::Circle if self.sweep(2).unwrap_or(360.0).abs() >= 360.0 => write!(name, "Circle r{}", n(0)),
-            Mode::Circle => write!(name, "Arc r{} {}deg", n(0), n(2)),
-            Mode::Ellipse => write!(name, "Ellipse {}x{}", n(0), n(1)),
-            Mode::Sine => write!(name, "Sine A{} P{}", n(0), n(1)),
+            Mode::Line => write!(name, "{} {},{}", say(Msg::LabelLine), n(0), n(1)),
+            Mode::Circle if self.sweep(2).unwrap_or(360.0).abs() >= 360.0 => {
+                write!(name, "{} r{}", say(Msg::NameCircle), n(0))
+            }
+            Mode::Circle => write!(name, "{} r{} {}{}", say(Msg::NameArc), n(0), n(2), say(Msg::Degrees)),
+            Mode::Ellipse => write!(name, "{} {}x{}", say(Msg::LabelEllipse), n(0), n(1)),
+            Mode::Sine => write!(name, "{} A{} P{}", say(Msg::NameSine), n(0), n(1)),
             Mode::Function => write!(name, "y={}", Text(self.function_text())),
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home => {
-                name.push_str(self.mode.label()).map_err(|_| core::fmt::Error)
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => {
+                write!(name, "{}", say(self.mode.label()))
             }
         };
         name

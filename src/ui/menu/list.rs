@@ -4,12 +4,13 @@
 use crate::keypad::Key;
 
 /// Where `key` moves the cursor from `at` in a list of `len` entries: `A` one up, `B` one down
-/// (no wrap), digit `d` to entry `d` (1 the first) if there is one; any other key leaves it.
+/// (no wrap), digit `d` to entry `d` (1 the first, 0 the tenth) if there is one; any other key
+/// leaves it.
 pub fn moved(at: usize, len: usize, key: Key) -> usize {
     match key {
         Key::A => at.saturating_sub(1),
         Key::B => (at + 1).min(len.saturating_sub(1)),
-        Key::Digit(d) if (1..=len).contains(&usize::from(d)) => usize::from(d) - 1,
+        Key::Digit(d) if (usize::from(d) + 9) % 10 < len => (usize::from(d) + 9) % 10,
         _ => at,
     }
 }
@@ -23,5 +24,6 @@ mod tests {
         assert_eq!((moved(0, 3, Key::A), moved(2, 3, Key::B), moved(1, 3, Key::B)), (0, 2, 2));
         assert_eq!((moved(0, 3, Key::Digit(3)), moved(1, 3, Key::Digit(4)), moved(1, 3, Key::Digit(0))), (2, 1, 1));
         assert_eq!(moved(1, 3, Key::C), 1);
+        assert_eq!((moved(1, 10, Key::Digit(0)), moved(1, 10, Key::Digit(1))), (9, 0));
     }
 }

@@ -1,6 +1,8 @@
 //! The menu's top-level modes: their order in the mode list, their titles and labels. The
 //! fields of a mode's form are the forms' own (`form`).
 
+use crate::ui::texts::Msg;
+
 /// A top-level mode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -16,11 +18,13 @@ pub enum Mode {
     Presets,
     /// Runs the homing cycle (`$H`) at once.
     Home,
+    /// Switches the LCD's language (`$216`) at once.
+    Language,
 }
 
 impl Mode {
-    /// Every mode, in menu order: `1` picks the first.
-    pub const ALL: [Mode; 9] = [
+    /// Every mode, in menu order: `1` picks the first, `0` the tenth.
+    pub const ALL: [Mode; 10] = [
         Mode::Jog,
         Mode::Line,
         Mode::Circle,
@@ -30,35 +34,38 @@ impl Mode {
         Mode::Settings,
         Mode::Home,
         Mode::Presets,
+        Mode::Language,
     ];
 
     /// Screen title.
-    pub const fn title(self) -> &'static str {
+    pub const fn title(self) -> Msg {
         match self {
-            Mode::Jog => "JOG",
-            Mode::Line => "LINE",
-            Mode::Circle => "CIRCLE/ARC",
-            Mode::Ellipse => "ELLIPSE",
-            Mode::Sine => "SINE",
-            Mode::Function => "FUNCTION",
-            Mode::Settings => "SETTINGS",
-            Mode::Presets => "PRESETS",
-            Mode::Home => "HOME",
+            Mode::Jog => Msg::TitleJog,
+            Mode::Line => Msg::TitleLine,
+            Mode::Circle => Msg::TitleCircle,
+            Mode::Ellipse => Msg::TitleEllipse,
+            Mode::Sine => Msg::TitleSine,
+            Mode::Function => Msg::TitleFunction,
+            Mode::Settings => Msg::TitleSettings,
+            Mode::Presets => Msg::TitlePresets,
+            Mode::Home => Msg::TitleHome,
+            Mode::Language => Msg::TitleLanguage,
         }
     }
 
     /// Entry in the mode list.
-    pub const fn label(self) -> &'static str {
+    pub const fn label(self) -> Msg {
         match self {
-            Mode::Jog => "Jog",
-            Mode::Line => "Line",
-            Mode::Circle => "Circle/arc",
-            Mode::Ellipse => "Ellipse",
-            Mode::Sine => "Sine wave",
-            Mode::Function => "Function y=f(x)",
-            Mode::Settings => "Settings",
-            Mode::Presets => "Speed presets",
-            Mode::Home => "Home ($H)",
+            Mode::Jog => Msg::LabelJog,
+            Mode::Line => Msg::LabelLine,
+            Mode::Circle => Msg::LabelCircle,
+            Mode::Ellipse => Msg::LabelEllipse,
+            Mode::Sine => Msg::LabelSine,
+            Mode::Function => Msg::LabelFunction,
+            Mode::Settings => Msg::LabelSettings,
+            Mode::Presets => Msg::LabelPresets,
+            Mode::Home => Msg::LabelHome,
+            Mode::Language => Msg::LabelLanguage,
         }
     }
 

@@ -11,9 +11,6 @@ use crate::keypad::Key;
 use crate::settings::{SETTING_INFO, SettingInfo, Settings};
 use crate::ui::entry::NumberEntry;
 
-/// The keys while a value is typed, shown under it.
-pub const SETTING_EDIT_HINT: &str = "#set *. Bdel Dback";
-
 /// The settings screen: the setting shown, and the new value being typed, if any.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SettingPage {

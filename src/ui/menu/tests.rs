@@ -229,8 +229,8 @@ fn mode_list_by_digit_and_by_navigation() {
     for _ in 0..20 {
         m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
     }
-    assert_eq!(m.selected(), Mode::Presets, "stops at the bottom, no wrap");
-    for _ in 0..3 {
+    assert_eq!(m.selected(), Mode::Language, "stops at the bottom, no wrap");
+    for _ in 0..4 {
         m.handle(KeyEvent::Press(Key::A), &idle(), &s);
     }
     m.handle(KeyEvent::Press(Key::Hash), &idle(), &s);
@@ -394,4 +394,16 @@ fn a_typed_function_is_drawn_and_its_errors_say_the_column() {
     assert_eq!((form(&m).typed(), form(&m).preset()), (None, FunctionPreset::Parabola));
     type_keys(&mut m, "D", &idle());
     assert_eq!(*m.screen(), Screen::Modes);
+}
+
+#[test]
+fn key_0_switches_the_language_from_the_mode_list() {
+    let mut m = Menu::new();
+    let english = Settings::default();
+    let action = m.handle(KeyEvent::Press(Key::Digit(0)), &idle(), &english);
+    assert_eq!(action, MenuAction::SetSetting { id: crate::settings::LANGUAGE_SETTING, value: 1.0 });
+    assert_eq!(m.selected(), Mode::Language);
+    let chinese = Settings { language: crate::language::Language::Chinese, ..english };
+    let action = m.handle(KeyEvent::Press(Key::Hash), &idle(), &chinese);
+    assert_eq!(action, MenuAction::SetSetting { id: crate::settings::LANGUAGE_SETTING, value: 0.0 });
 }

@@ -11,6 +11,7 @@ use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::{Padded, Text};
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINES};
+use crate::ui::texts::Msg;
 use crate::ui::trail::Trail;
 
 /// Widest position value shown (`-500.000`, or fewer decimals for larger values).
@@ -89,17 +90,17 @@ impl<const N: usize> Write for Cut<'_, N> {
     }
 }
 
-pub(super) fn state_name(status: &Status) -> &'static str {
+pub(super) fn state_name(status: &Status) -> Msg {
     match status.state {
-        RunState::Idle => "IDLE",
-        RunState::Run => "RUN",
-        RunState::Hold if status.door => "DOOR",
-        RunState::Hold => "HOLD",
-        RunState::Jog => "JOG",
-        RunState::Alarm => "ALARM",
-        RunState::Check => "CHECK",
-        RunState::Sleep => "SLEEP",
-        RunState::Home => "HOME",
+        RunState::Idle => Msg::StateIdle,
+        RunState::Run => Msg::StateRun,
+        RunState::Hold if status.door => Msg::StateDoor,
+        RunState::Hold => Msg::StateHold,
+        RunState::Jog => Msg::StateJog,
+        RunState::Alarm => Msg::StateAlarm,
+        RunState::Check => Msg::StateCheck,
+        RunState::Sleep => Msg::StateSleep,
+        RunState::Home => Msg::StateHome,
     }
 }
 
@@ -109,7 +110,7 @@ pub(super) fn position_line(status: &Status, settings: &Settings, offset_mm: [f3
     position_in(status, settings, offset_mm, "", POSITION_CHARS)
 }
 
-/// [`position_line`] after `prefix`, each value at most `width` characters.
+/// [`position_line`] after `prefix` and a space, each value at most `width` characters.
 pub(super) fn position_in(
     status: &Status,
     settings: &Settings,
@@ -120,7 +121,8 @@ pub(super) fn position_in(
     let x = mm_text(settings.steps_to_mm(Axis::X, status.position.x) - offset_mm[0], width);
     let y = mm_text(settings.steps_to_mm(Axis::Y, status.position.y) - offset_mm[1], width);
     // Inverted while the position may be wrong: until homed.
-    let line = format_args!("{}X{} Y{}", Text(prefix), Padded::right(&x, width), Padded::right(&y, width));
+    let gap = Text(if prefix.is_empty() { "" } else { " " });
+    let line = format_args!("{}{gap}X{} Y{}", Text(prefix), Padded::right(&x, width), Padded::right(&y, width));
     TextLine::new(line, status.position_lost)
 }
 

@@ -24,6 +24,7 @@ use embedded_graphics::primitives::Rectangle;
 
 use super::lines::{Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
 use crate::decimal::{Int, write_digits};
+use crate::language::Language;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::{Padded, Text};
@@ -33,6 +34,7 @@ use crate::ui::layout::{
 };
 use crate::ui::menu::Menu;
 use crate::ui::run::{Plan, Run, RunPage};
+use crate::ui::texts::{Msg, Say};
 use crate::ui::trail::Trail;
 
 /// Characters of text left of a preview `width_px` wide.
@@ -61,14 +63,14 @@ impl fmt::Display for Clock {
 }
 
 /// A drawing built and not started: its planned path, its name and time, and the keys.
-pub(super) fn preview_view(plan: &Plan, status: &Status) -> ScreenView {
+pub(super) fn preview_view(plan: &Plan, status: &Status, language: Language) -> ScreenView {
     let w = columns_beside(PREVIEW_CONFIRM_WIDTH_PX);
     ScreenView {
         lines: [
             TextLine::new(format_args!("{}", Padded::left(&plan.name, w)), true),
-            line(format_args!("Time ~{}", Clock(plan.estimate_ms))),
-            TextLine::plain("# draw"),
-            TextLine::plain("D back"),
+            line(format_args!("{} ~{}", Say(Msg::Time, language), Clock(plan.estimate_ms))),
+            TextLine::plain(Msg::KeysDraw.text(language)),
+            TextLine::plain(Msg::KeysBack.text(language)),
         ],
         preview: Some(PreviewBox {
             area: right_box(PREVIEW_CONFIRM_WIDTH_PX),
@@ -83,15 +85,18 @@ pub(super) fn preview_view(plan: &Plan, status: &Status) -> ScreenView {
 /// The run screen, on the menu's page.
 pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Settings, live: &Live) -> ScreenView {
     let done = run.ended_ms.is_some();
+    let language = settings.language;
+    let say = |msg| Say(msg, language);
     let state = match status.state {
-        _ if done => "DONE",
+        _ if done => Msg::Done,
         // Confirmed, waiting for the servos or the pen (short, so the name keeps its figures).
-        RunState::Idle => "GO",
+        RunState::Idle => Msg::Go,
         _ => state_name(status),
-    };
+    }
+    .text(language);
     let name = match &run.plan {
         Some(plan) => plan.name.as_str(),
-        None => "G-code",
+        None => Msg::NameGcode.text(language),
     };
     let preview = |area| PreviewBox {
         area,
@@ -110,9 +115,9 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             ScreenView {
                 lines: [
                     TextLine::new(format_args!("{}{}", Padded::left(name, w), Text(state)), true),
-                    position_in(status, settings, live.work_offset_mm, "W ", 9),
-                    position_in(status, settings, [0.0; 2], "M ", 9),
-                    TextLine::plain(if done { "Any key: back" } else { "C hold D abort # page" }),
+                    position_in(status, settings, live.work_offset_mm, Msg::Work.text(language), 9),
+                    position_in(status, settings, [0.0; 2], Msg::Machine.text(language), 9),
+                    TextLine::plain(if done { Msg::KeysAny } else { Msg::KeysRun }.text(language)),
                 ],
                 preview: None,
             }
@@ -122,13 +127,15 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             let w = columns - state.len() - 1;
             let elapsed = Clock(run.elapsed_ms(live.now_ms));
             let progress = match (done, run.percent(status.emitted_steps)) {
-                (true, _) => line(format_args!("Plot time {elapsed}")),
+                (true, _) => line(format_args!("{} {elapsed}", say(Msg::PlotTime))),
                 (false, Some(percent)) => {
                     let feed = status.overrides.feed_percent;
                     let left = run.left_ms(status.emitted_steps, feed, live.now_ms).unwrap_or(0);
-                    line(format_args!("{}% {elapsed} left {}", Int::from(percent), Clock(left)))
+                    line(format_args!("{}% {elapsed} {} {}", Int::from(percent), say(Msg::Left), Clock(left)))
                 }
-                (false, None) => line(format_args!("{elapsed}  {} queued", Int::from(status.queued_jobs))),
+                (false, None) => {
+                    line(format_args!("{elapsed}  {} {}", Int::from(status.queued_jobs), say(Msg::Queued)))
+                }
             };
             let speed = if done { 0 } else { (live.speed_mm_per_min + 0.5) as i32 };
             ScreenView {

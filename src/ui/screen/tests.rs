@@ -14,9 +14,12 @@ use embedded_graphics::mono_font::MonoTextStyle;
 use embedded_graphics::mono_font::ascii::FONT_5X7;
 use embedded_graphics::text::{Baseline, Text};
 
+/// Past the splash, at rest, nothing drawn, with no work offset.
+const LATER: Live = Live { now_ms: SPLASH_MS, ..Live::NONE };
+
 /// The screen at rest, nothing drawn, with no work offset.
 fn view(menu: &Menu, status: &Status, settings: &Settings) -> ScreenView {
-    super::view(menu, status, settings, &Live::NONE)
+    super::view(menu, status, settings, &LATER)
 }
 
 fn draw<D: DrawTarget<Color = BinaryColor>>(
@@ -25,7 +28,7 @@ fn draw<D: DrawTarget<Color = BinaryColor>>(
     settings: &Settings,
     target: &mut D,
 ) -> Result<(), D::Error> {
-    super::draw(menu, status, settings, &Live::NONE, target)
+    super::draw(menu, status, settings, &LATER, target)
 }
 
 const W: usize = SCREEN_WIDTH_PX as usize;
@@ -94,8 +97,9 @@ fn press(menu: &mut Menu, keys: &str, status: &Status) {
     }
 }
 
-fn texts(v: &ScreenView) -> [&str; SCREEN_LINES] {
-    [v.lines[0].text.as_str(), v.lines[1].text.as_str(), v.lines[2].text.as_str(), v.lines[3].text.as_str()]
+/// The view's lines as a person reads them.
+fn texts(v: &ScreenView) -> [std::string::String; SCREEN_LINES] {
+    v.lines.clone().map(|line| crate::ui::texts::readable(&line.text))
 }
 
 fn fresh(menu: &Menu, status: &Status) -> Frame {
@@ -170,15 +174,15 @@ fn mode_list_jog_and_settings_screens() {
     press(&mut m, "BBBBBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], [">7 Settings", " 8 Home ($H)"]);
     press(&mut m, "#", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s)), ["SETTINGS 1/38       IDLE", "$0 Pulse width", "5 us", "2.5..100 # edit"]);
+    assert_eq!(texts(&view(&m, &idle, &s)), ["SETTINGS 1/39       IDLE", "$0 Pulse width", "5 us", "2.5..100 # edit"]);
     press(&mut m, "BBBBBBBBBBBBBBBBBBBBBBBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$202 Diagonal steps", "1", "0..1 # edit"]);
     press(&mut m, "BBBB 1*5", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set *. Bdel Dback"]);
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Whole numbers only");
-    press(&mut m, "DDBBB", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[2..], [" 8 Home ($H)", ">9 Speed presets"]);
+    press(&mut m, "DDBB", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2..], [">9 Speed presets", " 0 Language 语言"]);
     press(&mut m, "#B", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["F3000 R6000 A500", ">2 Felt tip *", " 3 Fast draft"]);
     press(&mut m, "D1", &idle);
@@ -329,4 +333,46 @@ fn a_typed_function_shows_its_end_the_wheel_and_its_error() {
     assert_eq!(texts(&view(&m, &idle, &s))[2], "y=0))))))))))))))))))))_");
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Col 7 unmatched ( or )");
+}
+
+#[test]
+fn the_splash_shows_at_power_up_until_a_key_or_its_time() {
+    let mut m = Menu::new();
+    let (idle, s) = (Status::default(), Settings::default());
+    let at = |now_ms| Live { now_ms, ..Live::NONE };
+    let splash = texts(&super::view(&m, &idle, &s, &at(0)));
+    assert_eq!(splash[1..], ["Servo pen plotter", "0: 中文", "Any key: menu"]);
+    assert!(splash[0].starts_with("SERVOPLOT ") && super::view(&m, &idle, &s, &at(0)).lines[0].inverted);
+    assert_eq!(texts(&super::view(&m, &idle, &s, &at(SPLASH_MS)))[2..], [">1 Jog", " 2 Line"]);
+    // A key puts it away at once, and acts on the mode list.
+    press(&mut m, "B", &idle);
+    assert_eq!(texts(&super::view(&m, &idle, &s, &at(0)))[2..], [">2 Line", " 3 Circle/arc"]);
+}
+
+#[test]
+fn every_screen_speaks_chinese_when_set() {
+    let mut m = Menu::new();
+    let idle = Status::default();
+    let s = Settings { language: crate::language::Language::Chinese, ..Settings::default() };
+    assert_eq!(texts(&super::view(&m, &idle, &s, &Live::NONE))[1], "伺服绘图仪", "the splash");
+    assert_eq!(
+        texts(&view(&m, &idle, &s)),
+        ["SERVOPLOT           空闲", "X    0.000 Y    0.000", ">1 点动", " 2 直线"]
+    );
+    press(&mut m, "3", &idle);
+    assert_eq!(
+        texts(&view(&m, &idle, &s)),
+        ["圆/圆弧 1/3         空闲", "X    0.000 Y    0.000", "半径 mm: _", "#确定 *. A- B删 D返回"]
+    );
+    press(&mut m, "#", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[3], "请输入数值");
+    press(&mut m, "9999#", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[3], "范围 0.1..500 mm");
+    press(&mut m, "DD7", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$0 脉冲宽度", "5 us", "2.5..100 #修改"]);
+    let failed = Status { fault: Some(MotionFault::Homing(HomingFail::Approach(crate::geom::Axis::Y))), ..idle };
+    assert_eq!(texts(&view(&m, &failed, &s))[3], "回零 Y 失败");
+    let stopped = Status { fault: Some(MotionFault::Curve(CurveError::DivisionByZero)), ..Status::default() };
+    assert_eq!(texts(&view(&m, &stopped, &s))[3], "停止: 除以 0");
+    assert_eq!(texts(&view(&m, &stopped, &Settings::default()))[3], "Stopped: division by 0");
 }

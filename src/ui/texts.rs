@@ -1,0 +1,101 @@
+//! Every text the LCD shows, in English and in 中文: the [`Msg`] of each, and its text in a
+//! [`Language`]. The texts are written in `src/ui/texts.txt`; build.rs makes the tables of this
+//! module from it, each language's texts as one string, and renders the Chinese characters they
+//! use from u8g2's 7x7 GB2312 font (a font crate's, subset to these texts: about 1.3 KB where
+//! the whole font is 100 KB).
+//!
+//! In the tables, a Chinese character is written as the character [`HANZI_FIRST`] + k that
+//! stands for its glyph k in [`GLYPHS_7X7`]: two bytes in UTF-8, as it takes two columns on the
+//! screen, so a line's length in bytes is its width in columns in either language.
+
+use core::fmt;
+
+use crate::language::Language;
+
+include!(concat!(env!("OUT_DIR"), "/texts.rs"));
+
+impl Msg {
+    /// The text in `language`.
+    pub fn text(self, language: Language) -> &'static str {
+        let (all, lengths) = match language {
+            Language::English => (ENGLISH, &ENGLISH_LENGTHS),
+            Language::Chinese => (CHINESE, &CHINESE_LENGTHS),
+        };
+        // The texts before it: a few hundred additions, at the LCD's pace.
+        let (before, this) = lengths.split_at(self as usize);
+        let start: usize = before.iter().map(|&n| usize::from(n)).sum();
+        let end = start + this.first().map_or(0, |&n| usize::from(n));
+        all.get(start..end).unwrap_or("")
+    }
+}
+
+/// A text in a language, for format strings: `write!(out, "{} {}", Say(Msg::Range, lang), n)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Say(pub Msg, pub Language);
+
+impl fmt::Display for Say {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.0.text(self.1))
+    }
+}
+
+/// `text` as a person reads it: the characters standing for Chinese glyphs turned back into
+/// the Chinese characters (for tests and the simulator's logs).
+#[cfg(not(target_os = "none"))]
+pub fn readable(text: &str) -> std::string::String {
+    text.chars()
+        .map(|c| {
+            let k = (c as u32).wrapping_sub(HANZI_FIRST as u32) as usize;
+            HANZI.chars().nth(k).unwrap_or(c)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::settings::SETTING_INFO;
+    use crate::ui::layout::SCREEN_COLUMNS;
+
+    /// A text's length in bytes is its width in columns: one an ASCII character, two a
+    /// Chinese one.
+    #[test]
+    fn every_text_fits_a_line_and_is_as_wide_as_it_is_long() {
+        for msg in Msg::ALL {
+            for language in [Language::English, Language::Chinese] {
+                let text = msg.text(language);
+                assert!(!text.is_empty() && text.len() <= SCREEN_COLUMNS, "{:?} {}", msg, readable(text));
+                let columns: usize = readable(text).chars().map(|c| if c.is_ascii() { 1 } else { 2 }).sum();
+                assert_eq!(columns, text.len(), "{}", readable(text));
+            }
+        }
+    }
+
+    #[test]
+    fn every_text_reads_back_in_both_languages() {
+        assert_eq!(Msg::TitleJog.text(Language::English), "JOG");
+        assert_eq!(readable(Msg::TitleJog.text(Language::Chinese)), "点动");
+        assert_eq!(readable(Msg::Setting216.text(Language::English)), "Language 1=中文");
+        assert_eq!(readable(Msg::ErrSteep.text(Language::Chinese)), "太陡: 减小 A 或 1/P");
+    }
+
+    /// Longest setting name: "$205 " and the name fill the LCD's 20 columns.
+    const SETTING_NAME_MAX_COLUMNS: usize = 15;
+
+    #[test]
+    fn every_setting_has_a_name_that_fits_and_every_name_a_setting() {
+        for info in SETTING_INFO {
+            let name = Msg::setting(info.id).unwrap_or_else(|| panic!("${} has no name", info.id));
+            for language in [Language::English, Language::Chinese] {
+                let text = name.text(language);
+                assert!(text.len() <= SETTING_NAME_MAX_COLUMNS, "${} {}", info.id, readable(text));
+            }
+        }
+        for id in 0..=u16::MAX {
+            if Msg::setting(id).is_some() {
+                assert!(SETTING_INFO.iter().any(|info| info.id == id), "a name for ${id}, no such setting");
+            }
+        }
+    }
+}
