@@ -80,7 +80,7 @@ fn key_0_switches_the_screen_to_chinese_and_a_power_cycle_keeps_it() {
     let second = power_on(first.flash.clone(), "wait:2500", "$$\n$216=0\n");
     assert!(second.answers().lines().any(|l| l == "$216=1"), "{}", second.answers());
     let (_, splash) = &second.frames[0];
-    assert_eq!((text(splash, 1, 24), text(splash, 2, 24)), ("伺服绘图仪".into(), "0: English".into()));
+    assert_eq!((text(splash, 1, 24), text(splash, 2, 24)), ("伺服绘图机".into(), "0: English".into()));
     assert_eq!(second.settings.language, Language::English);
     let (_, last) = second.frames.last().unwrap();
     assert_eq!((text(last, 0, 24), text(last, 2, 24)), ("SERVOPLOT           IDLE".into(), ">1 Jog".into()));

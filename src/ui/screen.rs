@@ -2,8 +2,10 @@
 //!
 //! [`view`] turns the menu, the machine status and the settings, with what the LCD task adds
 //! ([`Live`]: the clock, the pen's speed, the work offset, the path drawn), into a
-//! [`ScreenView`]: four text lines of [`SCREEN_COLUMNS`] characters in the 5x7 font (whose
-//! decimal point is a dot; the 5x8 font's is a cross, and "0.000" read "0+000"), the title line
+//! [`ScreenView`]: four text lines of [`SCREEN_COLUMNS`] columns in the 5x7 font (whose
+//! decimal point is a dot; the 5x8 font's is a cross, and "0.000" read "0+000") and, in 中文,
+//! 7x7 Chinese glyphs two columns wide, every text in the language of the settings
+//! ([`texts`](crate::ui::texts)); a splash at power-up; the title line
 //! inverted, an error (if any) inverted on the bottom line, and where a path is shown, its
 //! [`PreviewBox`]. The view is small and compares cheaply, so the LCD task redraws only when it
 //! changes. [`render`] draws a whole view: every line's full width is cleared before its text is

@@ -354,7 +354,7 @@ fn every_screen_speaks_chinese_when_set() {
     let mut m = Menu::new();
     let idle = Status::default();
     let s = Settings { language: crate::language::Language::Chinese, ..Settings::default() };
-    assert_eq!(texts(&super::view(&m, &idle, &s, &Live::NONE))[1], "伺服绘图仪", "the splash");
+    assert_eq!(texts(&super::view(&m, &idle, &s, &Live::NONE))[1], "伺服绘图机", "the splash");
     assert_eq!(
         texts(&view(&m, &idle, &s)),
         ["SERVOPLOT           空闲", "X    0.000 Y    0.000", ">1 点动", " 2 直线"]
@@ -369,7 +369,7 @@ fn every_screen_speaks_chinese_when_set() {
     press(&mut m, "9999#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "范围 0.1..500 mm");
     press(&mut m, "DD7", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$0 脉冲宽度", "5 us", "2.5..100 #修改"]);
+    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$0 脉冲宽度", "5 us", "2.5..100 #设定"]);
     let failed = Status { fault: Some(MotionFault::Homing(HomingFail::Approach(crate::geom::Axis::Y))), ..idle };
     assert_eq!(texts(&view(&m, &failed, &s))[3], "回零 Y 失败");
     let stopped = Status { fault: Some(MotionFault::Curve(CurveError::DivisionByZero)), ..Status::default() };
