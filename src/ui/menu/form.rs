@@ -356,21 +356,26 @@ impl Form {
     /// The drawing's name on the run screen: the mode and its main figures.
     pub fn name(&self, language: Language) -> String<JOB_NAME_CHARS> {
         let mut name = String::new();
-        let n = |i: usize| Num(self.number(i).unwrap_or(0.0));
-        let say = |msg| Say(msg, language);
-        let _ = match self.mode {
-            Mode::Line => write!(name, "{} {},{}", say(Msg::LabelLine), n(0), n(1)),
-            Mode::Circle if self.sweep(2).unwrap_or(360.0).abs() >= 360.0 => {
-                write!(name, "{} r{}", say(Msg::NameCircle), n(0))
+        // The name, then each figure after its separator: field numbers into the form.
+        let (label, figures): (Msg, &[(&str, usize)]) = match self.mode {
+            Mode::Line => (Msg::LabelLine, &[(" ", 0), (",", 1)]),
+            Mode::Circle if self.sweep(2).unwrap_or(360.0).abs() >= 360.0 => (Msg::NameCircle, &[(" r", 0)]),
+            Mode::Circle => (Msg::NameArc, &[(" r", 0), (" ", 2)]),
+            Mode::Ellipse => (Msg::LabelEllipse, &[(" ", 0), ("x", 1)]),
+            Mode::Sine => (Msg::NameSine, &[(" A", 0), (" P", 1)]),
+            Mode::Function => {
+                let _ = write!(name, "y={}", Text(self.function_text()));
+                return name;
             }
-            Mode::Circle => write!(name, "{} r{} {}{}", say(Msg::NameArc), n(0), n(2), say(Msg::Degrees)),
-            Mode::Ellipse => write!(name, "{} {}x{}", say(Msg::LabelEllipse), n(0), n(1)),
-            Mode::Sine => write!(name, "{} A{} P{}", say(Msg::NameSine), n(0), n(1)),
-            Mode::Function => write!(name, "y={}", Text(self.function_text())),
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => {
-                write!(name, "{}", say(self.mode.label()))
-            }
+            mode => (mode.label(), &[]),
         };
+        let _ = write!(name, "{}", Say(label, language));
+        for &(separator, field) in figures {
+            let _ = write!(name, "{}{}", Text(separator), Num(self.number(field).unwrap_or(0.0)));
+        }
+        if label == Msg::NameArc {
+            let _ = write!(name, "{}", Say(Msg::Degrees, language));
+        }
         name
     }
 }

@@ -407,3 +407,22 @@ fn key_0_switches_the_language_from_the_mode_list() {
     let action = m.handle(KeyEvent::Press(Key::Hash), &idle(), &chinese);
     assert_eq!(action, MenuAction::SetSetting { id: crate::settings::LANGUAGE_SETTING, value: 0.0 });
 }
+
+#[test]
+fn drawings_are_named_by_their_figures_in_either_language() {
+    use crate::language::Language;
+    use crate::ui::texts::readable;
+    let cases = [
+        ("2 1 0 # 5 #", "Line 10,5", "直线 10,5"),
+        ("3 1 2 # # #", "Circle r12", "圆 r12"),
+        ("3 1 2 # 3 0 # 9 0 #", "Arc r12 90deg", "圆弧 r12 90度"),
+        ("4 3 0 # 1 5 # # #", "Ellipse 30x15", "椭圆 30x15"),
+        ("5 5 # 2 0 # # 4 0 #", "Sine A5 P20", "正弦 A5 P20"),
+    ];
+    for (keys, english, chinese) in cases {
+        let mut m = Menu::new();
+        type_keys(&mut m, keys, &idle());
+        assert_eq!(form(&m).name(Language::English).as_str(), english, "{keys}");
+        assert_eq!(readable(&form(&m).name(Language::Chinese)), chinese, "{keys}");
+    }
+}
