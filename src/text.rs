@@ -15,8 +15,9 @@ impl Display for Text<'_> {
     }
 }
 
-/// A string of ASCII characters fitted to `width` characters: cut if longer, filled with spaces
-/// if shorter, on the right (`right: false`) or on the left.
+/// A string fitted to `width` bytes: cut if longer (before the character that would not fit
+/// whole), filled with spaces if shorter, on the right (`right: false`) or on the left. On the
+/// LCD a byte is a column (see `ui::texts`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Padded<'a> {
     pub text: &'a str,
@@ -38,8 +39,12 @@ impl<'a> Padded<'a> {
 
 impl Display for Padded<'_> {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
-        let text = self.text.get(..self.width).unwrap_or(self.text);
-        let fill = self.width - text.len();
+        let mut end = self.width.min(self.text.len());
+        while !self.text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let text = self.text.get(..end).unwrap_or_default();
+        let fill = self.width - end;
         if !self.right {
             f.write_str(text)?;
         }
@@ -65,5 +70,8 @@ mod tests {
         assert_eq!(format!("[{}]", Padded::right("abc", 5)), "[  abc]");
         assert_eq!(format!("[{}]", Padded::left("abcdef", 4)), "[abcd]");
         assert_eq!(format!("[{}|{}]", Padded::left("", 0), Text("x y")), "[|x y]");
+        // A two-byte character that would not fit whole is left out.
+        assert_eq!(format!("[{}]", Padded::left("ab\u{100}", 3)), "[ab ]");
+        assert_eq!(format!("[{}]", Padded::right("\u{100}c", 3)), "[\u{100}c]");
     }
 }
