@@ -213,7 +213,7 @@ fn scale(mut mantissa: u64, mut exp10: i32) -> Result<f32, DecimalError> {
     // power stays exact (the rounding changes the mantissa by less than 1e-9 of itself).
     while exp10 < -POW10_EXACT_MAX_DECADES && mantissa >= MANTISSA_TRIM_MIN {
         // mantissa < 10^19, far from u64::MAX.
-        mantissa = (mantissa + 5) / 10;
+        mantissa = crate::wide::div_rem(mantissa + 5, 10).0;
         exp10 += 1;
     }
     // Correctly rounded, exact below 2^24.
@@ -273,8 +273,9 @@ pub fn write_digits(out: &mut dyn core::fmt::Write, mut value: u64, min_digits: 
     let min_start = U64_MAX_DIGITS - min_digits.clamp(1, U64_MAX_DIGITS);
     while value > 0 || start > min_start {
         start -= 1;
-        digits[start] = (value % 10) as u8;
-        value /= 10;
+        let (rest, digit) = crate::wide::div_rem(value, 10);
+        digits[start] = digit as u8;
+        value = rest;
     }
     digits[start..].iter().try_for_each(|&d| out.write_char(char::from(b'0' + d)))
 }

@@ -274,10 +274,17 @@ impl Drawing {
         let Ok(copy) = Curve::new(&self.shape, self.start, settings) else { return };
         at(self.start);
         let mut n = 0u64;
+        // Counted down to each sample rather than `n % every`: no 64-bit division (see
+        // `crate::wide`). An `every` of 0 samples no point between the ends.
+        let mut to_sample = every;
         let walked = walk(copy, self.start, |p| {
             n += 1;
-            if n.is_multiple_of(every) && n != self.steps {
-                at(p);
+            to_sample = to_sample.wrapping_sub(1);
+            if to_sample == 0 {
+                to_sample = every;
+                if n != self.steps {
+                    at(p);
+                }
             }
         });
         if n > 0 {

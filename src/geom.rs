@@ -21,7 +21,8 @@ impl Axis {
         }
     }
 
-    /// `X` or `Y`.
+    /// `X` or `Y`. Out of line: seven places name an axis, none on the motion path.
+    #[inline(never)]
     pub const fn name(self) -> &'static str {
         match self {
             Axis::X => "X",

@@ -42,6 +42,7 @@ pub mod text;
 pub mod ui;
 pub mod unit;
 pub mod watchdog;
+pub mod wide;
 
 #[cfg(not(target_os = "none"))]
 pub mod sim;

@@ -6,7 +6,8 @@ use crate::settings::Settings;
 use crate::ui::Menu;
 
 impl Machine {
-    /// A copy of the current settings.
+    /// A copy of the current settings. Out of line: a dozen places read them, none per step.
+    #[inline(never)]
     pub fn settings(&self) -> Settings {
         self.settings.lock(|s| *s.borrow())
     }

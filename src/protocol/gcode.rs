@@ -345,7 +345,8 @@ impl GcodeState {
     }
 
     /// Makes the planned position the machine's real one: after a jog cancel, an abort, an
-    /// alarm, or a move made outside the protocol (keypad).
+    /// alarm, or a move made outside the protocol (keypad). Out of line: four callers.
+    #[inline(never)]
     pub fn sync_position(&mut self, position: Point, settings: &Settings) {
         self.position = position;
         self.position_mm = [settings.steps_to_mm(Axis::X, position.x), settings.steps_to_mm(Axis::Y, position.y)];

@@ -1,7 +1,7 @@
 //! The keypad task: scans the 4x4 matrix every `KEYPAD_SCAN_PERIOD_MS`, decodes key events and
 //! hands them to the menu, then carries out what the menu asks for.
 
-use embassy_time::{Duration, Instant, Ticker, Timer};
+use embassy_time::{Duration, Ticker, Timer};
 use embedded_hal::digital::{InputPin, OutputPin};
 
 use crate::job::{Control, Job};
@@ -22,7 +22,7 @@ pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 
     loop {
         ticker.next().await;
         let raw = scan(&mut columns, &mut rows).await;
-        let now_ms = Instant::now().as_millis() as u32;
+        let now_ms = super::now_ms();
         for event in decoder.update(raw, now_ms) {
             let status = machine.status();
             let settings = machine.settings();

@@ -8,7 +8,7 @@
 //! counts, which costs the motion and the pulses nothing.
 
 use embassy_futures::select::select;
-use embassy_time::{Duration, Instant, Timer};
+use embassy_time::{Duration, Timer};
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_hal::delay::DelayNs;
@@ -92,7 +92,7 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
     let mut last_frame_ms = 0u32;
     let mut drawn = RunPath::default();
     loop {
-        let now_ms = Instant::now().as_millis() as u32;
+        let now_ms = super::now_ms();
         let status = machine.status();
         let settings = machine.settings();
         let menu = machine.menu();

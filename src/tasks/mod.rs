@@ -8,3 +8,15 @@ pub mod lcd;
 pub mod motion;
 pub mod serial;
 pub mod servo;
+
+use embassy_time::{Instant, TICK_HZ};
+
+/// Clock ticks per millisecond: a whole number that fits 16 bits (the clock counts at 1 MHz).
+const TICKS_PER_MS: u64 = TICK_HZ / 1000;
+const _: () = assert!(TICK_HZ.is_multiple_of(1000) && TICKS_PER_MS <= u16::MAX as u64);
+
+/// Milliseconds since boot, wrapping every 2^32 ms (49.7 days): `Instant::now().as_millis() as
+/// u32`, divided without the runtime's 64-bit division (see [`crate::wide`]).
+pub fn now_ms() -> u32 {
+    crate::wide::div_rem(Instant::now().as_ticks(), TICKS_PER_MS as u16).0 as u32
+}

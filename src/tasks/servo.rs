@@ -64,7 +64,7 @@ pub async fn run<P: OutputPin>(
             debounce.clear();
         }
         // The clock of the timings below, wrapping as it allows.
-        let ms = Instant::now().as_millis() as u32;
+        let ms = super::now_ms();
         let mut idle_off = enable.idle_off(ms, machine.at_standstill(), &settings);
         if idle_off && enable.is_on() {
             // Going off for standing still: first no longer ready, then still standing still?

@@ -53,6 +53,7 @@ use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
+use embedded_hal::delay::DelayNs;
 use embedded_hal_bus::spi::ExclusiveDevice;
 use pen::PenPwm;
 use servoplot::machine::Machine;
@@ -103,7 +104,8 @@ unsafe fn UART5() {
     unsafe { EXECUTOR_MOTION.on_interrupt() }
 }
 
-type Lcd = St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, Delay>, Output<'static>, Delay>;
+type Lcd =
+    St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, SpiDelay>, Output<'static>, Delay>;
 
 #[embassy_executor::task]
 async fn motion(machine: &'static Machine, steps: StepProducer<'static>) -> ! {
@@ -160,6 +162,23 @@ impl embedded_hal::digital::OutputPin for NoCs {
     }
     fn set_high(&mut self) -> Result<(), Infallible> {
         Ok(())
+    }
+}
+
+/// The SPI device's delays: embassy-time's, the nanoseconds rounded up to whole microseconds
+/// (the clock's ticks) in 32 bits, as embassy-time rounds them in 64 (which would link the
+/// runtime's 64-bit division, see `servoplot::wide`).
+struct SpiDelay;
+
+impl DelayNs for SpiDelay {
+    fn delay_ns(&mut self, ns: u32) {
+        DelayNs::delay_us(&mut Delay, ns.div_ceil(1_000));
+    }
+    fn delay_us(&mut self, us: u32) {
+        DelayNs::delay_us(&mut Delay, us);
+    }
+    fn delay_ms(&mut self, ms: u32) {
+        DelayNs::delay_ms(&mut Delay, ms);
     }
 }
 
@@ -272,7 +291,7 @@ async fn main(spawner: Spawner) {
     spi_config.frequency = Hertz(LCD_SPI_HZ);
     spi_config.mode = spi::MODE_3;
     let spi_bus = Spi::new_blocking_txonly(p.SPI2, p.PB13, p.PB15, spi_config);
-    let spi_dev = unwrap!(ExclusiveDevice::new(spi_bus, NoCs, Delay));
+    let spi_dev = unwrap!(ExclusiveDevice::new(spi_bus, NoCs, SpiDelay));
     let lcd_cs = Output::new(p.PB12, Level::Low, Speed::Low);
     let lcd_rst = Output::new(p.PB11, Level::High, Speed::Low);
     spawner.spawn(unwrap!(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));

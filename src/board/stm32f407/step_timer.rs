@@ -4,6 +4,7 @@
 //! pulse engine at the highest priority; the motion task pends that interrupt to start it.
 
 use core::cell::RefCell;
+use core::mem::MaybeUninit;
 
 use embassy_stm32::Peri;
 use embassy_stm32::gpio::{Level, Output};
@@ -117,9 +118,27 @@ struct Pulses {
     machine: &'static Machine,
 }
 
-static PULSES: Mutex<CriticalSectionRawMutex, RefCell<Option<Pulses>>> = Mutex::new(RefCell::new(None));
+/// Where the interrupt finds the engine once [`start`] has put it there. Not an
+/// `Option<Pulses>`: its `None` is not all zero bytes, so the static would be copied from flash
+/// at boot (120 B of it); this one is zero, in `.bss`, and the interrupt tests one byte all the
+/// same.
+struct Slot {
+    /// `pulses` holds the engine.
+    filled: bool,
+    pulses: MaybeUninit<Pulses>,
+}
 
-/// Hands the engine to the interrupt and enables it at `priority`.
+impl Slot {
+    fn get(&mut self) -> Option<&mut Pulses> {
+        // SAFETY: `filled` is set only once `pulses` is written, and never cleared.
+        self.filled.then(|| unsafe { self.pulses.assume_init_mut() })
+    }
+}
+
+static PULSES: Mutex<CriticalSectionRawMutex, RefCell<Slot>> =
+    Mutex::new(RefCell::new(Slot { filled: false, pulses: MaybeUninit::uninit() }));
+
+/// Hands the engine to the interrupt and enables it at `priority`; once, at power-on.
 pub fn start(
     timer: Tim1StepTimer,
     steps: StepConsumer<'static>,
@@ -127,7 +146,11 @@ pub fn start(
     priority: interrupt::Priority,
 ) {
     let pulses = Pulses { engine: PulseEngine::new(timer, steps), machine };
-    PULSES.lock(|p| *p.borrow_mut() = Some(pulses));
+    PULSES.lock(|p| {
+        let mut slot = p.borrow_mut();
+        slot.pulses.write(pulses);
+        slot.filled = true;
+    });
     interrupt::TIM1_UP_TIM10.set_priority(priority);
     interrupt::TIM1_UP_TIM10.unpend();
     // SAFETY: the handler below only touches PULSES, set just above.
@@ -148,7 +171,7 @@ fn TIM1_UP_TIM10() {
         regs.sr().write_value(SrAdv(!1));
     }
     PULSES.lock(|p| {
-        if let Some(p) = p.borrow_mut().as_mut() {
+        if let Some(p) = p.borrow_mut().get() {
             if update {
                 p.engine.on_period(p.machine);
             }
