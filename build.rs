@@ -10,7 +10,7 @@ use embedded_graphics::mono_font::MonoTextStyle;
 use embedded_graphics::mono_font::ascii::FONT_5X7;
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::text::{Baseline, Text};
-use std::collections::BTreeSet;
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use u8g2_fonts::FontRenderer;
@@ -19,11 +19,15 @@ use u8g2_fonts::types::{FontColor, VerticalPosition};
 
 /// The LCD's texts, `name | English | 中文` a line.
 const TEXTS: &str = "src/ui/texts.txt";
-/// The first of the characters that stand for Chinese glyphs in the texts' tables: the k-th
+/// The first of the characters that stand for Chinese glyphs on the screen's lines: the k-th
 /// glyph is `HANZI_FIRST + k`, two bytes in UTF-8 up to U+07FF, as it is two columns wide on the
 /// screen.
 const HANZI_FIRST: u32 = 0x100;
 const HANZI_LAST: u32 = 0x7ff;
+/// In the texts' tables, the first [`HANZI_ONE_BYTE`] glyphs (the most used) are one byte,
+/// `0x80 + k`; the others two, [`HANZI_ESCAPE`] then `k - HANZI_ONE_BYTE`.
+const HANZI_ONE_BYTE: usize = 128;
+const HANZI_ESCAPE: u8 = 0x01;
 
 fn main() {
     println!("cargo:rerun-if-changed=memory.x");
@@ -127,9 +131,9 @@ struct Entry {
     chinese: String,
 }
 
-/// `$OUT_DIR/texts.rs`: from [`TEXTS`], the `Msg` enum, each language's texts as one string
-/// and their lengths in it, a Chinese character written as the glyph that stands for
-/// it, and those glyphs: the Chinese characters used, each rendered from u8g2's 7x7 GB2312 font
+/// `$OUT_DIR/texts.rs`: from [`TEXTS`], the `Msg` enum, each language's texts as one run of
+/// bytes and their lengths in it, ASCII as it is and a Chinese character as the number of its
+/// glyph (one byte, or two for the least used), and those glyphs: the Chinese characters used, each rendered from u8g2's 7x7 GB2312 font
 /// by its own renderer, 49 bits a glyph in the 5x7 table's order.
 fn write_texts(out: &Path) {
     let source = std::fs::read_to_string(TEXTS).expect("the texts file is readable");
@@ -150,16 +154,27 @@ fn write_texts(out: &Path) {
         );
         entries.push(Entry { name: name.into(), english: english.into(), chinese: chinese.into() });
     }
-    let used: BTreeSet<char> = entries.iter().flat_map(|e| e.english.chars().chain(e.chinese.chars())).collect();
-    let hanzi: Vec<char> = used.iter().copied().filter(|c| !(' '..='~').contains(c)).collect();
+    // The Chinese characters, the most used first.
+    let mut uses: BTreeMap<char, usize> = BTreeMap::new();
+    for c in entries.iter().flat_map(|e| e.english.chars().chain(e.chinese.chars())) {
+        if !(' '..='~').contains(&c) {
+            *uses.entry(c).or_default() += 1;
+        }
+    }
+    let mut hanzi: Vec<char> = uses.keys().copied().collect();
+    hanzi.sort_by_key(|c| (std::cmp::Reverse(uses[c]), *c));
     assert!(HANZI_FIRST + hanzi.len() as u32 <= HANZI_LAST + 1, "too many Chinese characters");
-    let encode = |text: &str| -> String {
-        text.chars()
-            .map(|c| match hanzi.binary_search(&c) {
-                Ok(k) => char::from_u32(HANZI_FIRST + k as u32).expect("in the two-byte range"),
-                Err(_) => c,
-            })
-            .collect()
+    assert!(hanzi.len() <= HANZI_ONE_BYTE + 256, "too many Chinese characters for the escape byte");
+    let encode = |text: &str| -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for c in text.chars() {
+            match hanzi.iter().position(|&h| h == c) {
+                Some(k) if k < HANZI_ONE_BYTE => bytes.push(0x80 + k as u8),
+                Some(k) => bytes.extend([HANZI_ESCAPE, (k - HANZI_ONE_BYTE) as u8]),
+                None => bytes.push(u8::try_from(c).expect("ASCII")),
+            }
+        }
+        bytes
     };
 
     let mut src = String::from(
@@ -178,7 +193,13 @@ fn write_texts(out: &Path) {
         ("CHINESE", entries.iter().map(|e| encode(&e.chinese)).collect()),
     ] {
         let lengths: Vec<u8> = texts.iter().map(|t| u8::try_from(t.len()).expect("a text fits a line")).collect();
-        writeln!(src, "const {table}: &str = {:?};", texts.concat()).expect("writing to a String");
+        writeln!(
+            src,
+            "const {table}: [u8; {}] = {:?};",
+            lengths.iter().map(|&n| usize::from(n)).sum::<usize>(),
+            texts.concat()
+        )
+        .expect("writing to a String");
         writeln!(src, "const {table}_LENGTHS: [u8; {}] = {lengths:?};", lengths.len()).expect("writing to a String");
     }
     src.push_str("\nimpl Msg {\n    /// The name of setting `$id`, if it has one.\n");
@@ -217,7 +238,13 @@ fn write_texts(out: &Path) {
         .expect("writing to a String");
     writeln!(
         src,
-        "/// The Chinese characters, in glyph order.\n#[cfg(not(target_os = \"none\"))]\npub const HANZI: &str = {:?};",
+        "/// The glyphs a table byte `0x80 + k` stands for; the others are `{HANZI_ESCAPE:#04x}` and\n\
+         /// `k - HANZI_ONE_BYTE`.\nconst HANZI_ONE_BYTE: usize = {HANZI_ONE_BYTE};\nconst HANZI_ESCAPE: u8 = {HANZI_ESCAPE:#04x};"
+    )
+    .expect("writing to a String");
+    writeln!(
+        src,
+        "/// The Chinese characters, in glyph order (the most used first).\n#[cfg(not(target_os = \"none\"))]\npub const HANZI: &str = {:?};",
         hanzi.iter().collect::<String>()
     )
     .expect("writing to a String");

@@ -41,7 +41,7 @@ impl Plan {
     /// steps, and the time that path takes at the planner's cruise speed.
     pub fn of(drawing: &Drawing, name: String<JOB_NAME_CHARS>, feed: Feed, settings: &Settings) -> Plan {
         let mut path = Trail::new();
-        let every = (drawing.steps() / (TRAIL_POINTS as u64 - 2)).max(1);
+        let every = crate::wide::div_rem(drawing.steps(), TRAIL_POINTS as u16 - 2).0.max(1);
         drawing.sample_path(settings, every, &mut |p| path.push(p, true));
         let limits = Limits::from_settings(settings);
         let [vx, vy] = limits.max_speed_mm_per_s();
@@ -87,7 +87,9 @@ impl Run {
     /// Progress in whole percent of the plan's steps: 100 only once every step is out.
     pub fn percent(&self, emitted_steps: u32) -> Option<u8> {
         let (done, all) = self.done_steps(emitted_steps)?;
-        Some((u64::from(done) * 100 / u64::from(all)) as u8)
+        // In f32 (no 64-bit division on the target); a step short of the end stays below 100.
+        let percent = (done as f32 * 100.0 / all as f32) as u8;
+        Some(if done < all { percent.min(99) } else { 100 })
     }
 
     /// The time left, ms; `None` without a plan. At first it is the planner's time for the
@@ -97,16 +99,14 @@ impl Run {
     /// curves, holds, override changes.
     pub fn left_ms(&self, emitted_steps: u32, feed_percent: u8, now_ms: u32) -> Option<u32> {
         let (done, all) = self.done_steps(emitted_steps)?;
-        let (done, all) = (u64::from(done), u64::from(all));
-        let left = all - done.min(all);
-        let estimate = u64::from(self.plan.as_ref()?.estimate_ms);
-        let planned = estimate * left / all * 100 / u64::from(feed_percent.max(1));
-        let paced = match done {
-            0 => planned,
-            _ => u64::from(self.elapsed_ms(now_ms)) * left / done,
-        };
-        let blend = (planned * (all - done) + paced * done) / all;
-        Some(blend.min(u64::from(u32::MAX)) as u32)
+        // In f32: a display's precision, and no 64-bit division on the target.
+        let (done, all) = (done as f32, all as f32);
+        let left = all - done;
+        let estimate = self.plan.as_ref()?.estimate_ms as f32;
+        let planned = estimate * left / all * 100.0 / f32::from(feed_percent.max(1));
+        let paced = if done > 0.0 { self.elapsed_ms(now_ms) as f32 * left / done } else { planned };
+        // Saturating: a time beyond 49 days shows as that.
+        Some(((planned * left + paced * done) / all) as u32)
     }
 }
 

@@ -82,9 +82,9 @@ fn splash_view(language: Language) -> ScreenView {
     ScreenView {
         lines: [
             TextLine { inverted: true, ..TextLine::plain(concat!("SERVOPLOT ", env!("CARGO_PKG_VERSION"))) },
-            TextLine::plain(Msg::SplashName.text(language)),
-            TextLine::plain(Msg::SplashLanguage.text(language)),
-            TextLine::plain(Msg::SplashKeys.text(language)),
+            TextLine::say(Msg::SplashName, language),
+            TextLine::say(Msg::SplashLanguage, language),
+            TextLine::say(Msg::SplashKeys, language),
         ],
         preview: None,
     }
@@ -119,9 +119,9 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             )
         }
     };
-    let state = state_name(status).text(language);
-    let pad = SCREEN_COLUMNS.saturating_sub(state.len());
-    *title = TextLine::new(format_args!("{}{}", Padded::left(&title_text, pad), Text(state)), true);
+    let state = say(state_name(status));
+    let pad = SCREEN_COLUMNS.saturating_sub(state.columns());
+    *title = TextLine::new(format_args!("{}{state}", Padded::left(&title_text, pad)), true);
     *l1 = position_line(status, settings, live.work_offset_mm);
 
     match menu.screen() {
@@ -137,11 +137,11 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         Screen::Jog => match menu.jog() {
             Some(jog) => {
                 *l2 = TextLine::new(format_args!("{} {}", say(Msg::JogMoving), Direction(jog.step)), false);
-                *l3 = TextLine::plain(Msg::JogRelease.text(language));
+                *l3 = TextLine::say(Msg::JogRelease, language);
             }
             None => {
                 *l2 = TextLine::plain("2 +Y 8 -Y 4 -X 6 +X");
-                *l3 = TextLine::plain(Msg::JogKeys.text(language));
+                *l3 = TextLine::say(Msg::JogKeys, language);
             }
         },
         Screen::Form(form) => match form.field() {
@@ -152,7 +152,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     format_args!("{} {}: {sign}{}_", say(spec.label), Text(spec.unit.symbol()), Text(entry.digits())),
                     false,
                 );
-                *l3 = TextLine::plain(spec.hint.text(language));
+                *l3 = TextLine::say(spec.hint, language);
             }
             Some(Field::Preset) => match form.typed() {
                 Some(typed) => {
@@ -166,7 +166,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     let p = form.preset();
                     *l2 =
                         TextLine::new(format_args!("f{} y={}", Int::from(p.index() + 1), Text(p.expression())), false);
-                    *l3 = TextLine::plain(Msg::KeysPreset.text(language));
+                    *l3 = TextLine::say(Msg::KeysPreset, language);
                 }
             },
             None => {}
@@ -175,13 +175,14 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             let info = page.info();
             let unit = Text(info.unit.symbol());
             let gap = Text(if unit.0.is_empty() { "" } else { " " });
-            let name = Msg::setting(info.id).map_or("", |name| name.text(language));
-            *l1 = TextLine::new(format_args!("${} {}", Int::from(info.id), Text(name)), false);
+            // Every setting has a name (a test holds the two lists to each other).
+            let name = say(Msg::setting(info.id).unwrap_or(Msg::TitleSettings));
+            *l1 = TextLine::new(format_args!("${} {name}", Int::from(info.id)), false);
             match page.edit() {
                 Some(entry) => {
                     let sign = Text(if entry.is_negative() { "-" } else { "" });
                     *l2 = TextLine::new(format_args!("={sign}{}_{gap}{unit}", Text(entry.digits())), false);
-                    *l3 = TextLine::plain(Msg::KeysSet.text(language));
+                    *l3 = TextLine::say(Msg::KeysSet, language);
                 }
                 None => {
                     let value = settings.get(info.id).unwrap_or(0.0);
@@ -228,7 +229,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             0 => TextLine::plain(&what),
             n => TextLine::new(format_args!("{}, {} {}", Text(&what), Int::from(n), say(Msg::Queued)), false),
         };
-        lines[3] = TextLine::plain(keys.text(language));
+        lines[3] = TextLine::say(keys, language);
     }
     ScreenView { lines, preview: None }
 }
@@ -323,7 +324,7 @@ impl fmt::Display for ErrorText {
             UiError::NotWhole => Msg::ErrWhole,
             UiError::Clash => Msg::ErrClash,
         };
-        f.write_str(msg.text(self.1))
+        write!(f, "{}", say(msg))
     }
 }
 

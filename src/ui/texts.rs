@@ -1,41 +1,60 @@
-//! Every text the LCD shows, in English and in 中文: the [`Msg`] of each, and its text in a
-//! [`Language`]. The texts are written in `src/ui/texts.txt`; build.rs makes the tables of this
-//! module from it, each language's texts as one string, and renders the Chinese characters they
-//! use from u8g2's 7x7 GB2312 font (a font crate's, subset to these texts: about 1.3 KB where
-//! the whole font is 100 KB).
+//! Every text the LCD shows, in English and in 中文: the [`Msg`] of each, and [`Say`], its
+//! text in a [`Language`]. The texts are written in `src/ui/texts.txt`; build.rs makes the
+//! tables of this module from it, each language's texts as one run of bytes, and renders the
+//! Chinese characters they use from u8g2's 7x7 GB2312 font (a font crate's, subset to these
+//! texts: about 1.2 KB where the whole font is 100 KB).
 //!
-//! In the tables, a Chinese character is written as the character [`HANZI_FIRST`] + k that
-//! stands for its glyph k in [`GLYPHS_7X7`]: two bytes in UTF-8, as it takes two columns on the
-//! screen, so a line's length in bytes is its width in columns in either language.
+//! In the tables a Chinese character is the number of its glyph in [`GLYPHS_7X7`]: one byte
+//! for the 128 most used, two for the others. On the screen's lines it is the character
+//! [`HANZI_FIRST`] + k: two bytes in UTF-8, as it takes two columns on the screen, so a line's
+//! length in bytes is its width in columns in either language.
 
-use core::fmt;
+use core::fmt::{self, Write};
 
 use crate::language::Language;
 
 include!(concat!(env!("OUT_DIR"), "/texts.rs"));
 
-impl Msg {
-    /// The text in `language`.
-    pub fn text(self, language: Language) -> &'static str {
-        let (all, lengths) = match language {
-            Language::English => (ENGLISH, &ENGLISH_LENGTHS),
-            Language::Chinese => (CHINESE, &CHINESE_LENGTHS),
-        };
-        // The texts before it: a few hundred additions, at the LCD's pace.
-        let (before, this) = lengths.split_at(self as usize);
-        let start: usize = before.iter().map(|&n| usize::from(n)).sum();
-        let end = start + this.first().map_or(0, |&n| usize::from(n));
-        all.get(start..end).unwrap_or("")
-    }
-}
-
 /// A text in a language, for format strings: `write!(out, "{} {}", Say(Msg::Range, lang), n)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Say(pub Msg, pub Language);
 
+impl Say {
+    /// The text's bytes as the tables keep them.
+    fn bytes(self) -> &'static [u8] {
+        let (all, lengths): (&[u8], &[u8]) = match self.1 {
+            Language::English => (&ENGLISH, &ENGLISH_LENGTHS),
+            Language::Chinese => (&CHINESE, &CHINESE_LENGTHS),
+        };
+        // The texts before it: a few hundred additions, at the LCD's pace.
+        let (before, this) = lengths.split_at(self.0 as usize);
+        let start: usize = before.iter().map(|&n| usize::from(n)).sum();
+        let end = start + this.first().map_or(0, |&n| usize::from(n));
+        all.get(start..end).unwrap_or_default()
+    }
+
+    /// Its characters: ASCII, or the character standing for a Chinese glyph.
+    fn chars(self) -> impl Iterator<Item = char> {
+        let mut bytes = self.bytes().iter();
+        core::iter::from_fn(move || {
+            let glyph = match *bytes.next()? {
+                HANZI_ESCAPE => HANZI_ONE_BYTE + usize::from(*bytes.next()?),
+                b @ 0x80.. => usize::from(b - 0x80),
+                b => return Some(char::from(b)),
+            };
+            char::from_u32(HANZI_FIRST as u32 + glyph as u32)
+        })
+    }
+
+    /// How many columns it takes on the screen: two a Chinese character.
+    pub fn columns(self) -> usize {
+        self.chars().map(char::len_utf8).sum()
+    }
+}
+
 impl fmt::Display for Say {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.0.text(self.1))
+        self.chars().try_for_each(|c| f.write_char(c))
     }
 }
 
@@ -64,20 +83,23 @@ mod tests {
     fn every_text_fits_a_line_and_is_as_wide_as_it_is_long() {
         for msg in Msg::ALL {
             for language in [Language::English, Language::Chinese] {
-                let text = msg.text(language);
-                assert!(!text.is_empty() && text.len() <= SCREEN_COLUMNS, "{:?} {}", msg, readable(text));
-                let columns: usize = readable(text).chars().map(|c| if c.is_ascii() { 1 } else { 2 }).sum();
-                assert_eq!(columns, text.len(), "{}", readable(text));
+                let text = std::format!("{}", Say(msg, language));
+                assert!(!text.is_empty() && text.len() <= SCREEN_COLUMNS, "{:?} {}", msg, readable(&text));
+                let columns: usize = readable(&text).chars().map(|c| if c.is_ascii() { 1 } else { 2 }).sum();
+                assert_eq!((columns, Say(msg, language).columns()), (text.len(), text.len()), "{}", readable(&text));
             }
         }
     }
 
     #[test]
     fn every_text_reads_back_in_both_languages() {
-        assert_eq!(Msg::TitleJog.text(Language::English), "JOG");
-        assert_eq!(readable(Msg::TitleJog.text(Language::Chinese)), "点动");
-        assert_eq!(readable(Msg::Setting216.text(Language::English)), "Language 1=中文");
-        assert_eq!(readable(Msg::ErrSteep.text(Language::Chinese)), "太陡: 减小 A 或 1/P");
+        let say = |msg, language| readable(&std::format!("{}", Say(msg, language)));
+        assert_eq!(say(Msg::TitleJog, Language::English), "JOG");
+        assert_eq!(say(Msg::TitleJog, Language::Chinese), "点动");
+        assert_eq!(say(Msg::Setting216, Language::English), "Language 1=中文");
+        assert_eq!(say(Msg::ErrSteep, Language::Chinese), "太陡: 减小 A 或 1/P");
+        // The least used characters take the escape.
+        assert_eq!(say(Msg::Setting215, Language::Chinese), "蜂鸣器");
     }
 
     /// Longest setting name: "$205 " and the name fill the LCD's 20 columns.
@@ -88,8 +110,8 @@ mod tests {
         for info in SETTING_INFO {
             let name = Msg::setting(info.id).unwrap_or_else(|| panic!("${} has no name", info.id));
             for language in [Language::English, Language::Chinese] {
-                let text = name.text(language);
-                assert!(text.len() <= SETTING_NAME_MAX_COLUMNS, "${} {}", info.id, readable(text));
+                let text = std::format!("{}", Say(name, language));
+                assert!(text.len() <= SETTING_NAME_MAX_COLUMNS, "${} {}", info.id, readable(&text));
             }
         }
         for id in 0..=u16::MAX {

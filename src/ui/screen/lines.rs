@@ -7,11 +7,12 @@ use embedded_graphics::primitives::Rectangle;
 use heapless::String;
 
 use crate::geom::{self, Axis};
+use crate::language::Language;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::text::{Padded, Text};
+use crate::text::Padded;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINES};
-use crate::ui::texts::Msg;
+use crate::ui::texts::{Msg, Say};
 use crate::ui::trail::Trail;
 
 /// Widest position value shown (`-500.000`, or fewer decimals for larger values).
@@ -30,6 +31,11 @@ impl TextLine {
         let mut line = TextLine { text: String::new(), inverted };
         let _ = Cut(&mut line.text).write_fmt(args);
         line
+    }
+
+    /// `msg` in `language`, not inverted.
+    pub(super) fn say(msg: Msg, language: Language) -> Self {
+        TextLine::new(format_args!("{}", Say(msg, language)), false)
     }
 
     /// `text` as it is, not inverted.
@@ -107,23 +113,26 @@ pub(super) fn state_name(status: &Status) -> Msg {
 /// The pen's position in work coordinates (`offset_mm` the work offset), or in machine
 /// coordinates with no offset, `width` characters a value at most.
 pub(super) fn position_line(status: &Status, settings: &Settings, offset_mm: [f32; 2]) -> TextLine {
-    position_in(status, settings, offset_mm, "", POSITION_CHARS)
+    position_in(status, settings, offset_mm, None, POSITION_CHARS)
 }
 
-/// [`position_line`] after `prefix` and a space, each value at most `width` characters.
+/// [`position_line`] after `prefix` (if any) and a space, each value at most `width` characters.
 pub(super) fn position_in(
     status: &Status,
     settings: &Settings,
     offset_mm: [f32; 2],
-    prefix: &str,
+    prefix: Option<Say>,
     width: usize,
 ) -> TextLine {
     let x = mm_text(settings.steps_to_mm(Axis::X, status.position.x) - offset_mm[0], width);
     let y = mm_text(settings.steps_to_mm(Axis::Y, status.position.y) - offset_mm[1], width);
     // Inverted while the position may be wrong: until homed.
-    let gap = Text(if prefix.is_empty() { "" } else { " " });
-    let line = format_args!("{}{gap}X{} Y{}", Text(prefix), Padded::right(&x, width), Padded::right(&y, width));
-    TextLine::new(line, status.position_lost)
+    let (x, y) = (Padded::right(&x, width), Padded::right(&y, width));
+    let lost = status.position_lost;
+    match prefix {
+        Some(prefix) => TextLine::new(format_args!("{prefix} X{x} Y{y}"), lost),
+        None => TextLine::new(format_args!("X{x} Y{y}"), lost),
+    }
 }
 
 /// `mm` with 3 decimals, or fewer when it would not fit `width` characters

@@ -17,7 +17,9 @@
 //! `#` shows the path over the whole screen, then machine coordinates with the keys. Once the
 //! machine is at rest the first page says DONE and gives the plot time, until a key.
 
-use core::fmt;
+use core::fmt::{self, Write};
+
+use heapless::String;
 
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::primitives::Rectangle;
@@ -27,13 +29,13 @@ use crate::decimal::{Int, write_digits};
 use crate::language::Language;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
-use crate::text::{Padded, Text};
+use crate::text::Padded;
 use crate::ui::layout::{
     PREVIEW_BESIDE_WIDTH_PX, PREVIEW_CONFIRM_WIDTH_PX, SCREEN_CHAR_WIDTH_PX, SCREEN_COLUMNS, SCREEN_HEIGHT_PX,
     SCREEN_MARGIN_PX, SCREEN_WIDTH_PX,
 };
 use crate::ui::menu::Menu;
-use crate::ui::run::{Plan, Run, RunPage};
+use crate::ui::run::{JOB_NAME_CHARS, Plan, Run, RunPage};
 use crate::ui::texts::{Msg, Say};
 use crate::ui::trail::Trail;
 
@@ -69,8 +71,8 @@ pub(super) fn preview_view(plan: &Plan, status: &Status, language: Language) -> 
         lines: [
             TextLine::new(format_args!("{}", Padded::left(&plan.name, w)), true),
             line(format_args!("{} ~{}", Say(Msg::Time, language), Clock(plan.estimate_ms))),
-            TextLine::plain(Msg::KeysDraw.text(language)),
-            TextLine::plain(Msg::KeysBack.text(language)),
+            TextLine::say(Msg::KeysDraw, language),
+            TextLine::say(Msg::KeysBack, language),
         ],
         preview: Some(PreviewBox {
             area: right_box(PREVIEW_CONFIRM_WIDTH_PX),
@@ -87,16 +89,19 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
     let done = run.ended_ms.is_some();
     let language = settings.language;
     let say = |msg| Say(msg, language);
-    let state = match status.state {
+    let state = say(match status.state {
         _ if done => Msg::Done,
         // Confirmed, waiting for the servos or the pen (short, so the name keeps its figures).
         RunState::Idle => Msg::Go,
         _ => state_name(status),
-    }
-    .text(language);
+    });
+    let mut gcode: String<JOB_NAME_CHARS> = String::new();
     let name = match &run.plan {
         Some(plan) => plan.name.as_str(),
-        None => Msg::NameGcode.text(language),
+        None => {
+            let _ = write!(gcode, "{}", say(Msg::NameGcode));
+            gcode.as_str()
+        }
     };
     let preview = |area| PreviewBox {
         area,
@@ -111,20 +116,20 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             preview: Some(preview(Rectangle::new(Point::zero(), Size::new(SCREEN_WIDTH_PX, SCREEN_HEIGHT_PX)))),
         },
         RunPage::Machine => {
-            let w = SCREEN_COLUMNS - state.len();
+            let w = SCREEN_COLUMNS - state.columns();
             ScreenView {
                 lines: [
-                    TextLine::new(format_args!("{}{}", Padded::left(name, w), Text(state)), true),
-                    position_in(status, settings, live.work_offset_mm, Msg::Work.text(language), 9),
-                    position_in(status, settings, [0.0; 2], Msg::Machine.text(language), 9),
-                    TextLine::plain(if done { Msg::KeysAny } else { Msg::KeysRun }.text(language)),
+                    TextLine::new(format_args!("{}{state}", Padded::left(name, w)), true),
+                    position_in(status, settings, live.work_offset_mm, Some(say(Msg::Work)), 9),
+                    position_in(status, settings, [0.0; 2], Some(say(Msg::Machine)), 9),
+                    TextLine::say(if done { Msg::KeysAny } else { Msg::KeysRun }, language),
                 ],
                 preview: None,
             }
         }
         RunPage::Numbers => {
             let columns = columns_beside(PREVIEW_BESIDE_WIDTH_PX);
-            let w = columns - state.len() - 1;
+            let w = columns - state.columns() - 1;
             let elapsed = Clock(run.elapsed_ms(live.now_ms));
             let progress = match (done, run.percent(status.emitted_steps)) {
                 (true, _) => line(format_args!("{} {elapsed}", say(Msg::PlotTime))),
@@ -140,8 +145,8 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
             let speed = if done { 0 } else { (live.speed_mm_per_min + 0.5) as i32 };
             ScreenView {
                 lines: [
-                    TextLine::new(format_args!("{} {}", Padded::left(name, w), Text(state)), true),
-                    position_in(status, settings, live.work_offset_mm, "", 7),
+                    TextLine::new(format_args!("{} {state}", Padded::left(name, w)), true),
+                    position_in(status, settings, live.work_offset_mm, None, 7),
                     progress,
                     line(format_args!("F{} mm/min {}%", Int::from(speed), Int::from(status.overrides.feed_percent))),
                 ],
