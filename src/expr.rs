@@ -102,23 +102,6 @@ pub enum ParseErrorKind {
     NumberOutOfRange,
 }
 
-impl ParseErrorKind {
-    /// A short English description, for the serial link and the display (with the column,
-    /// it fits one LCD line).
-    pub const fn message(self) -> &'static str {
-        match self {
-            ParseErrorKind::UnexpectedChar => "not expected here",
-            ParseErrorKind::UnexpectedEnd => "unexpected end",
-            ParseErrorKind::UnknownName => "unknown name",
-            ParseErrorKind::MismatchedParen => "unmatched ( or )",
-            ParseErrorKind::TooLong => "too long",
-            ParseErrorKind::TooComplex => "too complex",
-            ParseErrorKind::WrongArgCount => "argument count",
-            ParseErrorKind::NumberOutOfRange => "number too large",
-        }
-    }
-}
-
 /// Why a source text was refused, and where: `pos` is the 0-based byte offset of the offending
 /// character or token (the text's length for [`ParseErrorKind::UnexpectedEnd`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -18,10 +18,12 @@ use crate::geom::Axis;
 use crate::homing::HomingFail;
 use crate::inputs::Trip;
 use crate::interp::CurveError;
+use crate::language::Language;
 use crate::protocol::startup::StartupLines;
 use crate::settings::{SETTING_INFO, Settings};
 use crate::status::{MotionFault, RunState, Status};
 use crate::text::Text;
+use crate::ui::texts::{Msg, Say};
 
 /// The GRBL version the plotter speaks; senders look for "Grbl 1.1".
 pub const GRBL_VERSION: &str = "1.1h";
@@ -92,7 +94,8 @@ pub fn ok(out: &mut impl Write) -> fmt::Result {
 pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
     match error {
         GrblError::Expression { column, kind } => {
-            write!(out, "[MSG:Expression error at column {}: {}]\r\n", Int::from(column), Text(kind.message()))?;
+            let why = Say(Msg::from(kind), Language::English);
+            write!(out, "[MSG:Expression error at column {}: {why}]\r\n", Int::from(column))?;
         }
         GrblError::FunctionUndefined { x_mm, error } => {
             out.write_str("[MSG:Function undefined at x=")?;

@@ -32,7 +32,6 @@ use heapless::String;
 
 use crate::decimal::{Int, Num};
 use crate::drawing::DrawError;
-use crate::expr::ParseErrorKind;
 use crate::geom::Step;
 use crate::homing::HomingFail;
 use crate::inputs::Trip;
@@ -297,7 +296,7 @@ impl fmt::Display for ErrorText {
         let say = |msg| Say(msg, self.1);
         let msg = match self.0 {
             UiError::Expression(e) => {
-                let why = say(expression_error(e.kind));
+                let why = say(Msg::from(e.kind));
                 return write!(f, "{} {} {why}", say(Msg::ErrColumn), Int::from(e.pos + 1));
             }
             UiError::Entry(EntryError::TooLong) => {
@@ -325,20 +324,6 @@ impl fmt::Display for ErrorText {
             UiError::Clash => Msg::ErrClash,
         };
         write!(f, "{}", say(msg))
-    }
-}
-
-/// Why an expression was refused, after its column.
-const fn expression_error(kind: ParseErrorKind) -> Msg {
-    match kind {
-        ParseErrorKind::UnexpectedChar => Msg::ExprUnexpectedChar,
-        ParseErrorKind::UnexpectedEnd => Msg::ExprUnexpectedEnd,
-        ParseErrorKind::UnknownName => Msg::ExprUnknownName,
-        ParseErrorKind::MismatchedParen => Msg::ExprParen,
-        ParseErrorKind::TooLong => Msg::ExprTooLong,
-        ParseErrorKind::TooComplex => Msg::ExprTooComplex,
-        ParseErrorKind::WrongArgCount => Msg::ExprArgCount,
-        ParseErrorKind::NumberOutOfRange => Msg::ExprNumber,
     }
 }
 

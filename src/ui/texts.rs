@@ -11,6 +11,7 @@
 
 use core::fmt::{self, Write};
 
+use crate::expr::ParseErrorKind;
 use crate::language::Language;
 
 include!(concat!(env!("OUT_DIR"), "/texts.rs"));
@@ -55,6 +56,23 @@ impl Say {
 impl fmt::Display for Say {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         self.chars().try_for_each(|c| f.write_char(c))
+    }
+}
+
+/// Why an expression was refused, after its column: on the LCD, and in English on the host
+/// link.
+impl From<ParseErrorKind> for Msg {
+    fn from(kind: ParseErrorKind) -> Msg {
+        match kind {
+            ParseErrorKind::UnexpectedChar => Msg::ExprUnexpectedChar,
+            ParseErrorKind::UnexpectedEnd => Msg::ExprUnexpectedEnd,
+            ParseErrorKind::UnknownName => Msg::ExprUnknownName,
+            ParseErrorKind::MismatchedParen => Msg::ExprParen,
+            ParseErrorKind::TooLong => Msg::ExprTooLong,
+            ParseErrorKind::TooComplex => Msg::ExprTooComplex,
+            ParseErrorKind::WrongArgCount => Msg::ExprArgCount,
+            ParseErrorKind::NumberOutOfRange => Msg::ExprNumber,
+        }
     }
 }
 
