@@ -187,6 +187,16 @@ type UsbLink = (usb::UsbRx, usb::UsbTx);
 
 /// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
 /// 42 MHz, APB2 84 MHz.
+/// A task's token: each task is spawned once, at start-up, so its pool always has room.
+fn spawned<S>(
+    token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
+) -> embassy_executor::SpawnToken<S> {
+    match token {
+        Ok(token) => token,
+        Err(_) => panic!("a task spawned twice"),
+    }
+}
+
 fn clocks() -> Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
@@ -246,7 +256,7 @@ async fn main(spawner: Spawner) {
     step_timer::start(step_timer, step_consumer, machine, PULSE_PRIORITY);
     interrupt::UART5.set_priority(MOTION_PRIORITY);
     let motion_spawner = EXECUTOR_MOTION.start(interrupt::UART5);
-    motion_spawner.spawn(unwrap!(motion(machine, steps)));
+    motion_spawner.spawn(spawned(motion(machine, steps)));
 
     let columns = [
         Output::new(p.PD0, Level::High, Speed::Low),
@@ -260,9 +270,9 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD10, Pull::Up),
         Input::new(p.PD11, Pull::Up),
     ];
-    spawner.spawn(unwrap!(keypad(machine, columns, rows)));
-    spawner.spawn(unwrap!(servo(machine, son, pen, lights, dog)));
-    spawner.spawn(unwrap!(homing(machine)));
+    spawner.spawn(spawned(keypad(machine, columns, rows)));
+    spawner.spawn(spawned(servo(machine, son, pen, lights, dog)));
+    spawner.spawn(spawned(homing(machine)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
     static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();
@@ -285,7 +295,7 @@ async fn main(spawner: Spawner) {
     interrupt::USART2.set_priority(HOST_LINK_PRIORITY);
     let (tx, rx) = uart.split();
     let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, HOST_LINK_PRIORITY);
-    spawner.spawn(unwrap!(serial(machine, store, loaded, (rx, tx), usb)));
+    spawner.spawn(spawned(serial(machine, store, loaded, (rx, tx), usb)));
 
     let mut spi_config = spi::Config::default();
     spi_config.frequency = Hertz(LCD_SPI_HZ);
@@ -294,5 +304,5 @@ async fn main(spawner: Spawner) {
     let spi_dev = unwrap!(ExclusiveDevice::new(spi_bus, NoCs, SpiDelay));
     let lcd_cs = Output::new(p.PB12, Level::Low, Speed::Low);
     let lcd_rst = Output::new(p.PB11, Level::High, Speed::Low);
-    spawner.spawn(unwrap!(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));
+    spawner.spawn(spawned(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));
 }

@@ -90,7 +90,7 @@ pub fn start(
     let (tx, rx, control) = class.split_with_control();
 
     interrupt::OTG_FS.set_priority(priority);
-    spawner.spawn(defmt::unwrap!(usb_device(builder.build())));
+    spawner.spawn(super::spawned(usb_device(builder.build())));
     (
         UsbRx { rx, control, open: false, packet: [0; USB_PACKET_BYTES], start: 0, end: 0 },
         UsbTx { tx, packet_full: false },
