@@ -202,14 +202,24 @@ fn write_texts(out: &Path) {
         .expect("writing to a String");
         writeln!(src, "const {table}_LENGTHS: [u8; {}] = {lengths:?};", lengths.len()).expect("writing to a String");
     }
-    src.push_str("\nimpl Msg {\n    /// The name of setting `$id`, if it has one.\n");
-    src.push_str("    pub const fn setting(id: u16) -> Option<Msg> {\n        Some(match id {\n");
-    for e in &entries {
-        if let Some(id) = e.name.strip_prefix("Setting") {
-            writeln!(src, "            {id} => Msg::{},", e.name).expect("writing to a String");
-        }
-    }
-    src.push_str("            _ => return None,\n        })\n    }\n}\n\n");
+    let settings: Vec<(&str, &str)> =
+        entries.iter().filter_map(|e| Some((e.name.strip_prefix("Setting")?, e.name.as_str()))).collect();
+    writeln!(
+        src,
+        "\n/// The settings' names, in the file's order, which is `SETTING_INFO`'s (a test holds the\n\
+         /// two to each other).\npub const SETTING_NAMES: [Msg; {}] = [{}];",
+        settings.len(),
+        settings.iter().map(|(_, name)| format!("Msg::{name}")).collect::<Vec<_>>().join(", ")
+    )
+    .expect("writing to a String");
+    writeln!(
+        src,
+        "/// The `$` number each of [`SETTING_NAMES`] names.\n#[cfg(not(target_os = \"none\"))]\n\
+         pub const SETTING_NAME_IDS: [u16; {}] = [{}];\n",
+        settings.len(),
+        settings.iter().map(|(id, _)| *id).collect::<Vec<_>>().join(", ")
+    )
+    .expect("writing to a String");
     writeln!(
         src,
         "#[cfg(not(target_os = \"none\"))]\nimpl Msg {{\n    /// Every text, in the file's order.\n    pub const ALL: [Msg; {}] = [{}];\n}}\n",

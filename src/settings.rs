@@ -22,7 +22,7 @@ pub enum SettingError {
 }
 
 /// Identifies one setting: its `$` number, its unit and its range. Its name on the LCD is the
-/// UI's ([`crate::ui::texts::Msg::setting`]).
+/// UI's ([`crate::ui::texts::SETTING_NAMES`]).
 #[derive(Clone, Copy, Debug)]
 pub struct SettingInfo {
     pub id: u16,

@@ -47,7 +47,7 @@ use crate::ui::entry::{ENTRY_MAX_CHARS, EntryError};
 use crate::ui::glyphs;
 use crate::ui::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
 use crate::ui::menu::{Field, Menu, Mode, Screen, UiError};
-use crate::ui::texts::{Msg, Say};
+use crate::ui::texts::{Msg, SETTING_NAMES, Say};
 use crate::ui::trail::{self, Trail};
 
 mod lines;
@@ -174,8 +174,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             let info = page.info();
             let unit = Text(info.unit.symbol());
             let gap = Text(if unit.0.is_empty() { "" } else { " " });
-            // Every setting has a name (a test holds the two lists to each other).
-            let name = say(Msg::setting(info.id).unwrap_or(Msg::TitleSettings));
+            let name = say(SETTING_NAMES.get(page.index()).copied().unwrap_or(Msg::TitleSettings));
             *l1 = TextLine::new(format_args!("${} {name}", Int::from(info.id)), false);
             match page.edit() {
                 Some(entry) => {
