@@ -28,6 +28,9 @@ const HANZI_LAST: u32 = 0x7ff;
 /// `0x80 + k`; the others two, [`HANZI_ESCAPE`] then `k - HANZI_ONE_BYTE`.
 const HANZI_ONE_BYTE: usize = 128;
 const HANZI_ESCAPE: u8 = 0x01;
+/// Byte values no text uses, each made to stand for the pair of bytes used most often in the
+/// texts (either of which may be such a code again): the texts' own compression.
+const PAIR_CODES: std::ops::RangeInclusive<u8> = 0x02..=0x1f;
 
 fn main() {
     println!("cargo:rerun-if-changed=memory.x");
@@ -124,6 +127,80 @@ fn write_bytes(src: &mut String, bits: &[bool]) {
     src.push_str("];\n");
 }
 
+/// A text's bytes as symbols: a byte, or (above 0xff) an escaped glyph with its number byte,
+/// which no pair may split.
+fn symbols(bytes: &[u8]) -> Vec<u16> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == HANZI_ESCAPE {
+            out.push(0x100 | u16::from(bytes[i + 1]));
+            i += 2;
+        } else {
+            assert!(!PAIR_CODES.contains(&bytes[i]), "a text uses a pair code's byte");
+            out.push(u16::from(bytes[i]));
+            i += 1;
+        }
+    }
+    out
+}
+
+fn unsymbols(symbols: &[u16]) -> Vec<u8> {
+    symbols
+        .iter()
+        .flat_map(|&s| match u8::try_from(s) {
+            Ok(b) => vec![b],
+            Err(_) => vec![HANZI_ESCAPE, s as u8],
+        })
+        .collect()
+}
+
+/// Gives each of [`PAIR_CODES`] in turn to the pair of bytes most used in `texts` (while one
+/// saves bytes), replacing it there; returns the codes and their pairs.
+fn pair_codes(texts: &mut [Vec<u16>]) -> Vec<(u8, [u8; 2])> {
+    let mut pairs = Vec::new();
+    for code in PAIR_CODES {
+        let mut counts: BTreeMap<(u16, u16), usize> = BTreeMap::new();
+        for text in texts.iter() {
+            for w in text.windows(2) {
+                if w[0] < 0x100 && w[1] < 0x100 {
+                    *counts.entry((w[0], w[1])).or_default() += 1;
+                }
+            }
+        }
+        // Each use saves a byte; the pair's entry costs two.
+        let Some((&(first, second), _)) =
+            counts.iter().filter(|&(_, &n)| n > 3).max_by_key(|&(pair, &n)| (n, std::cmp::Reverse(*pair)))
+        else {
+            break;
+        };
+        for text in texts.iter_mut() {
+            let mut out = Vec::with_capacity(text.len());
+            let mut i = 0;
+            while i < text.len() {
+                if i + 1 < text.len() && (text[i], text[i + 1]) == (first, second) {
+                    out.push(u16::from(code));
+                    i += 2;
+                } else {
+                    out.push(text[i]);
+                    i += 1;
+                }
+            }
+            *text = out;
+        }
+        pairs.push((code, [first as u8, second as u8]));
+    }
+    pairs
+}
+
+/// How deep the pairs nest under `code`: 1 for a pair of plain bytes.
+fn pair_depth(code: u8, pairs: &[(u8, [u8; 2])]) -> usize {
+    match pairs.iter().find(|(c, _)| *c == code) {
+        Some((_, pair)) => 1 + pair.iter().map(|&b| pair_depth(b, pairs)).max().unwrap_or(0),
+        None => 0,
+    }
+}
+
 /// One line of [`TEXTS`].
 struct Entry {
     name: String,
@@ -188,9 +265,26 @@ fn write_texts(out: &Path) {
         writeln!(src, "    {},", e.name).expect("writing to a String");
     }
     src.push_str("}\n\n");
+    let mut texts: Vec<Vec<u16>> =
+        entries.iter().flat_map(|e| [&e.english, &e.chinese]).map(|text| symbols(&encode(text))).collect();
+    let pairs = pair_codes(&mut texts);
+    let depth = pairs.iter().map(|&(code, _)| pair_depth(code, &pairs)).max().unwrap_or(0);
+    let bytes: Vec<Vec<u8>> = texts.iter().map(|t| unsymbols(t)).collect();
+    writeln!(
+        src,
+        "/// Each byte of `PAIR_CODES` stands for a pair of bytes (which may be such codes again,\n\
+         /// at most `PAIR_DEPTH` deep), written by build.rs.\n\
+         const PAIR_CODES: core::ops::RangeInclusive<u8> = {:#04x}..={:#04x};\n\
+         const PAIRS: [[u8; 2]; {}] = {:?};\nconst PAIR_DEPTH: usize = {depth};",
+        PAIR_CODES.start(),
+        PAIR_CODES.start() + pairs.len() as u8 - 1,
+        pairs.len(),
+        pairs.iter().map(|(_, pair)| *pair).collect::<Vec<_>>()
+    )
+    .expect("writing to a String");
     for (table, texts) in [
-        ("ENGLISH", entries.iter().map(|e| encode(&e.english)).collect::<Vec<_>>()),
-        ("CHINESE", entries.iter().map(|e| encode(&e.chinese)).collect()),
+        ("ENGLISH", bytes.iter().step_by(2).cloned().collect::<Vec<_>>()),
+        ("CHINESE", bytes.iter().skip(1).step_by(2).cloned().collect()),
     ] {
         let lengths: Vec<u8> = texts.iter().map(|t| u8::try_from(t.len()).expect("a text fits a line")).collect();
         writeln!(

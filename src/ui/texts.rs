@@ -37,13 +37,32 @@ impl Say {
     /// Its characters: ASCII, or the character standing for a Chinese glyph.
     fn chars(self) -> impl Iterator<Item = char> {
         let mut bytes = self.bytes().iter();
+        // The bytes pair codes stand for, still to come, the next last.
+        let mut pending = [0u8; PAIR_DEPTH + 1];
+        let mut waiting = 0;
         core::iter::from_fn(move || {
-            let glyph = match *bytes.next()? {
-                HANZI_ESCAPE => HANZI_ONE_BYTE + usize::from(*bytes.next()?),
-                b @ 0x80.. => usize::from(b - 0x80),
-                b => return Some(char::from(b)),
-            };
-            char::from_u32(HANZI_FIRST as u32 + glyph as u32)
+            loop {
+                let b = match waiting {
+                    0 => *bytes.next()?,
+                    _ => {
+                        waiting -= 1;
+                        pending[waiting]
+                    }
+                };
+                let glyph = match b {
+                    HANZI_ESCAPE => HANZI_ONE_BYTE + usize::from(*bytes.next()?),
+                    0x80.. => usize::from(b - 0x80),
+                    _ if PAIR_CODES.contains(&b) => {
+                        let [first, second] = PAIRS[usize::from(b - PAIR_CODES.start())];
+                        *pending.get_mut(waiting)? = second;
+                        *pending.get_mut(waiting + 1)? = first;
+                        waiting += 2;
+                        continue;
+                    }
+                    _ => return Some(char::from(b)),
+                };
+                return char::from_u32(HANZI_FIRST as u32 + glyph as u32);
+            }
         })
     }
 
@@ -107,6 +126,21 @@ mod tests {
                 assert_eq!((columns, Say(msg, language).columns()), (text.len(), text.len()), "{}", readable(&text));
             }
         }
+    }
+
+    /// Every text, decoded, is the file's, in the file's order.
+    #[test]
+    fn every_text_is_the_one_written_in_the_file() {
+        let lines = include_str!("texts.txt").lines().filter(|l| !l.trim().is_empty() && !l.starts_with('#'));
+        let mut count = 0;
+        for (line, msg) in lines.zip(Msg::ALL) {
+            let parts: std::vec::Vec<&str> = line.split(" | ").map(str::trim).collect();
+            assert_eq!(parts[0], std::format!("{msg:?}"));
+            assert_eq!(readable(&std::format!("{}", Say(msg, Language::English))), parts[1]);
+            assert_eq!(readable(&std::format!("{}", Say(msg, Language::Chinese))), parts[2]);
+            count += 1;
+        }
+        assert_eq!(count, Msg::ALL.len());
     }
 
     #[test]
