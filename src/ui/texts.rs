@@ -149,7 +149,7 @@ mod tests {
         assert_eq!(say(Msg::TitleJog, Language::English), "JOG");
         assert_eq!(say(Msg::TitleJog, Language::Chinese), "点动");
         assert_eq!(say(Msg::Setting216, Language::English), "Language 1=中文");
-        assert_eq!(say(Msg::ErrSteep, Language::Chinese), "太陡: 减小 A 或 1/P");
+        assert_eq!(say(Msg::ErrSteep, Language::Chinese), "太陡: A 或 1/P 太大");
         // The least used characters take the escape.
         assert_eq!(say(Msg::Setting215, Language::Chinese), "蜂鸣器");
     }
