@@ -185,8 +185,6 @@ impl DelayNs for SpiDelay {
 /// The host link on the USB port: its receiving and sending ends.
 type UsbLink = (usb::UsbRx, usb::UsbTx);
 
-/// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
-/// 42 MHz, APB2 84 MHz.
 /// A task's token: each task is spawned once, at start-up, so its pool always has room.
 fn spawned<S>(
     token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
@@ -197,6 +195,8 @@ fn spawned<S>(
     }
 }
 
+/// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
+/// 42 MHz, APB2 84 MHz.
 fn clocks() -> Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
