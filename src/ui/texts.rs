@@ -2,12 +2,13 @@
 //! text in a [`Language`]. The texts are written in `src/ui/texts.txt`; build.rs makes the
 //! tables of this module from it, each language's texts as one run of bytes, and renders the
 //! Chinese characters they use from u8g2's 7x7 GB2312 font (a font crate's, subset to these
-//! texts: about 1.2 KB where the whole font is 100 KB).
+//! texts: about 1 KB where the whole font is 100 KB).
 //!
 //! In the tables a Chinese character is the number of its glyph in [`GLYPHS_7X7`]: one byte
-//! for the 128 most used, two for the others. On the screen's lines it is the character
-//! [`HANZI_FIRST`] + k: two bytes in UTF-8, as it takes two columns on the screen, so a line's
-//! length in bytes is its width in columns in either language.
+//! for the 128 most used, two for the others; and each byte value no text uses stands for a
+//! pair of bytes used often (pairs nest). On the screen's lines a Chinese character is the
+//! character [`HANZI_FIRST`] + k: two bytes in UTF-8, as it takes two columns on the screen, so
+//! a line's length in bytes is its width in columns in either language.
 
 use core::fmt::{self, Write};
 
