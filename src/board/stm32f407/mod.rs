@@ -31,6 +31,7 @@
 mod inputs;
 mod panic;
 mod pen;
+mod spawn;
 mod step_timer;
 mod usb;
 
@@ -61,6 +62,7 @@ use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
 use servoplot::tasks::{self, lcd::St7920Lcd};
 use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
+use spawn::spawned;
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
 
@@ -184,16 +186,6 @@ impl DelayNs for SpiDelay {
 
 /// The host link on the USB port: its receiving and sending ends.
 type UsbLink = (usb::UsbRx, usb::UsbTx);
-
-/// A task's token: each task is spawned once, at start-up, so its pool always has room.
-fn spawned<S>(
-    token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
-) -> embassy_executor::SpawnToken<S> {
-    match token {
-        Ok(token) => token,
-        Err(_) => panic!("a task spawned twice"),
-    }
-}
 
 /// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
 /// 42 MHz, APB2 84 MHz.

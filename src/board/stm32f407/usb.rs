@@ -22,6 +22,8 @@ use embassy_usb::driver::EndpointError;
 use embassy_usb::{Builder, UsbDevice};
 use static_cell::StaticCell;
 
+use super::spawn::spawned;
+
 /// pid.codes' vendor ID for open hardware, and its test product ID (1209:0001).
 const USB_VID: u16 = 0x1209;
 const USB_PID: u16 = 0x0001;
@@ -90,7 +92,7 @@ pub fn start(
     let (tx, rx, control) = class.split_with_control();
 
     interrupt::OTG_FS.set_priority(priority);
-    spawner.spawn(super::spawned(usb_device(builder.build())));
+    spawner.spawn(spawned(usb_device(builder.build())));
     (
         UsbRx { rx, control, open: false, packet: [0; USB_PACKET_BYTES], start: 0, end: 0 },
         UsbTx { tx, packet_full: false },
