@@ -156,7 +156,57 @@ pub enum PlannerState {
 }
 
 impl<C: Interpolator, const N: usize> Planner<C, N> {
-    /// An idle planner.
+    /// An idle planner, built in `slot` where it lies: it is 50 KB, too much to build on a
+    /// small stack and move (see [`new`](Self::new)). The board builds its planner so, in
+    /// static storage.
+    pub fn init(slot: &mut core::mem::MaybeUninit<Self>, limits: Limits) -> &mut Self {
+        use core::ptr::addr_of_mut;
+        let p = slot.as_mut_ptr();
+        // SAFETY: every field of `*p` is written once below, in place (the rings a slot at a
+        // time), before the slot is taken as initialised; `every_field` lists them all, so that
+        // a new field cannot be left out unnoticed.
+        unsafe {
+            addr_of_mut!((*p).limits).write(limits);
+            addr_of_mut!((*p).factors).write(Factors::NONE);
+            addr_of_mut!((*p).pending_limits).write(None);
+            Ring::init_in_place(addr_of_mut!((*p).segments));
+            addr_of_mut!((*p).held).write(0);
+            addr_of_mut!((*p).scan).write(ScanPoint::new());
+            CopyRing::init_in_place(addr_of_mut!((*p).steps));
+            CopyRing::init_in_place(addr_of_mut!((*p).chunks));
+            CopyRing::init_in_place(addr_of_mut!((*p).blocks));
+            addr_of_mut!((*p).request).write(Request::Run);
+            addr_of_mut!((*p).speed).write(None);
+            addr_of_mut!((*p).run).write(Run::EMPTY);
+            addr_of_mut!((*p).carry).write(0);
+            addr_of_mut!((*p).emitted_since_scan).write(0);
+            slot.assume_init_mut()
+        }
+    }
+
+    /// Every field of the planner: this pattern stops compiling when one is added, a reminder
+    /// that [`init`](Self::init) must write it too.
+    #[allow(dead_code)]
+    fn every_field(self) {
+        let Planner {
+            limits: _,
+            factors: _,
+            pending_limits: _,
+            segments: _,
+            held: _,
+            scan: _,
+            steps: _,
+            chunks: _,
+            blocks: _,
+            request: _,
+            speed: _,
+            run: _,
+            carry: _,
+            emitted_since_scan: _,
+        } = self;
+    }
+
+    /// An idle planner, built as a value (on the host, or in a test).
     pub fn new(limits: Limits) -> Self {
         Planner {
             limits,

@@ -10,8 +10,10 @@ use core::task::{Context, Poll, Waker};
 
 use servoplot::drawing::{self, Request};
 use servoplot::geom::Point;
+use servoplot::interp::Curve;
 use servoplot::job::{Feed, Job};
 use servoplot::machine::{Machine, MotionFault, Refused};
+use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::pulse::StepQueue;
 use servoplot::settings::Settings;
 use servoplot::sim::clock;
@@ -44,7 +46,14 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
 
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
-    let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}, servoplot::tasks::motion::RealTime));
+    let mut planner: Box<Planner<Curve, PLANNER_SEGMENTS>> = Box::new(Planner::new(Limits::from_settings(&loose)));
+    let mut motion = pin!(servoplot::tasks::motion::run(
+        &machine,
+        &mut planner,
+        producer,
+        || {},
+        servoplot::tasks::motion::RealTime
+    ));
     let mut cx = Context::from_waker(Waker::noop());
     let mut path = vec![Point::ORIGIN];
     for _ in 0..1_000_000 {

@@ -12,8 +12,10 @@ use core::pin::pin;
 use core::task::{Context, Poll, RawWaker, RawWakerVTable, Waker};
 
 use critical_section::Mutex;
+use servoplot::interp::Curve;
 use servoplot::job::Job;
 use servoplot::machine::Machine;
+use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::pulse::StepQueue;
 use servoplot::settings::Settings;
 use servoplot::status::RunState;
@@ -51,6 +53,16 @@ fn noop_waker() -> Waker {
     unsafe { Waker::from_raw(RawWaker::new(core::ptr::null(), &VTABLE)) }
 }
 
+/// The planner the motion task runs with: built once and kept, since every case ends at rest
+/// with the planner idle.
+fn planner() -> &'static mut Planner<Curve, PLANNER_SEGMENTS> {
+    static mut PLANNER: Option<Planner<Curve, PLANNER_SEGMENTS>> = None;
+    // SAFETY: the harness measures one case at a time on one core, and each case's motion task
+    // is dropped before the next case borrows the planner again.
+    let slot = unsafe { &mut *core::ptr::addr_of_mut!(PLANNER) };
+    slot.get_or_insert_with(|| Planner::new(Limits::default()))
+}
+
 /// Most polls one job may take before the harness gives up.
 const MAX_POLLS: usize = 100_000;
 
@@ -63,7 +75,8 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     machine.set_pen_settled(machine.pen_order());
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
-    let mut motion = pin!(servoplot::tasks::motion::run(&machine, producer, || {}, servoplot::tasks::motion::RealTime));
+    let mut motion =
+        pin!(servoplot::tasks::motion::run(&machine, planner(), producer, || {}, servoplot::tasks::motion::RealTime));
     if machine.try_submit(job, machine.plan_epoch()).is_err() {
         panic!("job queue");
     }

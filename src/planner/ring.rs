@@ -16,6 +16,25 @@ impl<T, const N: usize> Ring<T, N> {
         Ring { slots: [const { None }; N], head: 0, len: 0 }
     }
 
+    /// Makes `*this` an empty ring where it lies, a slot at a time (never a whole ring on the
+    /// stack).
+    ///
+    /// # Safety
+    ///
+    /// `this` is valid for writes and aligned; what it held is overwritten, not dropped.
+    pub unsafe fn init_in_place(this: *mut Self) {
+        // SAFETY: the caller's promise; `addr_of_mut!` takes each field's place without
+        // reading or referencing what is there.
+        unsafe {
+            let slots = core::ptr::addr_of_mut!((*this).slots).cast::<Option<T>>();
+            for i in 0..N {
+                slots.add(i).write(None);
+            }
+            core::ptr::addr_of_mut!((*this).head).write(0);
+            core::ptr::addr_of_mut!((*this).len).write(0);
+        }
+    }
+
     pub fn is_full(&self) -> bool {
         self.len >= N
     }
@@ -87,6 +106,24 @@ impl<T: Copy + Default, const N: usize> CopyRing<T, N> {
 
     pub fn new() -> Self {
         CopyRing { slots: [T::default(); N], head: 0, tail: 0 }
+    }
+
+    /// Makes `*this` an empty ring where it lies, a slot at a time (never a whole ring on the
+    /// stack).
+    ///
+    /// # Safety
+    ///
+    /// `this` is valid for writes and aligned.
+    pub unsafe fn init_in_place(this: *mut Self) {
+        // SAFETY: as for `Ring::init_in_place`; `T` is `Copy`: nothing is dropped.
+        unsafe {
+            let slots = core::ptr::addr_of_mut!((*this).slots).cast::<T>();
+            for i in 0..N {
+                slots.add(i).write(T::default());
+            }
+            core::ptr::addr_of_mut!((*this).head).write(0);
+            core::ptr::addr_of_mut!((*this).tail).write(0);
+        }
     }
 
     pub fn len(&self) -> usize {

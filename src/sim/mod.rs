@@ -32,7 +32,9 @@ use std::vec::Vec;
 use embassy_futures::join::{join, join5};
 
 use crate::geom::{Axis, Point};
+use crate::interp::Curve;
 use crate::machine::Machine;
+use crate::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
@@ -181,10 +183,13 @@ impl Wake for FlagWaker {
 pub fn run(config: SimConfig) -> SimReport {
     clock::reset();
     let flash = config.flash.clone();
-    let (store, loaded) = Store::open(config.flash, STORE_RANGE);
+    let (mut store, loaded) = Store::open(config.flash, STORE_RANGE);
     let machine = Machine::new(store.kept().settings);
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
+    // On the heap: the host's stack need not hold its 50 KB.
+    let mut planner: std::boxed::Box<Planner<Curve, PLANNER_SEGMENTS>> =
+        std::boxed::Box::new(Planner::new(Limits::from_settings(&machine.settings())));
     let (steps, step_consumer) = step_queue.split();
     let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
@@ -210,9 +215,15 @@ pub fn run(config: SimConfig) -> SimReport {
     let firmware = join(
         join5(
             step_timer::run(&machine, &mut engine, &kicks),
-            tasks::motion::run(&machine, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
+            tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
             tasks::keypad::run(&machine, columns, rows),
-            tasks::serial::run(&machine, store, loaded, (serial.clone(), serial.clone()), (usb.clone(), usb.clone())),
+            tasks::serial::run(
+                &machine,
+                &mut store,
+                loaded,
+                (serial.clone(), serial.clone()),
+                (usb.clone(), usb.clone()),
+            ),
             tasks::lcd::run(&machine, lcd),
         ),
         join(

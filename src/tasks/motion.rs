@@ -82,11 +82,17 @@ impl WorkTime for RealTime {
     }
 }
 
-/// Runs the motion forever. `steps` is the producer end of the step queue; `kick` wakes the
-/// pulse engine after steps were published; `work` lets the time of the work pass (see
-/// [`WorkTime`]).
-pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl FnMut(), mut work: impl WorkTime) -> ! {
-    let mut planner: Planner<Curve, PLANNER_SEGMENTS> = Planner::new(Limits::from_settings(&machine.settings()));
+/// Runs the motion forever with `planner` (idle; the board keeps it in static storage, built in
+/// place: it is 50 KB). `steps` is the producer end of the step queue; `kick` wakes the pulse
+/// engine after steps were published; `work` lets the time of the work pass (see [`WorkTime`]).
+pub async fn run(
+    machine: &Machine,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    mut steps: StepProducer<'_>,
+    mut kick: impl FnMut(),
+    mut work: impl WorkTime,
+) -> ! {
+    planner.set_limits(Limits::from_settings(&machine.settings()));
     let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
@@ -100,13 +106,13 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
     loop {
         if let Some(trip) = machine.take_trip() {
             held = None;
-            halted(machine, &mut planner, &mut steps, &mut queued, trip).await;
+            halted(machine, planner, &mut steps, &mut queued, trip).await;
         }
         if let Some(control) = machine.take_control() {
             if control == Control::Abort {
                 held = None;
             }
-            apply(machine, &mut planner, control);
+            apply(machine, planner, control);
         }
         let now = machine.overrides();
         if now != overrides {
@@ -133,7 +139,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
             }
-            moving = plan(machine, &mut planner, job, &settings);
+            moving = plan(machine, planner, job, &settings);
         }
         if machine.pulses_idle() && !planner.is_idle() && !ready_to_start(machine) {
             // Starting from rest: servos off for standing still (`$1`) take their enable delay,
@@ -142,7 +148,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             continue;
         }
         let steps_before = queued.steps;
-        let filled = fill(machine, &mut planner, &mut steps, &mut queued, &mut work).await;
+        let filled = fill(machine, planner, &mut steps, &mut queued, &mut work).await;
         if queued.steps != steps_before {
             machine.set_plan_empty(false);
             if machine.run_state() != RunState::Alarm {
@@ -159,7 +165,7 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
             error!("curve stopped part way: {:?}", e);
             machine.set_run_state(RunState::Alarm);
             machine.set_fault(Some(MotionFault::Curve(e)));
-            abort(machine, &mut planner);
+            abort(machine, planner);
         }
         let stands = matches!(planner.state(), PlannerState::Idle | PlannerState::Held);
         if !matches!(filled, FillEnd::QueueFull) && stands && !queued.resting {
@@ -200,11 +206,11 @@ pub async fn run(machine: &Machine, mut steps: StepProducer<'_>, mut kick: impl 
                         if machine.run_state() != RunState::Alarm {
                             machine.set_run_state(RunState::Idle);
                         }
-                        wait_for_work(machine, &planner).await;
+                        wait_for_work(machine, planner).await;
                     }
                     PlannerState::Held => {
                         machine.set_run_state(RunState::Hold);
-                        wait_for_work(machine, &planner).await;
+                        wait_for_work(machine, planner).await;
                     }
                     PlannerState::Running | PlannerState::Holding | PlannerState::Aborting => {
                         Timer::after(Duration::from_micros(MOTION_RETRY_US)).await;

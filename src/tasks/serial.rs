@@ -88,10 +88,11 @@ struct Host<'m> {
 }
 
 /// Speaks GRBL on two host links forever, each given as its receiving and its sending end,
-/// keeping what a power cycle keeps in `store`; `loaded` says whether power-on read it back.
+/// keeping what a power cycle keeps in `store` (the board's, in static storage); `loaded` says
+/// whether power-on read it back.
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     machine: &Machine,
-    store: Store<F>,
+    store: &mut Store<F>,
     loaded: Result<(), StoreError>,
     first: (R1, W1),
     second: (R2, W2),
@@ -265,7 +266,7 @@ enum Unfinished {
 
 /// Says why the flash store gave the defaults, if it did, and runs the startup blocks; then
 /// takes the links' bytes in turn and carries out their lines, answering each on its own link.
-async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(), StoreError>) -> ! {
+async fn lines<F: NorFlash>(host: &Host<'_>, store: &mut Store<F>, loaded: Result<(), StoreError>) -> ! {
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
     let mut parser = Parser { host, gcode, store, epoch: host.machine.plan_epoch(), restart_after_answer: false };
     let links = [&host.links[0], &host.links[1]];
@@ -323,7 +324,7 @@ async fn lines<F: NorFlash>(host: &Host<'_>, store: Store<F>, loaded: Result<(),
 struct Parser<'h, 'm, F: NorFlash> {
     host: &'h Host<'m>,
     gcode: GcodeState,
-    store: Store<F>,
+    store: &'h mut Store<F>,
     epoch: PlanEpoch,
     /// The line being answered left check mode: the parser starts over once it is answered.
     restart_after_answer: bool,
