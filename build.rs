@@ -1,6 +1,6 @@
-//! Link scripts for the firmware image (the host build, the simulator, needs none), and for
-//! every build the LCD's glyph table and its texts in both languages, with the glyphs of the
-//! Chinese characters they use.
+//! Link scripts for the firmware images (each board's memory map; the host build, the simulator,
+//! needs none), and for every build the LCD's glyph table and its texts in both languages, with
+//! the glyphs of the Chinese characters they use.
 
 use embedded_graphics::Drawable;
 use embedded_graphics::Pixel;
@@ -16,6 +16,10 @@ use std::path::{Path, PathBuf};
 use u8g2_fonts::FontRenderer;
 use u8g2_fonts::fonts::u8g2_font_boutique_bitmap_7x7_t_gb2312;
 use u8g2_fonts::types::{FontColor, VerticalPosition};
+
+/// Each firmware image and its board's memory map.
+const IMAGES: [(&str, &str); 2] =
+    [("servoplot", "src/board/stm32f407/memory.x"), ("servoplot-mps2-an386", "src/board/mps2_an386/memory.x")];
 
 /// The LCD's texts, `name | English | 中文` a line.
 const TEXTS: &str = "src/ui/texts.txt";
@@ -33,17 +37,25 @@ const HANZI_ESCAPE: u8 = 0x01;
 const PAIR_CODES: std::ops::RangeInclusive<u8> = 0x02..=0x1f;
 
 fn main() {
-    println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed={TEXTS}");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     write_font(&out);
     write_texts(&out);
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none") {
-        // memory.x sits in the package root, which is on the linker's search path as the
-        // build script's output directory is not: copy it there for link.x to include.
-        std::fs::copy("memory.x", out.join("memory.x")).expect("memory.x is readable");
-        println!("cargo:rustc-link-search={}", out.display());
+        // Each image links with its board's memory map: cortex-m-rt's link.x includes
+        // memory.x (the linker finds it in the package root), which includes board-memory.x,
+        // found in a directory of its own on that image's search path.
+        println!("cargo:rerun-if-changed=memory.x");
+        for (bin, map) in IMAGES {
+            println!("cargo:rerun-if-changed={map}");
+            let dir = out.join(bin);
+            std::fs::create_dir_all(&dir).expect("OUT_DIR is writable");
+            std::fs::copy(map, dir.join("board-memory.x")).expect("the memory map is readable");
+            // Two arguments: flip-link reads `-L DIR` written apart.
+            println!("cargo:rustc-link-arg-bin={bin}=-L");
+            println!("cargo:rustc-link-arg-bin={bin}={}", dir.display());
+        }
         println!("cargo:rustc-link-arg-bins=--nmagic");
         // Identical functions (generic copies that compile to the same code) are kept once. No
         // code here compares function addresses.

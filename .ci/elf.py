@@ -1,9 +1,11 @@
 """Reads what the checks need from a 32-bit little-endian ELF file: its sections and its
-function symbols. Used by size.py, no_f64.py and the cost runner (cost/count.py)."""
+function and data symbols. Used by size.py, no_f64.py, the cost runner (cost/count.py) and the
+model board's runner (model/run.py)."""
 import struct
 import sys
 
 SHT_SYMTAB = 2
+STT_OBJECT = 1
 STT_FUNC = 2
 
 
@@ -30,8 +32,7 @@ def sections(path):
     return [(_name(data, strtab, name), typ, flags, addr, size) for name, typ, flags, addr, _, size, *_ in headers]
 
 
-def functions(path):
-    """(address, size, name) of every function symbol, Thumb bit cleared."""
+def _symbols(path, kind):
     data, headers, _ = _read(path)
     out = []
     for _, typ, _, _, off, size, link, _, _, entsize in headers:
@@ -40,6 +41,16 @@ def functions(path):
         strtab = headers[link][4]
         for i in range(size // entsize):
             name, value, sym_size, info, _, _ = struct.unpack_from("<IIIBBH", data, off + i * entsize)
-            if info & 0xF == STT_FUNC:
-                out.append((value & ~1, sym_size, _name(data, strtab, name)))
+            if info & 0xF == kind:
+                out.append((value & ~1 if kind == STT_FUNC else value, sym_size, _name(data, strtab, name)))
     return out
+
+
+def functions(path):
+    """(address, size, name) of every function symbol, Thumb bit cleared."""
+    return _symbols(path, STT_FUNC)
+
+
+def objects(path):
+    """(address, size, name) of every data symbol (statics)."""
+    return _symbols(path, STT_OBJECT)

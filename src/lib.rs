@@ -18,6 +18,7 @@ pub mod decimal;
 pub mod drawing;
 pub mod expr;
 pub mod geom;
+pub mod health;
 pub mod homing;
 pub mod inputs;
 pub mod interp;

@@ -5,7 +5,9 @@
 
 #[cfg(target_os = "none")]
 #[path = "board/stm32f407/mod.rs"]
-mod stm32f407;
+mod board;
+#[cfg(target_os = "none")]
+mod firmware;
 
 #[cfg(not(target_os = "none"))]
 fn main() -> std::process::ExitCode {

@@ -1,11 +1,11 @@
-//! The STM32F407VG board: clocks, the whole pin map, peripherals and executors.
+//! The STM32F407VG board: clocks, the whole pin map, and the peripherals behind the firmware's
+//! tasks (`crate::firmware`), with their interrupts at the firmware's priorities.
 //!
-//! Nothing else in the firmware names a pin or a peripheral instance. Priorities, most urgent
-//! first: the pulse engine runs in the step timer's update interrupt (TIM1, see `step_timer`);
-//! then embassy-time's timer (TIM2); the motion task on an interrupt executor (UART5's vector,
-//! unused as a UART), so the step queue stays full while a blocking LCD flush (~20 ms) runs;
-//! then the host links' UART and USB port; keypad, serial, the USB device, LCD, servo (which
-//! also feeds the independent watchdog) and homing share the thread-mode executor.
+//! Nothing else in the firmware names a pin or a peripheral instance. The pulse engine runs in
+//! the step timer's update interrupt (TIM1, see `step_timer`); embassy-time's timer is TIM2; the
+//! motion task's interrupt executor runs on UART5's vector and the thread-mode executor's
+//! pender on UART4's (both unused as UARTs); the host links are USART2 and the USB port; the
+//! servo task feeds the independent watchdog.
 //!
 //! | signal              | pin  | notes                                              |
 //! |---------------------|------|----------------------------------------------------|
@@ -31,18 +31,17 @@
 mod inputs;
 mod panic;
 mod pen;
-mod spawn;
+pub mod poll_clock;
 mod step_timer;
 mod usb;
 
 use core::convert::Infallible;
 
-use defmt::{info, unwrap};
 use defmt_rtt as _;
-use embassy_executor::{InterruptExecutor, Spawner};
-use embassy_stm32::flash::{Blocking as FlashBlocking, Flash};
+use embassy_executor::{SendSpawner, Spawner};
+use embassy_stm32::flash::{Blocking as FlashBlocking, Flash as ChipFlash};
 use embassy_stm32::gpio::OutputType;
-use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
+use embassy_stm32::gpio::{Input, Level, Output as Pin, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Blocking;
 use embassy_stm32::peripherals::IWDG;
@@ -56,32 +55,32 @@ use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
 use embedded_hal::delay::DelayNs;
 use embedded_hal_bus::spi::ExclusiveDevice;
-use pen::PenPwm;
+use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
-use servoplot::pulse::{StepProducer, StepQueue};
-use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
-use servoplot::tasks::{self, lcd::St7920Lcd};
+use servoplot::pulse::StepConsumer;
+use servoplot::tasks::lcd::St7920Lcd;
 use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
-use spawn::spawned;
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
+
+use crate::firmware::{executor, priority};
+
+pub use panic::safe_outputs;
+pub use pen::PenPwm;
+
+/// What the log calls the board.
+pub const NAME: &str = "STM32F407VG at 168 MHz";
 
 /// Crystal and core clock (see `clocks`).
 const HSE_HZ: u32 = 8_000_000;
 const SYSCLK_HZ: u32 = 168_000_000;
+const _: () = assert!(SYSCLK_HZ == poll_clock::PER_US * 1_000_000);
 
 /// What TIM2-TIM7 count at: twice APB1's SYSCLK / 4 (see `clocks`).
 const APB1_TIMER_HZ: u32 = SYSCLK_HZ / 4 * 2;
 
-/// Interrupt priorities, most urgent first: the step timer (the pulse engine), embassy-time's
-/// timer, motion, then the host links' UART and USB port; keypad, LCD, the serial protocol and
-/// the USB device's control requests run in thread mode below them all. The step timer's
-/// hardware places every pulse edge; its interrupt only has to preload the next period before
-/// the current one ends.
-const PULSE_PRIORITY: Priority = Priority::P0;
-const TIME_DRIVER_PRIORITY: Priority = Priority::P1;
-const MOTION_PRIORITY: Priority = Priority::P2;
-const HOST_LINK_PRIORITY: Priority = Priority::P3;
+/// The thread-mode executor's pender: UART4's interrupt, unused as a UART.
+pub const THREAD_PENDER_IRQ: u16 = pac::Interrupt::UART4 as u16;
 
 /// Serial host link speed.
 const HOST_BAUD: u32 = 115_200;
@@ -96,63 +95,61 @@ bind_interrupts!(struct Irqs {
     USART2 => usart::BufferedInterruptHandler<USART2>;
 });
 
-static EXECUTOR_MOTION: InterruptExecutor = InterruptExecutor::new();
-static MACHINE: StaticCell<Machine> = StaticCell::new();
-static STEP_QUEUE: StaticCell<StepQueue> = StaticCell::new();
-
 #[interrupt]
 unsafe fn UART5() {
-    // SAFETY: UART5 serves only as the motion executor's software interrupt.
-    unsafe { EXECUTOR_MOTION.on_interrupt() }
+    // SAFETY: UART5 serves only as the motion executor's interrupt.
+    unsafe { executor::MOTION_EXECUTOR.on_interrupt() }
 }
 
-type Lcd =
-    St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, SpiDelay>, Output<'static>, Delay>;
-
-#[embassy_executor::task]
-async fn motion(machine: &'static Machine, steps: StepProducer<'static>) -> ! {
-    tasks::motion::run(machine, steps, step_timer::kick, tasks::motion::RealTime).await
+#[interrupt]
+fn UART4() {
+    executor::on_thread_pender();
 }
 
-#[embassy_executor::task]
-async fn keypad(machine: &'static Machine, columns: [Output<'static>; 4], rows: [Input<'static>; 4]) -> ! {
-    tasks::keypad::run(machine, columns, rows).await
+/// Keypad pins: columns driven, rows read.
+pub type Column = Pin<'static>;
+pub type Row = Input<'static>;
+/// SON, the run LED and the buzzer.
+pub type Output = Pin<'static>;
+/// The flash the store keeps its sectors in.
+pub type Flash = ChipFlash<'static, FlashBlocking>;
+/// The host link on USART2.
+pub type HostRx = BufferedUartRx<'static>;
+pub type HostTx = BufferedUartTx<'static>;
+/// The second host link: the USB port's CDC-ACM serial port.
+pub type LinkRx = usb::UsbRx;
+pub type LinkTx = usb::UsbTx;
+/// The ST7920 on SPI2.
+pub type Lcd =
+    St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, SpiDelay>, Pin<'static>, Delay>;
+
+/// The independent watchdog.
+pub struct Watchdog(IndependentWatchdog<'static, IWDG>);
+
+impl Watchdog {
+    pub fn feed(&mut self) {
+        self.0.pet();
+    }
 }
 
-#[embassy_executor::task]
-async fn serial(
-    machine: &'static Machine,
-    store: Store<Flash<'static, FlashBlocking>>,
-    loaded: Result<(), StoreError>,
-    uart: (BufferedUartRx<'static>, BufferedUartTx<'static>),
-    usb: UsbLink,
-) -> ! {
-    tasks::serial::run(machine, store, loaded, uart, usb).await
-}
-
-#[embassy_executor::task]
-async fn servo(
-    machine: &'static Machine,
-    son: Output<'static>,
-    pen: PenPwm,
-    lights: [Output<'static>; 2],
-    mut dog: IndependentWatchdog<'static, IWDG>,
-) -> ! {
-    tasks::servo::run(machine, son, inputs::read, pen, lights, || dog.pet()).await
-}
-
-#[embassy_executor::task]
-async fn homing(machine: &'static Machine) -> ! {
-    tasks::homing::run(machine).await
-}
-
-#[embassy_executor::task]
-async fn lcd(machine: &'static Machine, lcd: Lcd) -> ! {
-    tasks::lcd::run(machine, lcd).await
+/// Everything the firmware's tasks drive, set up and idle.
+pub struct Board {
+    pub step_timer: Tim1StepTimer,
+    pub son: Output,
+    pub pen: PenPwm,
+    /// The run LED and the buzzer.
+    pub lights: [Output; 2],
+    pub columns: [Column; 4],
+    pub rows: [Row; 4],
+    pub watchdog: Watchdog,
+    pub flash: Flash,
+    pub host: (HostRx, HostTx),
+    pub second_link: (LinkRx, LinkTx),
+    pub lcd: Lcd,
 }
 
 /// The ST7920 driver drives CS itself (active high); the SPI device's own CS is this no-op.
-struct NoCs;
+pub struct NoCs;
 
 impl embedded_hal::digital::ErrorType for NoCs {
     type Error = Infallible;
@@ -170,7 +167,7 @@ impl embedded_hal::digital::OutputPin for NoCs {
 /// The SPI device's delays: embassy-time's, the nanoseconds rounded up to whole microseconds
 /// (the clock's ticks) in 32 bits, as embassy-time rounds them in 64 (which would link the
 /// runtime's 64-bit division, see `servoplot::wide`).
-struct SpiDelay;
+pub struct SpiDelay;
 
 impl DelayNs for SpiDelay {
     fn delay_ns(&mut self, ns: u32) {
@@ -183,9 +180,6 @@ impl DelayNs for SpiDelay {
         DelayNs::delay_ms(&mut Delay, ms);
     }
 }
-
-/// The host link on the USB port: its receiving and sending ends.
-type UsbLink = (usb::UsbRx, usb::UsbTx);
 
 /// SYSCLK_HZ from the HSE_HZ crystal: 8 / 4 * 168 / 2 = 168 MHz; 48 MHz for USB from Q; APB1
 /// 42 MHz, APB2 84 MHz.
@@ -208,12 +202,10 @@ fn clocks() -> Config {
     config
 }
 
-#[embassy_executor::main]
-async fn main(spawner: Spawner) {
-    // PULS low and SON off before anything else, after a watchdog reset too.
-    panic::safe_outputs();
+/// Sets the board up: clocks, the watchdog (running from here on), every pin and peripheral,
+/// the host links (the USB device's task on `spawner`). Nothing moves: PULS low, SON low.
+pub fn init(spawner: Spawner) -> Board {
     let p = embassy_stm32::init(clocks());
-    info!("servoplot {} on STM32F407VG at {} MHz", env!("CARGO_PKG_VERSION"), SYSCLK_HZ / 1_000_000);
     if pac::RCC.csr().read().wdgrstf() {
         defmt::warn!("reset by the watchdog: the pulses or the motion had stalled");
     }
@@ -222,39 +214,29 @@ async fn main(spawner: Spawner) {
     pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
     let mut dog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_MS * 1_000);
     dog.unleash();
-    // What the last power cycle kept: the settings the machine starts with, and the offsets and
-    // startup blocks the serial task starts with.
-    let (store, loaded) = Store::open(Flash::new_blocking(p.FLASH), STORE_FLASH_RANGE);
-    let machine: &'static Machine = MACHINE.init(Machine::new(store.kept().settings));
+    poll_clock::start();
+    interrupt::TIM2.set_priority(Priority::from(priority::TIME_DRIVER));
 
-    // Step/direction outputs, low (no pulse) until the pulse task drives them.
+    // Step/direction outputs, low (no pulse) until the pulse engine drives them.
     // PULS on TIM1's PWM outputs (low until a period ends with a pulse), SIGN on GPIO.
     let step_timer = Tim1StepTimer::new(
         p.TIM1,
         PwmPin::new(p.PE9, OutputType::PushPull),
         PwmPin::new(p.PE11, OutputType::PushPull),
-        [Output::new(p.PE10, Level::Low, Speed::VeryHigh), Output::new(p.PE12, Level::Low, Speed::VeryHigh)],
+        [Pin::new(p.PE10, Level::Low, Speed::VeryHigh), Pin::new(p.PE12, Level::Low, Speed::VeryHigh)],
         inputs::InputPins::new(p.PE4, p.PE5, p.PE6, p.PE7, p.PE8, p.PE14, p.PE15),
     );
     // Servo on: low until the servo task, started with the pulse engine running, turns it on.
-    let son = Output::new(p.PE13, Level::Low, Speed::Low);
+    let son = Pin::new(p.PE13, Level::Low, Speed::Low);
     // The pen servo: TIM3's 50 Hz PWM, no pulse until the servo task drives it (`$213`).
     let pen = PenPwm::new(p.TIM3, PwmPin::new(p.PC6, OutputType::PushPull), APB1_TIMER_HZ);
     // The run LED (the Discovery board's green LED) and the buzzer, off.
-    let lights = [Output::new(p.PD12, Level::Low, Speed::Low), Output::new(p.PB0, Level::Low, Speed::Low)];
-
-    interrupt::TIM2.set_priority(TIME_DRIVER_PRIORITY);
-    let (steps, step_consumer) = STEP_QUEUE.init(StepQueue::new()).split();
-    step_timer::start(step_timer, step_consumer, machine, PULSE_PRIORITY);
-    interrupt::UART5.set_priority(MOTION_PRIORITY);
-    let motion_spawner = EXECUTOR_MOTION.start(interrupt::UART5);
-    motion_spawner.spawn(spawned(motion(machine, steps)));
-
+    let lights = [Pin::new(p.PD12, Level::Low, Speed::Low), Pin::new(p.PB0, Level::Low, Speed::Low)];
     let columns = [
-        Output::new(p.PD0, Level::High, Speed::Low),
-        Output::new(p.PD1, Level::High, Speed::Low),
-        Output::new(p.PD2, Level::High, Speed::Low),
-        Output::new(p.PD3, Level::High, Speed::Low),
+        Pin::new(p.PD0, Level::High, Speed::Low),
+        Pin::new(p.PD1, Level::High, Speed::Low),
+        Pin::new(p.PD2, Level::High, Speed::Low),
+        Pin::new(p.PD3, Level::High, Speed::Low),
     ];
     let rows = [
         Input::new(p.PD8, Pull::Up),
@@ -262,9 +244,6 @@ async fn main(spawner: Spawner) {
         Input::new(p.PD10, Pull::Up),
         Input::new(p.PD11, Pull::Up),
     ];
-    spawner.spawn(spawned(keypad(machine, columns, rows)));
-    spawner.spawn(spawned(servo(machine, son, pen, lights, dog)));
-    spawner.spawn(spawned(homing(machine)));
 
     static RX_BUF: StaticCell<[u8; HOST_RX_BUFFER_BYTES]> = StaticCell::new();
     static TX_BUF: StaticCell<[u8; HOST_TX_BUFFER_BYTES]> = StaticCell::new();
@@ -284,17 +263,51 @@ async fn main(spawner: Spawner) {
         Err(_) => defmt::panic!("USART2 cannot run at {} baud", HOST_BAUD),
     };
     // Below the pulse and motion executors: a burst of received bytes never delays a pulse.
-    interrupt::USART2.set_priority(HOST_LINK_PRIORITY);
+    interrupt::USART2.set_priority(Priority::from(priority::HOST_LINK));
     let (tx, rx) = uart.split();
-    let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, HOST_LINK_PRIORITY);
-    spawner.spawn(spawned(serial(machine, store, loaded, (rx, tx), usb)));
+    let usb = usb::start(spawner, p.USB_OTG_FS, p.PA12, p.PA11, Priority::from(priority::HOST_LINK));
 
     let mut spi_config = spi::Config::default();
     spi_config.frequency = Hertz(LCD_SPI_HZ);
     spi_config.mode = spi::MODE_3;
     let spi_bus = Spi::new_blocking_txonly(p.SPI2, p.PB13, p.PB15, spi_config);
-    let spi_dev = unwrap!(ExclusiveDevice::new(spi_bus, NoCs, SpiDelay));
-    let lcd_cs = Output::new(p.PB12, Level::Low, Speed::Low);
-    let lcd_rst = Output::new(p.PB11, Level::High, Speed::Low);
-    spawner.spawn(spawned(lcd(machine, St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay))));
+    let spi_dev = defmt::unwrap!(ExclusiveDevice::new(spi_bus, NoCs, SpiDelay));
+    let lcd_cs = Pin::new(p.PB12, Level::Low, Speed::Low);
+    let lcd_rst = Pin::new(p.PB11, Level::High, Speed::Low);
+    let lcd = St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay);
+
+    Board {
+        step_timer,
+        son,
+        pen,
+        lights,
+        columns,
+        rows,
+        watchdog: Watchdog(dog),
+        flash: ChipFlash::new_blocking(p.FLASH),
+        host: (rx, tx),
+        second_link: usb,
+        lcd,
+    }
+}
+
+/// Hands the pulse engine to the step timer's interrupt, at the pulse priority.
+pub fn start_pulses(timer: Tim1StepTimer, steps: StepConsumer<'static>, machine: &'static Machine) {
+    step_timer::start(timer, steps, machine, Priority::from(priority::PULSE));
+}
+
+/// Wakes the pulse engine: the motion task queued steps.
+pub fn kick_pulses() {
+    step_timer::kick();
+}
+
+/// Starts the motion task's interrupt executor on UART5's vector, at the motion priority.
+pub fn start_motion_executor() -> SendSpawner {
+    interrupt::UART5.set_priority(Priority::from(priority::MOTION));
+    executor::MOTION_EXECUTOR.start(interrupt::UART5)
+}
+
+/// Every machine input's level (see `inputs`).
+pub fn read_inputs() -> InputLevels {
+    inputs::read()
 }

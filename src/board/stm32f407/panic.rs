@@ -12,7 +12,6 @@
 //! The panic's message and location are not read: reading them keeps every panic message's
 //! formatting in the image, about 6 KB of flash.
 
-use cortex_m_rt::{ExceptionFrame, exception};
 use embassy_stm32::pac;
 use embassy_stm32::pac::gpio::vals::Moder;
 
@@ -54,9 +53,10 @@ fn panic(_info: &core::panic::PanicInfo) -> ! {
     cortex_m::asm::udf()
 }
 
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+crate::firmware::stack::hard_fault_entry!(hard_fault);
+
+fn hard_fault() -> ! {
     stop_the_machine();
-    defmt::error!("hard fault: pulses stopped, servos off");
+    defmt::error!("hard fault (a stack overflow, too): pulses stopped, servos off");
     cortex_m::asm::udf()
 }

@@ -22,7 +22,7 @@ use embassy_usb::driver::EndpointError;
 use embassy_usb::{Builder, UsbDevice};
 use static_cell::StaticCell;
 
-use super::spawn::spawned;
+use crate::firmware::polls;
 
 /// pid.codes' vendor ID for open hardware, and its test product ID (1209:0001).
 const USB_VID: u16 = 0x1209;
@@ -92,7 +92,13 @@ pub fn start(
     let (tx, rx, control) = class.split_with_control();
 
     interrupt::OTG_FS.set_priority(priority);
-    spawner.spawn(spawned(usb_device(builder.build())));
+    match usb_device(builder.build()) {
+        Ok(token) => {
+            polls::register(token.id(), "usb");
+            spawner.spawn(token);
+        }
+        Err(_) => defmt::panic!("the USB device's task spawned twice"),
+    }
     (
         UsbRx { rx, control, open: false, packet: [0; USB_PACKET_BYTES], start: 0, end: 0 },
         UsbTx { tx, packet_full: false },

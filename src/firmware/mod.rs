@@ -1,0 +1,176 @@
+//! The firmware image, the same on every board: the shared state built in place in static
+//! storage, the executors and their interrupt priorities, and the task set. A board
+//! (`crate::board`) gives the pins, ports and timers behind the tasks; nothing here names one.
+//!
+//! Priorities ([`priority`]), most urgent first: the step timer's interrupt runs the pulse
+//! engine; then embassy-time's timer; the motion task on an interrupt executor, so
+//! the step queue stays full while thread-mode work runs; then the host link's port. The
+//! thread-mode executor runs the keypad, host link, LCD, servo (which feeds the watchdog),
+//! homing and health tasks.
+
+pub mod executor;
+pub mod polls;
+pub mod priority;
+pub mod stack;
+
+use core::mem::MaybeUninit;
+
+use defmt::info;
+use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
+use embassy_time::{Duration, Timer};
+use servoplot::health::{self, Health};
+use servoplot::interp::Curve;
+use servoplot::machine::Machine;
+use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use servoplot::pulse::{StepProducer, StepQueue};
+use servoplot::settings::Settings;
+use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
+use servoplot::tasks;
+use static_cell::{ConstStaticCell, StaticCell};
+
+use crate::board::{self, Board};
+
+/// How often the health task measures the stack and the polls.
+pub const HEALTH_PERIOD_MS: u64 = 1_000;
+
+/// The shared state, each built in place in its static, never on the stack and moved (the
+/// planner alone is 50 KB; `.ci/run` checks the image's largest stack frame).
+static MACHINE: StaticCell<Machine> = StaticCell::new();
+static STEP_QUEUE: ConstStaticCell<StepQueue> = ConstStaticCell::new(StepQueue::new());
+static PLANNER: StaticCell<Planner<Curve, PLANNER_SEGMENTS>> = StaticCell::new();
+static STORE: StaticCell<Store<board::Flash>> = StaticCell::new();
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    // Pulses off and servos off before anything else, after a watchdog reset too.
+    board::safe_outputs();
+    executor::run_thread_mode(executor::Irq(board::THREAD_PENDER_IRQ), priority::THREAD_PENDER, start)
+}
+
+/// Brings the board up and starts every task; on the thread-mode executor, before its first
+/// poll.
+#[inline(never)]
+fn start(spawner: Spawner) {
+    let board: Board = board::init(spawner);
+    info!("servoplot {} on {=str}", env!("CARGO_PKG_VERSION"), board::NAME);
+    // What the last power cycle kept: the settings the machine starts with, and the offsets and
+    // startup blocks the host link starts with.
+    let (store, loaded) = open_store(STORE.uninit(), board.flash);
+    let settings = store.kept().settings;
+    let why = if loaded.is_ok() { "kept in the flash store, or the defaults" } else { "the defaults" };
+    info!(
+        "settings loaded ({=str}): {} x {} steps/mm, pulses up to {} Hz",
+        why, settings.steps_per_mm[0], settings.steps_per_mm[1], settings.max_pulse_rate_hz
+    );
+    let machine: &'static Machine = build_machine(MACHINE.uninit(), settings);
+    let planner = Planner::init(PLANNER.uninit(), Limits::from_settings(&settings));
+
+    let (steps, step_consumer) = STEP_QUEUE.take().split();
+    board::start_pulses(board.step_timer, step_consumer, machine);
+    let motion_spawner: SendSpawner = board::start_motion_executor();
+    motion_spawner.spawn(timed(motion(machine, planner, steps), "motion"));
+
+    spawner.spawn(timed(keypad(machine, board.columns, board.rows), "keypad"));
+    spawner.spawn(timed(servo(machine, board.son, board.pen, board.lights, board.watchdog), "servo"));
+    spawner.spawn(timed(homing(machine), "homing"));
+    spawner.spawn(timed(serial(machine, store, loaded, board.host, board.second_link), "serial"));
+    spawner.spawn(timed(lcd(machine, board.lcd), "lcd"));
+    spawner.spawn(timed(health(), "health"));
+}
+
+/// The machine, built where it lies: `Machine::new`'s result is written straight into `slot`
+/// (out of line, so it is never a temporary in a caller's frame).
+#[inline(never)]
+fn build_machine(slot: &'static mut MaybeUninit<Machine>, settings: Settings) -> &'static Machine {
+    slot.write(Machine::new(settings))
+}
+
+/// The flash store, opened into `slot` (out of line: its buffers are a temporary of this
+/// frame only), and whether it gave back what was kept.
+#[inline(never)]
+fn open_store(
+    slot: &'static mut MaybeUninit<Store<board::Flash>>,
+    flash: board::Flash,
+) -> (&'static mut Store<board::Flash>, Result<(), StoreError>) {
+    let (store, loaded) = Store::open(flash, STORE_FLASH_RANGE);
+    (slot.write(store), loaded)
+}
+
+/// A task's token, its polls timed under `name`. Each task is spawned once, at start-up, so its
+/// pool always has room: a second spawn is a bug, said plainly.
+fn timed<S>(token: Result<SpawnToken<S>, SpawnError>, name: &'static str) -> SpawnToken<S> {
+    match token {
+        Ok(token) => {
+            polls::register(token.id(), name);
+            token
+        }
+        Err(_) => defmt::panic!("task {=str} spawned twice", name),
+    }
+}
+
+#[embassy_executor::task]
+async fn motion(
+    machine: &'static Machine,
+    planner: &'static mut Planner<Curve, PLANNER_SEGMENTS>,
+    steps: StepProducer<'static>,
+) -> ! {
+    tasks::motion::run(machine, planner, steps, board::kick_pulses, tasks::motion::RealTime).await
+}
+
+#[embassy_executor::task]
+async fn keypad(machine: &'static Machine, columns: [board::Column; 4], rows: [board::Row; 4]) -> ! {
+    tasks::keypad::run(machine, columns, rows).await
+}
+
+#[embassy_executor::task]
+async fn serial(
+    machine: &'static Machine,
+    store: &'static mut Store<board::Flash>,
+    loaded: Result<(), StoreError>,
+    host: (board::HostRx, board::HostTx),
+    second_link: (board::LinkRx, board::LinkTx),
+) -> ! {
+    tasks::serial::run(machine, store, loaded, host, second_link).await
+}
+
+#[embassy_executor::task]
+async fn servo(
+    machine: &'static Machine,
+    son: board::Output,
+    pen: board::PenPwm,
+    lights: [board::Output; 2],
+    mut watchdog: board::Watchdog,
+) -> ! {
+    tasks::servo::run(machine, son, board::read_inputs, pen, lights, || watchdog.feed()).await
+}
+
+#[embassy_executor::task]
+async fn homing(machine: &'static Machine) -> ! {
+    tasks::homing::run(machine).await
+}
+
+#[embassy_executor::task]
+async fn lcd(machine: &'static Machine, lcd: board::Lcd) -> ! {
+    tasks::lcd::run(machine, lcd).await
+}
+
+/// Measures the stack's peak and the longest task poll every [`HEALTH_PERIOD_MS`], publishes
+/// them for `$I`, and logs them whenever either has grown.
+#[embassy_executor::task]
+async fn health() -> ! {
+    let mut logged = Health { stack_peak_bytes: 0, stack_size_bytes: 0, longest_poll_us: 0 };
+    loop {
+        let (task, longest_poll_us) = polls::longest();
+        let now =
+            Health { stack_peak_bytes: stack::peak_bytes(), stack_size_bytes: stack::size_bytes(), longest_poll_us };
+        health::publish(&now);
+        if now.stack_peak_bytes > logged.stack_peak_bytes || now.longest_poll_us > logged.longest_poll_us {
+            info!(
+                "stack: {} of {} bytes at most; longest poll: {} us ({=str})",
+                now.stack_peak_bytes, now.stack_size_bytes, now.longest_poll_us, task
+            );
+            logged = now;
+        }
+        Timer::after(Duration::from_millis(HEALTH_PERIOD_MS)).await;
+    }
+}
