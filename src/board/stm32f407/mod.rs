@@ -27,7 +27,9 @@
 //! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
 //! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port   |
 //! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
+//! | USB host power off  | PC0  | high: the Discovery board's STMPS2141 VBUS switch (enable active low) stays off |
 
+mod chip;
 mod inputs;
 mod panic;
 mod pen;
@@ -206,12 +208,13 @@ fn clocks() -> Config {
 /// the host links (the USB device's task on `spawner`). Nothing moves: PULS low, SON low.
 pub fn init(spawner: Spawner) -> Board {
     let p = embassy_stm32::init(clocks());
+    chip::flash_accelerator_on();
+    chip::timers_stop_on_debug_halt();
+    chip::usb_host_power_off(p.PC0);
     if pac::RCC.csr().read().wdgrstf() {
         defmt::warn!("reset by the watchdog: the pulses or the motion had stalled");
     }
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    // Halted by a debugger, the board is not reset under it.
-    pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
     let mut dog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_MS * 1_000);
     dog.unleash();
     poll_clock::start();
