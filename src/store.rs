@@ -20,8 +20,11 @@
 //! gives them silently.
 //!
 //! On the F407 a write or an erase stalls every fetch from flash, interrupts included: nothing
-//! else runs meanwhile, so the store is plain blocking code, and the serial task saves only at
-//! rest (as GRBL writes its EEPROM), between the lines that change what is kept.
+//! else runs meanwhile (up to [`STORE_SAVE_STALL_MAX_MS`] for a save that erases a sector), so
+//! the store is plain blocking code, and the serial task saves only at rest (as GRBL writes its
+//! EEPROM), between the lines that change what is kept: a save in motion would leave the step
+//! timer pulsing at its last rate with no interrupt to stop it. The independent watchdog's
+//! shortest timeout outlasts the longest stall (`watchdog`).
 
 mod record;
 #[cfg(test)]
@@ -45,6 +48,19 @@ pub const STORE_SECTOR_BYTES: usize = 128 * 1024;
 /// How many the store uses.
 pub const STORE_SECTORS: usize = 2;
 const _: () = assert!((STORE_FLASH_RANGE.end - STORE_FLASH_RANGE.start) as usize == STORE_SECTORS * STORE_SECTOR_BYTES);
+
+/// The longest erase of one of those 128 KB sectors on the F407, erased 32 bits at a time (the
+/// parallelism for a 2.7-3.6 V supply, RM0090 §3.6.2): DS8626's "Flash memory programming"
+/// table gives t_ERASE128KB 1 s typical, 2 s at most (x8, the reset parallelism: 4 s).
+pub const STORE_SECTOR_ERASE_MAX_MS: u32 = 2_000;
+/// The longest program of one 32-bit word (x32): DS8626's t_prog, 16 µs typical, 100 µs at most.
+pub const STORE_WORD_PROGRAM_MAX_US: u32 = 100;
+/// The longest a save stalls the processor on the F407: one sector erased, its header and the
+/// longest record programmed. Every fetch from flash (instructions, interrupt vectors and
+/// handlers) waits for a program or an erase to end (one bank), so nothing runs meanwhile, not
+/// even the pulse interrupt: the serial task saves only with the machine at rest.
+pub const STORE_SAVE_STALL_MAX_MS: u32 = STORE_SECTOR_ERASE_MAX_MS
+    + (((SECTOR_HEADER_BYTES + STORE_BUFFER_BYTES) / ALIGN_BYTES) as u32 * STORE_WORD_PROGRAM_MAX_US).div_ceil(1_000);
 
 /// Starts a sector header: "SPLT".
 const SECTOR_MAGIC: u32 = 0x544c_5053;

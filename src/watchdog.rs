@@ -6,15 +6,42 @@
 //! resets the board. A task that waits forever is caught here: while steps should be flowing
 //! (steps queued, or the motion running, with the servos ready and nothing tripped), the pulses
 //! emitted must grow within [`WATCHDOG_STALL_MS`] more than the queued motion takes.
+//!
+//! The watchdog's timeout on the F407 is a range: its LSI clock runs anywhere from 17 to 47 kHz,
+//! so the prescaler and reload chosen here reset the board after 3.0 s ([`WATCHDOG_TIMEOUT_MS`],
+//! the fastest LSI) to 8.3 s ([`WATCHDOG_TIMEOUT_LONGEST_MS`], the slowest), 4.4 s at the typical
+//! 32 kHz. The shortest outlasts the longest save of the flash store, which stalls the processor
+//! for up to 2 s, by almost a second.
 
 use crate::geom::TICK_HZ;
 use crate::machine::Machine;
 use crate::status::RunState;
+use crate::store::STORE_SAVE_STALL_MAX_MS;
 
-/// The independent watchdog resets the board when it has not been fed for this long: longer
-/// than the flash store's sector erase (up to 2 s on the F407, at 3.3 V), during which the
-/// processor stalls and nothing feeds it.
-pub const WATCHDOG_TIMEOUT_MS: u32 = 4_000;
+/// The clock the F407's independent watchdog counts, its LSI oscillator: DS8626's "LSI
+/// oscillator characteristics" give 17 kHz to 47 kHz (32 kHz typical) over supply, temperature
+/// and parts. The timeout scales inversely with it, so it is a range, not a figure.
+pub const WATCHDOG_LSI_MIN_HZ: u32 = 17_000;
+pub const WATCHDOG_LSI_MAX_HZ: u32 = 47_000;
+/// The watchdog's prescaler: it counts LSI / 64 (IWDG_PR, RM0090 §21.4.2; /4 to /256).
+pub const WATCHDOG_PRESCALER: u32 = 64;
+/// Its reload value: it counts down from here to 0, then resets the board (IWDG_RLR, 12 bits,
+/// RM0090 §21.4.3).
+pub const WATCHDOG_RELOAD: u32 = 2_203;
+const _: () = assert!(WATCHDOG_RELOAD <= 0xFFF);
+
+/// The independent watchdog resets the board when it has not been fed for this long at the
+/// fastest LSI (47 kHz): the shortest its timeout can be, and the one the firmware must meet.
+/// It outlasts the longest stall of a save ([`STORE_SAVE_STALL_MAX_MS`]: a sector erase, up to
+/// 2 s, during which the processor stalls and nothing feeds it) by [`WATCHDOG_SAVE_MARGIN_MS`].
+pub const WATCHDOG_TIMEOUT_MS: u32 = WATCHDOG_PRESCALER * (WATCHDOG_RELOAD + 1) * 1_000 / WATCHDOG_LSI_MAX_HZ;
+/// The same at the slowest LSI (17 kHz): the longest a hung board can go before it is reset.
+pub const WATCHDOG_TIMEOUT_LONGEST_MS: u32 =
+    (WATCHDOG_PRESCALER * (WATCHDOG_RELOAD + 1) * 1_000).div_ceil(WATCHDOG_LSI_MIN_HZ);
+/// What the shortest timeout keeps over the longest save, for the feeding task's period and
+/// the polls that may run between its last feed and the save.
+pub const WATCHDOG_SAVE_MARGIN_MS: u32 = 900;
+const _: () = assert!(WATCHDOG_TIMEOUT_MS >= STORE_SAVE_STALL_MAX_MS + WATCHDOG_SAVE_MARGIN_MS);
 
 /// Longest time without a pulse, beyond the motion queued, before the machine counts as stalled.
 pub const WATCHDOG_STALL_MS: u32 = 1_000;
@@ -65,6 +92,19 @@ impl Progress {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
+
+    #[test]
+    fn the_shortest_timeout_outlasts_a_save_and_a_feeding_period() {
+        // The extremes the documentation gives, from the prescaler and reload the board writes.
+        assert_eq!((WATCHDOG_TIMEOUT_MS, WATCHDOG_TIMEOUT_LONGEST_MS), (3_001, 8_298));
+        assert_eq!(WATCHDOG_PRESCALER * (WATCHDOG_RELOAD + 1) * 1_000 / 32_000, 4_408, "typical LSI");
+        // The servo task fed the watchdog at most one period before a save began; the save
+        // stalls everything for up to a sector erase and a record; the rest is margin.
+        assert_eq!(STORE_SAVE_STALL_MAX_MS, 2_013, "a 2 s erase, then 122 words of 100 µs");
+        let unfed_ms = SERVO_ENABLE_POLL_MS as u32 + STORE_SAVE_STALL_MAX_MS;
+        assert!(WATCHDOG_TIMEOUT_MS >= unfed_ms * 14 / 10, "{} ms against {unfed_ms} ms", WATCHDOG_TIMEOUT_MS);
+    }
 
     fn look(emitted_steps: u32, expecting: bool) -> Look {
         Look { emitted_steps, expecting, queued_ms: 20 }

@@ -30,7 +30,9 @@
 //! | USB host power off  | PC0  | high: the Discovery board's STMPS2141 VBUS switch (enable active low) stays off |
 
 mod chip;
+mod flash;
 mod inputs;
+mod iwdg;
 mod panic;
 mod pen;
 pub mod poll_clock;
@@ -41,18 +43,15 @@ use core::convert::Infallible;
 
 use defmt_rtt as _;
 use embassy_executor::{SendSpawner, Spawner};
-use embassy_stm32::flash::{Blocking as FlashBlocking, Flash as ChipFlash};
 use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Level, Output as Pin, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Blocking;
-use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::peripherals::USART2;
 use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
-use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
 use embedded_hal::delay::DelayNs;
@@ -61,12 +60,12 @@ use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
 use servoplot::pulse::StepConsumer;
 use servoplot::tasks::lcd::St7920Lcd;
-use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
 
 use crate::firmware::{executor, priority};
 
+pub use iwdg::Watchdog;
 pub use panic::safe_outputs;
 pub use pen::PenPwm;
 
@@ -113,8 +112,8 @@ pub type Column = Pin<'static>;
 pub type Row = Input<'static>;
 /// SON, the run LED and the buzzer.
 pub type Output = Pin<'static>;
-/// The flash the store keeps its sectors in.
-pub type Flash = ChipFlash<'static, FlashBlocking>;
+/// The flash the store keeps its sectors in: sectors 10 and 11, erased and programmed at x32.
+pub type Flash = flash::StoreFlash;
 /// The host link on USART2.
 pub type HostRx = BufferedUartRx<'static>;
 pub type HostTx = BufferedUartTx<'static>;
@@ -124,15 +123,6 @@ pub type LinkTx = usb::UsbTx;
 /// The ST7920 on SPI2.
 pub type Lcd =
     St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, SpiDelay>, Pin<'static>, Delay>;
-
-/// The independent watchdog.
-pub struct Watchdog(IndependentWatchdog<'static, IWDG>);
-
-impl Watchdog {
-    pub fn feed(&mut self) {
-        self.0.pet();
-    }
-}
 
 /// Everything the firmware's tasks drive, set up and idle.
 pub struct Board {
@@ -215,8 +205,7 @@ pub fn init(spawner: Spawner) -> Board {
         defmt::warn!("reset by the watchdog: the pulses or the motion had stalled");
     }
     pac::RCC.csr().modify(|w| w.set_rmvf(true));
-    let mut dog = IndependentWatchdog::new(p.IWDG, WATCHDOG_TIMEOUT_MS * 1_000);
-    dog.unleash();
+    let watchdog = Watchdog::start(p.IWDG);
     poll_clock::start();
     interrupt::TIM2.set_priority(Priority::from(priority::TIME_DRIVER));
 
@@ -286,8 +275,8 @@ pub fn init(spawner: Spawner) -> Board {
         lights,
         columns,
         rows,
-        watchdog: Watchdog(dog),
-        flash: ChipFlash::new_blocking(p.FLASH),
+        watchdog,
+        flash: flash::StoreFlash::new(p.FLASH),
         host: (rx, tx),
         second_link: usb,
         lcd,
