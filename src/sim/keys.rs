@@ -3,6 +3,11 @@
 //! Columns are driven low one at a time by the scan task; a row reads low when a chain of pressed
 //! keys connects it to a low column. Three keys on the corners of a rectangle therefore make the
 //! fourth appear, as on the real keypad.
+//!
+//! The board's columns are open-drain: a column not driven low is released and drives nothing.
+//! A push-pull column ([`KeyMatrix::push_pull_column`]) drives high instead; keys that join it to
+//! a low column short the two outputs, which the model counts ([`KeyMatrix::shorts_seen`]), and a
+//! row caught between them reads high (a level between the two, not a press).
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -76,6 +81,10 @@ struct MatrixState {
     started_at_us: Option<u64>,
     /// Columns driven low, bit per column.
     low_columns: u8,
+    /// Push-pull columns driven high, bit per column.
+    high_columns: u8,
+    /// Rows read while joined to a low and a high column.
+    shorts_seen: u32,
 }
 
 /// The key matrix shared by its column and row pins.
@@ -94,7 +103,7 @@ impl KeyMatrix {
 
     /// A matrix whose script waits for [`KeyMatrix::start`].
     pub fn waiting(script: KeyScript) -> Self {
-        KeyMatrix { state: Rc::new(RefCell::new(MatrixState { script, started_at_us: None, low_columns: 0 })) }
+        KeyMatrix { state: Rc::new(RefCell::new(MatrixState { script, ..MatrixState::default() })) }
     }
 
     /// Starts the script now, unless it has started already.
@@ -107,8 +116,20 @@ impl KeyMatrix {
         self.state.borrow().started_at_us.is_some()
     }
 
+    /// An open-drain column output, as the board's: low, or released.
     pub fn column(&self, col: u8) -> ColumnPin {
-        ColumnPin { matrix: self.clone(), col }
+        ColumnPin { matrix: self.clone(), col, push_pull: false }
+    }
+
+    /// A push-pull column output, driven high (as it starts) or low.
+    pub fn push_pull_column(&self, col: u8) -> ColumnPin {
+        self.state.borrow_mut().high_columns |= 1 << col;
+        ColumnPin { matrix: self.clone(), col, push_pull: true }
+    }
+
+    /// How many row reads found a column driven low joined to one driven high.
+    pub fn shorts_seen(&self) -> u32 {
+        self.state.borrow().shorts_seen
     }
 
     pub fn row(&self, row: u8) -> RowPin {
@@ -122,7 +143,7 @@ impl KeyMatrix {
     }
 
     fn row_is_low(&self, row: u8) -> bool {
-        let s = self.state.borrow();
+        let mut s = self.state.borrow_mut();
         let pressed = s.started_at_us.map_or(0, |t0| s.script.pressed_at(clock::now_ticks().saturating_sub(t0)));
         // Rows and columns joined by pressed keys conduct: grow the set reachable from `row`.
         let (mut rows, mut cols) = (1u8 << row, 0u8);
@@ -141,7 +162,12 @@ impl KeyMatrix {
                 break;
             }
         }
-        cols & s.low_columns != 0
+        let low = cols & s.low_columns != 0;
+        if low && cols & s.high_columns != 0 {
+            s.shorts_seen += 1;
+            return false;
+        }
+        low
     }
 }
 
@@ -149,6 +175,8 @@ impl KeyMatrix {
 pub struct ColumnPin {
     matrix: KeyMatrix,
     col: u8,
+    /// Driven high when not low (else released).
+    push_pull: bool,
 }
 
 impl embedded_hal::digital::ErrorType for ColumnPin {
@@ -157,12 +185,18 @@ impl embedded_hal::digital::ErrorType for ColumnPin {
 
 impl embedded_hal::digital::OutputPin for ColumnPin {
     fn set_low(&mut self) -> Result<(), Self::Error> {
-        self.matrix.state.borrow_mut().low_columns |= 1 << self.col;
+        let mut s = self.matrix.state.borrow_mut();
+        s.low_columns |= 1 << self.col;
+        s.high_columns &= !(1 << self.col);
         Ok(())
     }
 
     fn set_high(&mut self) -> Result<(), Self::Error> {
-        self.matrix.state.borrow_mut().low_columns &= !(1 << self.col);
+        let mut s = self.matrix.state.borrow_mut();
+        s.low_columns &= !(1 << self.col);
+        if self.push_pull {
+            s.high_columns |= 1 << self.col;
+        }
         Ok(())
     }
 }
@@ -216,5 +250,46 @@ mod tests {
         assert!(row1.is_low().unwrap());
         col1.set_high().unwrap();
         assert!(row1.is_high().unwrap());
+    }
+
+    /// One pass over the matrix as the keypad task makes it: each column driven low in turn,
+    /// the rows read, the column let go.
+    fn scan(columns: &mut [ColumnPin; 4], rows: &mut [RowPin; 4]) -> u16 {
+        let mut raw = 0;
+        for (c, column) in columns.iter_mut().enumerate() {
+            column.set_low().unwrap();
+            for (r, row) in rows.iter_mut().enumerate() {
+                if row.is_low().unwrap() {
+                    raw |= 1 << (r * 4 + c);
+                }
+            }
+            column.set_high().unwrap();
+        }
+        raw
+    }
+
+    #[test]
+    fn two_keys_of_one_row_read_as_both_with_open_drain_columns_and_short_push_pull_ones() {
+        use crate::keypad::{Key, KeyEvent, KeypadDecoder};
+        clock::reset();
+        // Keys 1 (row 0, column 0) and 2 (row 0, column 1) held together.
+        let both = KeyScript { events: std::vec![(0, 0b11)] };
+        let open = KeyMatrix::new(both.clone());
+        let (mut columns, mut rows) = ([0, 1, 2, 3].map(|c| open.column(c)), [0, 1, 2, 3].map(|r| open.row(r)));
+        let mut decoder = KeypadDecoder::new();
+        let mut events = std::vec::Vec::new();
+        for scan_ms in (0..60).step_by(5) {
+            events.extend(decoder.update(scan(&mut columns, &mut rows), scan_ms));
+        }
+        assert_eq!(events, [KeyEvent::Press(Key::Digit(1)), KeyEvent::Press(Key::Digit(2))]);
+        assert_eq!(open.shorts_seen(), 0);
+
+        // Push-pull columns: the column scanned low is joined through the two keys to one
+        // driven high; the row reads neither level and both keys are lost.
+        let push_pull = KeyMatrix::new(both);
+        let (mut columns, mut rows) =
+            ([0, 1, 2, 3].map(|c| push_pull.push_pull_column(c)), [0, 1, 2, 3].map(|r| push_pull.row(r)));
+        assert_eq!(scan(&mut columns, &mut rows), 0);
+        assert_eq!(push_pull.shorts_seen(), 2, "one short per column scanned with a key down");
     }
 }

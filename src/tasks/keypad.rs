@@ -14,8 +14,10 @@ use crate::ui::menu::UiError;
 /// Time for a row input to settle after its column is driven low.
 pub const KEYPAD_SETTLE_US: u64 = 10;
 
-/// Scans the keypad forever. Columns are outputs driven low one at a time; rows are inputs with
-/// pull-ups, read low where a pressed key joins them to the driven column.
+/// Scans the keypad forever. Columns are open-drain outputs driven low one at a time and released
+/// (`set_high`) after, never driven high, so keys pressed together never join two driven
+/// outputs; rows are inputs with pull-ups, read low where a pressed key joins them to the driven
+/// column.
 pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 4], mut rows: [R; 4]) -> ! {
     let mut decoder = KeypadDecoder::new();
     let mut ticker = Ticker::every(Duration::from_millis(KEYPAD_SCAN_PERIOD_MS as u64));

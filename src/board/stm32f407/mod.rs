@@ -18,7 +18,7 @@
 //! | run LED / buzzer    | PD12 / PB0 | high lights / sounds (`$214`, `$215`)          |
 //! | pen servo (PWM)     | PC6  | TIM3 CH1, 50 Hz: the RC servo's signal (`$210`-`$213`) |
 //! | e-stop              | PE15 | input with pull-up, normally closed button to GND: open = stop (`$208`) |
-//! | keypad columns 1-4  | PD0-PD3 | outputs, driven low one at a time               |
+//! | keypad columns 1-4  | PD0-PD3 | open-drain outputs, driven low one at a time, else released |
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
 //! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
 //! | LCD SID (R/W)       | PB15 | SPI2 MOSI                                          |
@@ -44,7 +44,7 @@ use core::convert::Infallible;
 use defmt_rtt as _;
 use embassy_executor::{SendSpawner, Spawner};
 use embassy_stm32::gpio::OutputType;
-use embassy_stm32::gpio::{Input, Level, Output as Pin, Pull, Speed};
+use embassy_stm32::gpio::{Input, Level, Output as Pin, OutputOpenDrain, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Blocking;
 use embassy_stm32::peripherals::USART2;
@@ -107,8 +107,8 @@ fn UART4() {
     executor::on_thread_pender();
 }
 
-/// Keypad pins: columns driven, rows read.
-pub type Column = Pin<'static>;
+/// Keypad pins: columns driven low or released (open-drain), rows read.
+pub type Column = OutputOpenDrain<'static>;
 pub type Row = Input<'static>;
 /// SON, the run LED and the buzzer.
 pub type Output = Pin<'static>;
@@ -224,11 +224,15 @@ pub fn init(spawner: Spawner) -> Board {
     let pen = PenPwm::new(p.TIM3, PwmPin::new(p.PC6, OutputType::PushPull), APB1_TIMER_HZ);
     // The run LED (the Discovery board's green LED) and the buzzer, off.
     let lights = [Pin::new(p.PD12, Level::Low, Speed::Low), Pin::new(p.PB0, Level::Low, Speed::Low)];
+    // Keypad columns open-drain (GPIOx_OTYPER = 1, RM0090 §8.4.2): a column is driven low while
+    // it is scanned and released otherwise, never driven high, so two keys pressed in one row
+    // join the low column to a released one instead of shorting it to a high output. The rows'
+    // pull-ups (DS8626: R_PU 30-50 kΩ) take them back high.
     let columns = [
-        Pin::new(p.PD0, Level::High, Speed::Low),
-        Pin::new(p.PD1, Level::High, Speed::Low),
-        Pin::new(p.PD2, Level::High, Speed::Low),
-        Pin::new(p.PD3, Level::High, Speed::Low),
+        OutputOpenDrain::new(p.PD0, Level::High, Speed::Low),
+        OutputOpenDrain::new(p.PD1, Level::High, Speed::Low),
+        OutputOpenDrain::new(p.PD2, Level::High, Speed::Low),
+        OutputOpenDrain::new(p.PD3, Level::High, Speed::Low),
     ];
     let rows = [
         Input::new(p.PD8, Pull::Up),
