@@ -76,8 +76,19 @@ fn key_0_switches_the_screen_to_chinese_and_a_power_cycle_keeps_it() {
     assert_eq!(lines[0], "SERVOPLOT           空闲");
     assert_eq!(lines[2..], [" 9 速度预设", ">0 语言 Language"]);
 
-    // The next power-up greets in Chinese, and the host link reads and sets the language.
-    let second = power_on(first.flash.clone(), "wait:2500", "$$\n$216=0\n");
+    // The next power-up greets in Chinese, and the host link reads and sets the language (once
+    // the splash is up: the LCD controller takes 90 ms to start).
+    let mut serial = SimSerial::with_input(b"");
+    for (i, byte) in "$$\n$216=0\n".bytes().enumerate() {
+        serial = serial.with_byte_at(200_000 + i as u64 * 100, byte);
+    }
+    let second = sim::run(SimConfig {
+        flash: first.flash.clone(),
+        keys: KeyScript::parse("wait:2500").unwrap(),
+        serial,
+        keys_start: sim::KeysStart::AtOnce,
+        ..SimConfig::default()
+    });
     assert!(second.answers().lines().any(|l| l == "$216=1"), "{}", second.answers());
     let (_, splash) = &second.frames[0];
     assert_eq!((text(splash, 1, 24), text(splash, 2, 24)), ("伺服绘图机".into(), "0: English".into()));

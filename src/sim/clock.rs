@@ -8,8 +8,6 @@ use core::cell::Cell;
 use core::task::Waker;
 use std::cell::RefCell;
 
-use embedded_hal::delay::DelayNs;
-
 std::thread_local! {
     static NOW_TICKS: Cell<u64> = const { Cell::new(0) };
     /// Earliest deadline any timer asked for, with the wakers to call then.
@@ -74,12 +72,4 @@ pub fn jump_to_next_deadline() -> bool {
         w.wake();
     }
     true
-}
-
-/// A delay that costs no virtual time: blocking work of the lowest-priority task (the LCD), which
-/// on target is pre-empted by the pulse task and so never delays a pulse.
-pub struct FreeDelay;
-
-impl DelayNs for FreeDelay {
-    fn delay_ns(&mut self, _ns: u32) {}
 }

@@ -39,14 +39,13 @@ use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
 use crate::tasks::{self, lcd::St7920Lcd};
-use clock::FreeDelay;
 use cpu::{CpuModel, SimCpu};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 use flash::SimFlash;
 use inputs::{InputScript, SimInputs, Switches};
 use keys::{KeyMatrix, KeyScript};
-use lcd::{Frame, LcdPin, SimSpi};
+use lcd::{Frame, LcdPin, SIM_LCD_SPI_HZ, SimSpi};
 use pins::{LevelPin, PulseTrace, SimPen, SimWatchdog, TracePin};
 use serial::SimSerial;
 use step_timer::SimStepTimer;
@@ -95,6 +94,8 @@ pub struct SimReport {
     pub trace: PulseTrace,
     /// Every frame sent to the LCD, with the virtual time it was sent.
     pub frames: Vec<(u64, Frame)>,
+    /// LCD writes that came sooner after the previous one than the controller executes it.
+    pub lcd_writes_too_soon: u32,
     /// Everything the firmware answered on the UART link.
     pub serial_out: Vec<u8>,
     /// Everything the firmware answered on the USB link.
@@ -210,7 +211,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let links = [&serial, &usb];
     let cpu = config.cpu;
     let spi = SimSpi::default();
-    let lcd = St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), FreeDelay);
+    let lcd =
+        St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), spi.delay(), SIM_LCD_SPI_HZ);
 
     let firmware = join(
         join5(
@@ -303,9 +305,11 @@ pub fn run(config: SimConfig) -> SimReport {
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
+    let lcd_writes_too_soon = spi.model.borrow().writes_too_soon;
     SimReport {
         trace,
         frames,
+        lcd_writes_too_soon,
         serial_out: serial.output(),
         usb_out: usb.output(),
         position,

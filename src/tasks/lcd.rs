@@ -2,24 +2,26 @@
 //! `LCD_FRAME_MIN_MS`, at the lowest priority, and keeps the path drawn for the preview.
 //!
 //! Every frame is drawn whole from the menu and machine state (no stale digits), into the
-//! driver's buffer, and only the visible region is sent to the controller (~14 ms at 600 kHz).
+//! driver's picture, and sent to the controller a slice at a time with a yield between slices
+//! (the ST7920's paced writes take ~43 ms a picture: [`St7920Lcd`]).
 //! While a run is under way the task reads the pen's position every `PREVIEW_SAMPLE_MS` into
 //! the run's [`Trail`]: the path of the steps emitted, read from the position the pulse engine
 //! counts, which costs the motion and the pulses nothing.
 
+pub mod st7920;
+
 use embassy_futures::select::select;
+use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::pixelcolor::BinaryColor;
-use embedded_hal::delay::DelayNs;
-use embedded_hal::digital::OutputPin;
-use embedded_hal::spi::SpiDevice;
 
 use crate::machine::Machine;
 use crate::pen::PenLift;
-use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 use crate::ui::run::RunPath;
 use crate::ui::screen::{self, Live};
+
+pub use st7920::St7920Lcd;
 
 /// Shortest time between two frames (10 Hz at most).
 pub const LCD_FRAME_MIN_MS: u64 = 100;
@@ -31,63 +33,19 @@ pub const PREVIEW_SAMPLE_MS: u64 = 20;
 
 /// A display the LCD task can draw on and show.
 pub trait Lcd: DrawTarget<Color = BinaryColor> {
-    /// Prepares the controller; called once before the first frame.
-    fn init(&mut self);
-    /// Sends what was drawn to the glass.
-    fn show(&mut self);
-}
-
-/// An ST7920 in serial mode behind the `st7920` driver, showing its top-left 122x32 pixels.
-pub struct St7920Lcd<SPI: SpiDevice, RST: OutputPin, D: DelayNs> {
-    driver: st7920::ST7920<SPI, RST, RST>,
-    delay: D,
-}
-
-impl<SPI: SpiDevice, RST: OutputPin, D: DelayNs> St7920Lcd<SPI, RST, D> {
-    /// `cs` is the controller's chip select (RS pin, active high), driven by the driver.
-    pub fn new(spi: SPI, rst: RST, cs: RST, delay: D) -> Self {
-        St7920Lcd { driver: st7920::ST7920::new(spi, rst, Some(cs), false), delay }
-    }
-}
-
-impl<SPI: SpiDevice, RST: OutputPin, D: DelayNs> embedded_graphics::geometry::OriginDimensions
-    for St7920Lcd<SPI, RST, D>
-{
-    fn size(&self) -> embedded_graphics::geometry::Size {
-        embedded_graphics::geometry::Size::new(SCREEN_WIDTH_PX, SCREEN_HEIGHT_PX)
-    }
-}
-
-impl<SPI: SpiDevice, RST: OutputPin, D: DelayNs> DrawTarget for St7920Lcd<SPI, RST, D> {
-    type Color = BinaryColor;
-    type Error = core::convert::Infallible;
-
-    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<BinaryColor>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        self.driver.draw_iter(pixels)
-    }
-}
-
-impl<SPI: SpiDevice, RST: OutputPin, D: DelayNs> Lcd for St7920Lcd<SPI, RST, D> {
-    fn init(&mut self) {
-        if self.driver.init(&mut self.delay).is_err() {
-            warn!("LCD init failed");
-        }
-    }
-
-    fn show(&mut self) {
-        let r = self.driver.flush_region(0, 0, SCREEN_WIDTH_PX as u8, SCREEN_HEIGHT_PX as u8, &mut self.delay);
-        if r.is_err() {
-            warn!("LCD flush failed");
-        }
-    }
+    /// Takes the controller's start-up up to its next long wait and says how long that is, µs;
+    /// `None` once the controller is ready for pictures.
+    fn start(&mut self) -> Option<u32>;
+    /// Sends the next slice of what was drawn to the glass (the first call begins a picture):
+    /// `true` while slices of it remain to send.
+    fn show_slice(&mut self) -> bool;
 }
 
 /// Draws the screen forever.
 pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
-    lcd.init();
+    while let Some(wait_us) = lcd.start() {
+        Timer::after(Duration::from_micros(u64::from(wait_us))).await;
+    }
     let mut shown = None;
     let mut last_frame_ms = 0u32;
     let mut drawn = RunPath::default();
@@ -109,7 +67,7 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
         if shown.as_ref() != Some(&view) {
             if u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none() {
                 let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn.path), &mut lcd);
-                lcd.show();
+                show(&mut lcd).await;
                 shown = Some(view);
                 last_frame_ms = now_ms;
             } else {
@@ -118,5 +76,16 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
             }
         }
         select(machine.changed(), Timer::after(Duration::from_millis(wait_ms))).await;
+    }
+}
+
+/// Sends the picture drawn to the glass a slice at a time, letting every other task run before
+/// each slice: no poll of this task both draws a picture and sends, nor sends more than a slice.
+async fn show<L: Lcd>(lcd: &mut L) {
+    loop {
+        yield_now().await;
+        if !lcd.show_slice() {
+            break;
+        }
     }
 }

@@ -58,8 +58,9 @@ impl SetDutyCycle for NoPwm {
     }
 }
 
-/// The LCD's serial clock on the F407 board (its SPI2 at 600 kHz).
-const LCD_SPI_HZ: u64 = 600_000;
+/// The LCD's serial clock on the F407 board (its SPI2: APB1's 42 MHz / 64). The LCD driver
+/// paces its writes from it.
+pub const LCD_SPI_HZ: u32 = 656_250;
 
 /// The LCD's SPI device: each transfer takes the time the F407's blocking SPI takes to clock
 /// its bits out, so the LCD task's polls cost the model what they cost the board.
@@ -82,7 +83,7 @@ impl SpiDevice for LcdBus {
                     0
                 }
             };
-            block_for(Duration::from_micros((bytes as u64 * 8 * 1_000_000).div_ceil(LCD_SPI_HZ)));
+            block_for(Duration::from_micros((bytes as u64 * 8 * 1_000_000).div_ceil(u64::from(LCD_SPI_HZ))));
         }
         Ok(())
     }

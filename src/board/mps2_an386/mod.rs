@@ -117,7 +117,7 @@ pub fn init(_spawner: Spawner) -> Board {
         flash: devices::ModelFlash,
         host: uart::open(&uart::UART0_PORT, priority::HOST_LINK),
         second_link: uart::open(&uart::UART1_PORT, priority::HOST_LINK),
-        lcd: St7920Lcd::new(devices::LcdBus, devices::NoPin, devices::NoPin, Delay),
+        lcd: St7920Lcd::new(devices::LcdBus, devices::NoPin, devices::NoPin, Delay, devices::LCD_SPI_HZ),
     }
 }
 

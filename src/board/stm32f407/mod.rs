@@ -22,7 +22,7 @@
 //! | keypad rows 1-4     | PD8-PD11 | inputs with pull-ups                           |
 //! | LCD SCLK (E)        | PB13 | SPI2 SCK                                           |
 //! | LCD SID (R/W)       | PB15 | SPI2 MOSI                                          |
-//! | LCD CS (RS)         | PB12 | active high, driven by the st7920 driver           |
+//! | LCD CS (RS)         | PB12 | active high, driven by the LCD driver              |
 //! | LCD RST             | PB11 | PSB tied to GND selects serial mode                |
 //! | host TX / RX        | PA2 / PA3 | USART2, 115200 8N1, to a USB-serial adapter   |
 //! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port   |
@@ -77,8 +77,9 @@ const HSE_HZ: u32 = 8_000_000;
 const SYSCLK_HZ: u32 = 168_000_000;
 const _: () = assert!(SYSCLK_HZ == poll_clock::PER_US * 1_000_000);
 
-/// What TIM2-TIM7 count at: twice APB1's SYSCLK / 4 (see `clocks`).
-const APB1_TIMER_HZ: u32 = SYSCLK_HZ / 4 * 2;
+/// APB1's clock, SYSCLK / 4 (see `clocks`), and what TIM2-TIM7 count at: twice that.
+const APB1_HZ: u32 = SYSCLK_HZ / 4;
+const APB1_TIMER_HZ: u32 = APB1_HZ * 2;
 
 /// The thread-mode executor's pender: UART4's interrupt, unused as a UART.
 pub const THREAD_PENDER_IRQ: u16 = pac::Interrupt::UART4 as u16;
@@ -89,8 +90,11 @@ const HOST_BAUD: u32 = 115_200;
 /// counting), so 256 never overflows; answers are short, status reports the longest.
 const HOST_RX_BUFFER_BYTES: usize = 256;
 const HOST_TX_BUFFER_BYTES: usize = 256;
-/// ST7920 serial clock: the controller takes at most ~1 MHz at 5 V (datasheet t_scyc).
-const LCD_SPI_HZ: u32 = 600_000;
+/// ST7920 serial clock: the controller takes at most ~1 MHz at 5 V (datasheet t_scyc). SPI2
+/// divides APB1's 42 MHz by a power of two (SPI_CR1.BR, RM0090 §28.5.1): by 64, 656 kHz. Asked
+/// for exactly, embassy picks that divider (kernel clock / frequency = 64), and the LCD driver
+/// paces its writes from this figure, so it must be the clock the link really runs at.
+const LCD_SPI_HZ: u32 = APB1_HZ / 64;
 
 bind_interrupts!(struct Irqs {
     USART2 => usart::BufferedInterruptHandler<USART2>;
@@ -140,7 +144,7 @@ pub struct Board {
     pub lcd: Lcd,
 }
 
-/// The ST7920 driver drives CS itself (active high); the SPI device's own CS is this no-op.
+/// The LCD driver drives CS itself (active high); the SPI device's own CS is this no-op.
 pub struct NoCs;
 
 impl embedded_hal::digital::ErrorType for NoCs {
@@ -270,7 +274,7 @@ pub fn init(spawner: Spawner) -> Board {
     let spi_dev = defmt::unwrap!(ExclusiveDevice::new(spi_bus, NoCs, SpiDelay));
     let lcd_cs = Pin::new(p.PB12, Level::Low, Speed::Low);
     let lcd_rst = Pin::new(p.PB11, Level::High, Speed::Low);
-    let lcd = St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay);
+    let lcd = St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay, LCD_SPI_HZ);
 
     Board {
         step_timer,
