@@ -81,3 +81,20 @@ fn a_power_cut_while_saving_a_setting_keeps_the_old_value_or_the_new() {
         );
     }
 }
+
+#[test]
+fn a_setting_changed_between_moves_is_saved_only_once_the_pen_stands_still() {
+    // On the F407 a save stalls the processor, the pulse interrupt included, for as long as it
+    // writes (up to 2 s when it erases a sector): the moves before the line must have ended, and
+    // the next may start only after it.
+    let report = power_on(SimFlash::default(), "G1 X20 F3000\n$110=4000\nG1 X0\n");
+    assert!(report.answers().ends_with("]\r\nok\r\nok\r\nok\r\n"), "{}", report.answers());
+    let saves = report.flash.operations_at_us();
+    let (Some(&first), Some(&last)) = (saves.first(), saves.last()) else { panic!("nothing saved") };
+    assert_eq!(report.flash.erased_sectors().iter().sum::<u32>(), 1, "the first save erases a sector");
+    let pulses = &report.trace.pulses;
+    let before: Vec<_> = pulses.iter().filter(|p| p.t_us <= last).collect();
+    assert_eq!(before.len() * 2, pulses.len(), "the first move whole before the save, the second after");
+    let pulse_width_us = report.settings.pulse_width_us as u64;
+    assert!(before.last().is_some_and(|p| p.t_us + pulse_width_us < first), "the last pulse had ended");
+}

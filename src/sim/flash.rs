@@ -52,6 +52,8 @@ pub struct SimFlash<const SECTOR_BYTES: usize = STORE_SECTOR_BYTES> {
     /// Bytes written or erased so far, and erases so far per sector.
     changed_bytes: Rc<Cell<u64>>,
     erases: Rc<RefCell<Vec<u32>>>,
+    /// When each write or erase came, virtual time.
+    operations_at_us: Rc<RefCell<Vec<u64>>>,
     file: Option<Rc<RefCell<File>>>,
 }
 
@@ -70,6 +72,7 @@ impl<const SECTOR_BYTES: usize> SimFlash<SECTOR_BYTES> {
             power_bytes: Rc::new(Cell::new(None)),
             changed_bytes: Rc::new(Cell::new(0)),
             erases: Rc::new(RefCell::new(vec![0; sectors])),
+            operations_at_us: Rc::new(RefCell::new(Vec::new())),
             file: None,
         }
     }
@@ -112,9 +115,17 @@ impl<const SECTOR_BYTES: usize> SimFlash<SECTOR_BYTES> {
         self.erases.borrow().clone()
     }
 
+    /// The virtual time of every write and erase since power-on. On the F407 each stalls the
+    /// processor, interrupts included, until it ends (an erase up to 2 s): the machine must be
+    /// at rest then.
+    pub fn operations_at_us(&self) -> Vec<u64> {
+        self.operations_at_us.borrow().clone()
+    }
+
     /// Sets the bytes from `offset` on by `change`, one byte at a time while the power lasts,
     /// writing them through to the file.
     fn change(&self, offset: usize, len: usize, change: impl Fn(usize, u8) -> u8) -> Result<(), SimFlashError> {
+        self.operations_at_us.borrow_mut().push(crate::sim::clock::now_ticks());
         let mut bytes = self.bytes.borrow_mut();
         let range = bytes.get_mut(offset..offset + len).ok_or(SimFlashError::OutOfBounds)?;
         let mut done = 0;
