@@ -309,7 +309,7 @@ mod tests {
             let more = lcd.show_slice();
             slices += 1;
             let slice_ns = spi.model.borrow().link_free_ns() - before_ns;
-            assert!(slice_ns <= 1_400_000, "a slice takes {slice_ns} ns");
+            assert!(slice_ns <= 1_500_000, "a slice takes {slice_ns} ns");
             if !more {
                 break;
             }
@@ -318,15 +318,16 @@ mod tests {
         let m = spi.model.borrow();
         assert_eq!(slices, 32, "a row a slice");
         assert_eq!(m.bad_frames, 0);
-        // 7 start-up instructions, then 32 rows of two addresses and 16 bytes.
-        assert_eq!(m.writes, 7 + 32 * 18);
+        // 6 start-up instructions, then 32 rows of two addresses (sent twice by the st7920
+        // crate) and 16 bytes.
+        assert_eq!(m.writes, 6 + 32 * 20);
         assert_eq!(m.writes_too_soon, 0);
         assert!(
             m.shortest_write_gap_ns.is_some_and(|g| (72_000..74_000).contains(&g)),
             "{:?}",
             m.shortest_write_gap_ns
         );
-        assert!((42_000_000..43_000_000).contains(&picture_ns), "the picture took {picture_ns} ns");
+        assert!((46_000_000..47_500_000).contains(&picture_ns), "the picture took {picture_ns} ns");
         assert_eq!(m.frames.len(), 1, "one frame when chip select fell after the picture");
         let f = m.visible();
         assert_eq!(m.frames[0].1, f);
