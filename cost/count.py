@@ -10,6 +10,8 @@ and turns the instruction counts between the harness's marks into per-step figur
     python3 count.py --only circle --profile   # and which functions the instructions went to
     python3 count.py --check-model f407.txt    # fails if the simulator's model is out of date
     python3 count.py --write-model f407.txt    # writes it anew from what is counted
+    python3 count.py --masked           # longest stretch with interrupts masked (shared state)
+    python3 count.py --masked --image ELF --qemu-arg=-serial --qemu-arg=null   # any image
 """
 import argparse
 import os
@@ -24,6 +26,8 @@ TARGET = "thumbv7em-none-eabihf"
 ELF = os.path.join(HERE, "..", "target", TARGET, "release", "servoplot-cost")
 PLUGIN_SRC = os.path.join(HERE, "plugin", "insn_count.c")
 PLUGIN = os.path.join(HERE, "..", "target", "cost", "insn_count.so")
+MASKED_SRC = os.path.join(HERE, "plugin", "masked.c")
+MASKED_PLUGIN = os.path.join(HERE, "..", "target", "cost", "masked.so")
 QEMU = "qemu-system-arm"
 
 # The processor the counts are turned into time for: the STM32F407 at 168 MHz, and an estimate
@@ -56,11 +60,25 @@ MODEL_TOLERANCE = 0.05
 STEP_BUDGETS = {"line": 250, "arc": 250, "ellipse": 250, "sine": 600, "function": 600}
 PULSE_BUDGET = 300
 
+# The longest stretch with interrupts masked (--masked), instructions: outside the pulse
+# interrupt, the pulses wait at most this long for their interrupt (500 instructions are about
+# 4 us at 168 MHz, under a 5 us period at 200 kHz).
+MASKED_BUDGET = 500
+# The harness's cases --masked runs unless told otherwise: the shared state's operations.
+MASKED_CASES = "shared"
+# The critical-section crate's entry points, when the image has them out of line.
+CRITICAL_SECTION_SYMBOLS = ("_critical_section_1_0_acquire", "_critical_section_1_0_release")
+
+
+def build_plugin(source, plugin):
+    os.makedirs(os.path.dirname(plugin), exist_ok=True)
+    if not os.path.exists(plugin) or os.path.getmtime(plugin) < os.path.getmtime(source):
+        subprocess.run(["gcc", "-O2", "-Wall", "-shared", "-fPIC", "-o", plugin, source], check=True)
+
 
 def build():
-    os.makedirs(os.path.dirname(PLUGIN), exist_ok=True)
-    if not os.path.exists(PLUGIN) or os.path.getmtime(PLUGIN) < os.path.getmtime(PLUGIN_SRC):
-        subprocess.run(["gcc", "-O2", "-Wall", "-shared", "-fPIC", "-o", PLUGIN, PLUGIN_SRC], check=True)
+    build_plugin(PLUGIN_SRC, PLUGIN)
+    build_plugin(MASKED_SRC, MASKED_PLUGIN)
     subprocess.run(["cargo", "build", "--release", "--locked", "--quiet"], cwd=HERE, check=True)
 
 
@@ -185,6 +203,76 @@ def check_budgets(measured, per_pulse):
     print(f"\nevery case within its budget (per step: {STEP_BUDGETS}; per pulse: {PULSE_BUDGET})")
 
 
+def name_of(addr, syms):
+    """`function+offset` for a code address, from the image's function symbols."""
+    import bisect
+    if addr >= 0xFFFF_FFFF:
+        return "?"
+    starts = [a for a, _, _ in syms]
+    i = bisect.bisect_right(starts, addr) - 1
+    if i < 0:
+        return f"{addr:#x}"
+    start, _, name = syms[i]
+    return f"{demangle(name)}+{addr - start:#x}"
+
+
+def masked_run(elf, semihosting_arg, qemu_args):
+    """Runs `elf` on mps2-an386 under the masked plugin; the stretches it found, by kind."""
+    syms = sorted(functions(elf))
+    by_name = {name: addr for addr, _, name in syms}
+    plugin = MASKED_PLUGIN
+    for arg, name in zip(("acquire", "release"), CRITICAL_SECTION_SYMBOLS):
+        if name in by_name:
+            plugin += f",{arg}={by_name[name]:#x}"
+    log = os.path.join(os.path.dirname(MASKED_PLUGIN), "masked.txt")
+    semihosting = "enable=on,target=native" + (f",arg={semihosting_arg}" if semihosting_arg else "")
+    cmd = [QEMU, "-M", "mps2-an386", "-nographic", "-semihosting-config", semihosting, "-kernel", elf,
+           "-plugin", plugin, "-d", "plugin", "-D", log] + qemu_args
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"{elf} failed ({done.returncode}):\n{done.stdout}{done.stderr}")
+    stretches, notes = {}, []
+    with open(log) as f:
+        for line in f.read().splitlines():
+            words = line.split()
+            if words[:1] == ["stretch"]:
+                kind, begin, call, longest, count = words[1], int(words[2], 16), int(words[3], 16), int(words[4]), \
+                    int(words[5])
+                stretches.setdefault(kind, []).append((longest, count, begin, call))
+            elif words[:1] == ["open"]:
+                notes.append(f"still masked at exit: {words[1]} from {name_of(int(words[2], 16), syms)}, "
+                             f"{words[3]} instructions")
+            elif words[:1] == ["unmatched-msr"] and words[1] != "0":
+                notes.append(f"{words[1]} `msr primask` without a saved value: PRIMASK taken as cleared there")
+            elif words[:1] == ["saved"] and words[1:] != ["0", "0"]:
+                notes.append(f"{words[1]} saved PRIMASK values never written back ({words[2]} dropped): "
+                             "the stretches may be paired wrongly")
+            elif words[:1] == ["sites-full"]:
+                notes.append("more places than the plugin keeps: some stretches were not recorded")
+    return stretches, notes, syms
+
+
+def print_masked(stretches, notes, syms, budget, check):
+    """The longest stretches and where they began; fails over `budget` if `check`."""
+    print(f"Longest stretches with interrupts masked, instructions on a Cortex-M4F (budget {budget}):\n")
+    print("| kind | longest | stretches | began at | called from |")
+    print("|---|---:|---:|---|---|")
+    longest = 0
+    for kind in ("primask", "section"):
+        found = sorted(stretches.get(kind, []), reverse=True)
+        for n, count, begin, call in found[:8]:
+            print(f"| {kind} | {n} | {count} | {name_of(begin, syms)} | {name_of(call, syms)} |")
+        if found:
+            longest = max(longest, found[0][0])
+    for note in notes:
+        print(f"\n{note}")
+    if not stretches:
+        sys.exit("no masked stretch seen: is this the image that was meant?")
+    print(f"\nlongest masked stretch: {longest} instructions (budget {budget})")
+    if check and longest > budget:
+        sys.exit(f"over budget: a masked stretch of {longest} instructions, budget {budget}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only the cases whose name contains this text")
@@ -193,7 +281,22 @@ def main():
     parser.add_argument("--write-model", metavar="FILE", help="write the simulator's CPU model from the counts")
     parser.add_argument("--check-model", metavar="FILE", help="fail if the simulator's CPU model is out of date")
     parser.add_argument("--check-budgets", action="store_true", help="fail if a case is over its budget")
+    parser.add_argument("--masked", action="store_true",
+                        help="print the longest stretch with interrupts masked instead (the harness's shared-state "
+                             "operations, or --only's cases, or --image)")
+    parser.add_argument("--image", help="with --masked: run this mps2-an386 image instead of the harness")
+    parser.add_argument("--qemu-arg", action="append", default=[], help="with --masked --image: one more QEMU argument")
     args = parser.parse_args()
+    if args.masked:
+        if args.image:
+            build_plugin(MASKED_SRC, MASKED_PLUGIN)
+            found = masked_run(args.image, None, args.qemu_arg)
+        else:
+            if not args.no_build:
+                build()
+            found = masked_run(ELF, args.only or MASKED_CASES, [])
+        print_masked(*found, MASKED_BUDGET, args.check_budgets)
+        return
     if not args.no_build:
         build()
     measured, blocks, syms = run(args.only, args.profile)

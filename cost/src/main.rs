@@ -5,6 +5,7 @@
 #![no_main]
 
 mod pulse_path;
+mod shared;
 mod task;
 
 use cortex_m_rt::entry;
@@ -191,6 +192,9 @@ fn main() -> ! {
     }
     if "pulse".contains(only) || only.is_empty() {
         pulse_path_runs();
+    }
+    if "shared".contains(only) || only.is_empty() {
+        shared::run();
     }
     debug::exit(debug::EXIT_SUCCESS);
     halt()

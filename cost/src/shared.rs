@@ -1,0 +1,73 @@
+//! The shared state's critical sections: what the tasks do to the state they share, each a few
+//! times, so that `count.py --masked` (the `masked` plugin) finds the longest stretch with
+//! interrupts masked among them. Nothing here is timed by marks: the plugin watches every
+//! `cpsid i`…`cpsie i` of the run.
+//!
+//! The operations are the tasks' own: a key press through the menu and the run screen following
+//! the machine (keypad task), a redraw's reads (LCD task), a job submitted and taken (the inputs
+//! and the motion task), settings read and changed (host link, keypad, motion task and pulse
+//! engine), the status read (reports, LCD) and a control request taken.
+
+use servoplot::geom::Point;
+use servoplot::interp::Shape;
+use servoplot::job::{Control, Feed, Job};
+use servoplot::keypad::{Key, KeyEvent};
+use servoplot::machine::Machine;
+use servoplot::settings::Settings;
+use servoplot::ui::screen::{self, Live};
+
+/// Times each operation runs: enough to reach every branch the state can take (an empty and a
+/// full job queue, a menu on several screens).
+const ROUNDS: usize = 8;
+
+/// The keys pressed, in turn: through the mode list into a form and back out.
+const KEYS: [Key; 6] = [Key::Digit(8), Key::Digit(2), Key::Hash, Key::Digit(5), Key::Star, Key::C];
+
+/// Runs every operation [`ROUNDS`] times.
+pub fn run() {
+    let settings = Settings::default();
+    let machine = Machine::new(settings);
+    let job =
+        match servoplot::drawing::from_shape(Shape::Straight { to: Point::new(400, 300) }, Point::ORIGIN, &settings) {
+            Ok(drawing) => Job::draw(drawing, Feed::MmPerMin(1_000.0)),
+            Err(_) => panic!("drawing refused"),
+        };
+    for round in 0..ROUNDS {
+        // Keypad task: a key through the menu, then the run screen follows the machine.
+        for key in KEYS {
+            for event in [KeyEvent::Press(key), KeyEvent::Release(key)] {
+                let status = machine.status();
+                let settings = machine.settings();
+                let mut menu = machine.menu();
+                let _ = menu.handle(event, &status, &settings);
+                machine.set_menu(menu);
+            }
+            let status = machine.status();
+            machine.update_menu(|menu| menu.observe(&status, round as u32));
+        }
+        // LCD task: what a redraw reads.
+        let status = machine.status();
+        let settings = machine.settings();
+        let menu = machine.menu();
+        let live = Live {
+            now_ms: round as u32,
+            speed_mm_per_min: machine.speed_mm_per_min(&settings),
+            work_offset_mm: machine.work_offset_mm(),
+            drawn: None,
+        };
+        core::hint::black_box(screen::view(&menu, &status, &settings, &live));
+        // Inputs and motion task: jobs handed over until the queue is full, then taken.
+        let epoch = machine.plan_epoch();
+        while machine.try_submit(job.clone(), epoch).is_ok() {}
+        while let Some(taken) = machine.next_job() {
+            core::hint::black_box(taken);
+        }
+        // Host link and keypad change a setting; the motion task and the pulse engine read them.
+        let _ = machine.update_settings(|s| s.set(110, 2_000.0 + round as f32));
+        core::hint::black_box(machine.settings());
+        // Reports: the status, and a control requested and taken.
+        core::hint::black_box(machine.status());
+        machine.request(Control::Hold);
+        core::hint::black_box(machine.take_control());
+    }
+}
