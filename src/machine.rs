@@ -4,7 +4,9 @@
 //! receive `&Machine` and talk only through it: the job queue (inputs → motion), the control
 //! slot (inputs → motion), the counters of the step queue (the queue itself, motion → pulses,
 //! is a lock-free single-producer single-consumer ring owned by its two ends), the position
-//! counters (written only by the pulse engine) and a change signal that wakes the LCD.
+//! counters (written only by the pulse engine) and a change signal that wakes the LCD. The
+//! keypad menu is not here: the keypad and LCD tasks share it in thread mode
+//! ([`crate::tasks::panel`]).
 //!
 //! The machine also owns the rule that keeps the inputs' planned positions true: a job is
 //! planned from where the jobs before it end, and an abort drops those. Every job is handed
@@ -24,7 +26,7 @@
 //! Everything here is shared across priorities: every lock is a critical section that only
 //! copies a value in or out, and every counter has a single writer.
 
-mod settings_and_menu;
+mod settings;
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
@@ -45,7 +47,6 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
-use crate::ui::Menu;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -114,7 +115,6 @@ pub struct Machine {
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pulses_done: Signal<CriticalSectionRawMutex, ()>,
-    menu: Mutex<CriticalSectionRawMutex, RefCell<Menu>>,
     /// Pulses emitted (written only by the pulse engine).
     position: [AtomicI32; 2],
     state: AtomicU8,
@@ -190,7 +190,6 @@ impl Machine {
             asleep: AtomicBool::new(false),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
-            menu: Mutex::new(RefCell::new(Menu::new())),
             position: [AtomicI32::new(0), AtomicI32::new(0)],
             state: AtomicU8::new(if locked { STATE_ALARM } else { STATE_IDLE }),
             queued_steps: AtomicU32::new(0),

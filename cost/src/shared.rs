@@ -1,12 +1,17 @@
 //! The shared state's critical sections: what the tasks do to the state they share, each a few
 //! times, so that `count.py --masked` (the `masked` plugin) finds the longest stretch with
 //! interrupts masked among them. Nothing here is timed by marks: the plugin watches every
-//! `cpsid i`…`cpsie i` of the run.
+//! change of PRIMASK in the run.
 //!
 //! The operations are the tasks' own: a key press through the menu and the run screen following
 //! the machine (keypad task), a redraw's reads (LCD task), a job submitted and taken (the inputs
 //! and the motion task), settings read and changed (host link, keypad, motion task and pulse
-//! engine), the status read (reports, LCD) and a control request taken.
+//! engine), the status read (reports, LCD) and a control request taken. Where a task would
+//! wait, the harness polls the future once, so that the operation that ends the wait finds a
+//! waker to wake (one that does nothing: the executor's own work in a wake is not in it).
+
+use core::pin::pin;
+use core::task::{Context, Poll};
 
 use servoplot::geom::Point;
 use servoplot::interp::Shape;
@@ -14,6 +19,7 @@ use servoplot::job::{Control, Feed, Job};
 use servoplot::keypad::{Key, KeyEvent};
 use servoplot::machine::Machine;
 use servoplot::settings::Settings;
+use servoplot::tasks::panel::Panel;
 use servoplot::ui::screen::{self, Live};
 
 /// Times each operation runs: enough to reach every branch the state can take (an empty and a
@@ -27,6 +33,7 @@ const KEYS: [Key; 6] = [Key::Digit(8), Key::Digit(2), Key::Hash, Key::Digit(5), 
 pub fn run() {
     let settings = Settings::default();
     let machine = Machine::new(settings);
+    let panel = Panel::new();
     let job =
         match servoplot::drawing::from_shape(Shape::Straight { to: Point::new(400, 300) }, Point::ORIGIN, &settings) {
             Ok(drawing) => Job::draw(drawing, Feed::MmPerMin(1_000.0)),
@@ -38,31 +45,38 @@ pub fn run() {
             for event in [KeyEvent::Press(key), KeyEvent::Release(key)] {
                 let status = machine.status();
                 let settings = machine.settings();
-                let mut menu = machine.menu();
-                let _ = menu.handle(event, &status, &settings);
-                machine.set_menu(menu);
+                core::hint::black_box(panel.update(|menu| menu.handle(event, &status, &settings)));
             }
             let status = machine.status();
-            machine.update_menu(|menu| menu.observe(&status, round as u32));
+            panel.update_if(|menu| menu.observe(&status, round as u32));
         }
         // LCD task: what a redraw reads.
         let status = machine.status();
         let settings = machine.settings();
-        let menu = machine.menu();
         let live = Live {
             now_ms: round as u32,
             speed_mm_per_min: machine.speed_mm_per_min(&settings),
             work_offset_mm: machine.work_offset_mm(),
             drawn: None,
         };
-        core::hint::black_box(screen::view(&menu, &status, &settings, &live));
-        // Inputs and motion task: jobs handed over until the queue is full, then taken.
+        core::hint::black_box(panel.read(|menu| screen::view(menu, &status, &settings, &live)));
+        // Inputs and motion task: jobs handed over until the queue is full, one more waiting for
+        // room, then all taken; the motion task waits for the first.
         let epoch = machine.plan_epoch();
+        waits(machine.job_ready());
         while machine.try_submit(job.clone(), epoch).is_ok() {}
+        let mut waiting = pin!(machine.submit(job.clone(), epoch));
+        let mut queued = poll(waiting.as_mut()).is_ready();
         while let Some(taken) = machine.next_job() {
             core::hint::black_box(taken);
+            if !queued {
+                queued = poll(waiting.as_mut()).is_ready();
+            }
         }
-        // Host link and keypad change a setting; the motion task and the pulse engine read them.
+        // Host link and keypad change a setting, the LCD and the serial task waiting for it; the
+        // motion task and the pulse engine read them.
+        waits(machine.changed());
+        waits(machine.settings_changed());
         let _ = machine.update_settings(|s| s.set(110, 2_000.0 + round as f32));
         core::hint::black_box(machine.settings());
         // Reports: the status, and a control requested and taken.
@@ -70,4 +84,13 @@ pub fn run() {
         machine.request(Control::Hold);
         core::hint::black_box(machine.take_control());
     }
+}
+
+/// Polls `f` once with a waker that does nothing, leaving that waker wherever `f` waits.
+fn waits(f: impl Future) {
+    let _ = poll(pin!(f));
+}
+
+fn poll<F: Future>(f: core::pin::Pin<&mut F>) -> Poll<F::Output> {
+    f.poll(&mut Context::from_waker(core::task::Waker::noop()))
 }

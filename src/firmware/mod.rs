@@ -26,6 +26,7 @@ use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::settings::Settings;
 use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
 use servoplot::tasks;
+use servoplot::tasks::panel::Panel;
 use static_cell::{ConstStaticCell, StaticCell};
 
 use crate::board::{self, Board};
@@ -39,6 +40,8 @@ static MACHINE: StaticCell<Machine> = StaticCell::new();
 static STEP_QUEUE: ConstStaticCell<StepQueue> = ConstStaticCell::new(StepQueue::new());
 static PLANNER: StaticCell<Planner<Curve, PLANNER_SEGMENTS>> = StaticCell::new();
 static STORE: StaticCell<Store<board::Flash>> = StaticCell::new();
+/// The keypad menu, shared by the keypad and LCD tasks (both in thread mode).
+static PANEL: StaticCell<Panel> = StaticCell::new();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -70,11 +73,12 @@ fn start(spawner: Spawner) {
     let motion_spawner: SendSpawner = board::start_motion_executor();
     motion_spawner.spawn(timed(motion(machine, planner, steps), "motion"));
 
-    spawner.spawn(timed(keypad(machine, board.columns, board.rows), "keypad"));
+    let panel: &'static Panel = PANEL.init_with(Panel::new);
+    spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad"));
     spawner.spawn(timed(servo(machine, board.son, board.pen, board.lights, board.watchdog), "servo"));
     spawner.spawn(timed(homing(machine), "homing"));
     spawner.spawn(timed(serial(machine, store, loaded, board.host, board.second_link), "serial"));
-    spawner.spawn(timed(lcd(machine, board.lcd), "lcd"));
+    spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd"));
     spawner.spawn(timed(health(), "health"));
 }
 
@@ -118,8 +122,13 @@ async fn motion(
 }
 
 #[embassy_executor::task]
-async fn keypad(machine: &'static Machine, columns: [board::Column; 4], rows: [board::Row; 4]) -> ! {
-    tasks::keypad::run(machine, columns, rows).await
+async fn keypad(
+    machine: &'static Machine,
+    panel: &'static Panel,
+    columns: [board::Column; 4],
+    rows: [board::Row; 4],
+) -> ! {
+    tasks::keypad::run(machine, panel, columns, rows).await
 }
 
 #[embassy_executor::task]
@@ -150,8 +159,8 @@ async fn homing(machine: &'static Machine) -> ! {
 }
 
 #[embassy_executor::task]
-async fn lcd(machine: &'static Machine, lcd: board::Lcd) -> ! {
-    tasks::lcd::run(machine, lcd).await
+async fn lcd(machine: &'static Machine, panel: &'static Panel, lcd: board::Lcd) -> ! {
+    tasks::lcd::run(machine, panel, lcd).await
 }
 
 /// Measures the stack's peak and the longest task poll every [`HEALTH_PERIOD_MS`], publishes

@@ -38,7 +38,7 @@ use crate::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
-use crate::tasks::{self, lcd::St7920Lcd};
+use crate::tasks::{self, lcd::St7920Lcd, panel::Panel};
 use cpu::{CpuModel, SimCpu};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
@@ -186,6 +186,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let flash = config.flash.clone();
     let (mut store, loaded) = Store::open(config.flash, STORE_RANGE);
     let machine = Machine::new(store.kept().settings);
+    let panel = Panel::new();
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
     // On the heap: the host's stack need not hold its 50 KB.
@@ -218,7 +219,7 @@ pub fn run(config: SimConfig) -> SimReport {
         join5(
             step_timer::run(&machine, &mut engine, &kicks),
             tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
-            tasks::keypad::run(&machine, columns, rows),
+            tasks::keypad::run(&machine, &panel, columns, rows),
             tasks::serial::run(
                 &machine,
                 &mut store,
@@ -226,7 +227,7 @@ pub fn run(config: SimConfig) -> SimReport {
                 (serial.clone(), serial.clone()),
                 (usb.clone(), usb.clone()),
             ),
-            tasks::lcd::run(&machine, lcd),
+            tasks::lcd::run(&machine, &panel, lcd),
         ),
         join(
             tasks::servo::run(

@@ -1,5 +1,6 @@
 //! The keypad task: scans the 4x4 matrix every `KEYPAD_SCAN_PERIOD_MS`, decodes key events and
-//! hands them to the menu, then carries out what the menu asks for.
+//! hands them to the menu (changed in place, in the [`Panel`] it shares with the LCD task), then
+//! carries out what the menu asks for.
 
 use embassy_time::{Duration, Ticker, Timer};
 use embedded_hal::digital::{InputPin, OutputPin};
@@ -8,6 +9,7 @@ use crate::job::{Control, Job};
 use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
 use crate::machine::Machine;
 use crate::pen::{Pen, PenLift};
+use crate::tasks::panel::Panel;
 use crate::ui::MenuAction;
 use crate::ui::menu::UiError;
 
@@ -18,7 +20,12 @@ pub const KEYPAD_SETTLE_US: u64 = 10;
 /// (`set_high`) after, never driven high, so keys pressed together never join two driven
 /// outputs; rows are inputs with pull-ups, read low where a pressed key joins them to the driven
 /// column.
-pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 4], mut rows: [R; 4]) -> ! {
+pub async fn run<C: OutputPin, R: InputPin>(
+    machine: &Machine,
+    panel: &Panel,
+    mut columns: [C; 4],
+    mut rows: [R; 4],
+) -> ! {
     let mut decoder = KeypadDecoder::new();
     let mut ticker = Ticker::every(Duration::from_millis(KEYPAD_SCAN_PERIOD_MS as u64));
     loop {
@@ -28,14 +35,12 @@ pub async fn run<C: OutputPin, R: InputPin>(machine: &Machine, mut columns: [C; 
         for event in decoder.update(raw, now_ms) {
             let status = machine.status();
             let settings = machine.settings();
-            let mut menu = machine.menu();
-            let action = menu.handle(event, &status, &settings);
-            machine.set_menu(menu);
-            act(machine, action);
+            let action = panel.update(|menu| menu.handle(event, &status, &settings));
+            act(machine, panel, action);
         }
         // The run screen follows the machine between keys.
         let status = machine.status();
-        machine.update_menu(|menu| menu.observe(&status, now_ms));
+        panel.update_if(|menu| menu.observe(&status, now_ms));
     }
 }
 
@@ -56,7 +61,7 @@ async fn scan<C: OutputPin, R: InputPin>(columns: &mut [C; 4], rows: &mut [R; 4]
 }
 
 /// Carries out a menu action: queue a job, or pass a control to the motion task.
-fn act(machine: &Machine, action: MenuAction) {
+fn act(machine: &Machine, panel: &Panel, action: MenuAction) {
     match action {
         MenuAction::None => {}
         MenuAction::Start(mut job) => {
@@ -65,12 +70,12 @@ fn act(machine: &Machine, action: MenuAction) {
                 job.pen = Some(Pen::Down);
                 job.raise_after = true;
             }
-            queue(machine, job)
+            queue(machine, panel, job)
         }
         MenuAction::JogStart(direction) => {
             // At the edge already, a jog outwards goes nowhere.
             if let Some(job) = Job::jog(direction, machine.status().position, &machine.settings()) {
-                queue(machine, job);
+                queue(machine, panel, job);
             }
         }
         MenuAction::JogStop => machine.request(Control::Abort),
@@ -78,32 +83,30 @@ fn act(machine: &Machine, action: MenuAction) {
         MenuAction::Home => {
             machine.request_homing();
         }
-        MenuAction::SetSetting { id, value } => change_settings(machine, &[(id, value)]),
-        MenuAction::Preset(preset) => change_settings(machine, &preset.changes()),
+        MenuAction::SetSetting { id, value } => change_settings(machine, panel, &[(id, value)]),
+        MenuAction::Preset(preset) => change_settings(machine, panel, &preset.changes()),
     }
 }
 
 /// Changes settings as one: all of `changes`, or, if they would leave the settings disagreeing,
 /// none, and the menu says so. The serial task keeps them in flash.
-fn change_settings(machine: &Machine, changes: &[(u16, f32)]) {
+fn change_settings(machine: &Machine, panel: &Panel, changes: &[(u16, f32)]) {
     if machine.update_settings(|s| s.set_all(changes)).is_err() {
-        refuse(machine, UiError::Clash);
+        refuse(panel, UiError::Clash);
     }
 }
 
-fn queue(machine: &Machine, job: Job) {
+fn queue(machine: &Machine, panel: &Panel, job: Job) {
     // Planned from the pen as it stands now: the current epoch.
     if machine.try_submit(job, machine.plan_epoch()).is_err() {
         // The menu starts jobs only while the machine is idle, so this is a full queue from the
         // host link: the keypad job is refused, visibly, rather than waiting unseen.
-        refuse(machine, UiError::Busy);
+        refuse(panel, UiError::Busy);
         warn!("keypad job refused: job queue full");
     }
 }
 
 /// Shows on the menu why what was just confirmed did not happen.
-fn refuse(machine: &Machine, why: UiError) {
-    let mut menu = machine.menu();
-    menu.refuse(why);
-    machine.set_menu(menu);
+fn refuse(panel: &Panel, why: UiError) {
+    panel.update(|menu| menu.refuse(why));
 }

@@ -3,14 +3,16 @@
 //!
 //! Every frame is drawn whole from the menu and machine state (no stale digits), into the
 //! driver's picture, and sent to the controller a slice at a time with a yield between slices
-//! (the ST7920's paced writes take ~43 ms a picture: [`St7920Lcd`]).
+//! (the ST7920's paced writes take ~43 ms a picture: [`St7920Lcd`]). The menu is read in place,
+//! in the [`Panel`] the keypad task changes: only while a frame is worked out and drawn into the
+//! picture, never while the task waits or sends.
 //! While a run is under way the task reads the pen's position every `PREVIEW_SAMPLE_MS` into
 //! the run's [`Trail`]: the path of the steps emitted, read from the position the pulse engine
 //! counts, which costs the motion and the pulses nothing.
 
 pub mod st7920;
 
-use embassy_futures::select::select;
+use embassy_futures::select::select3;
 use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 use embedded_graphics::draw_target::DrawTarget;
@@ -18,6 +20,7 @@ use embedded_graphics::pixelcolor::BinaryColor;
 
 use crate::machine::Machine;
 use crate::pen::PenLift;
+use crate::tasks::panel::Panel;
 use crate::ui::run::RunPath;
 use crate::ui::screen::{self, Live};
 
@@ -42,7 +45,7 @@ pub trait Lcd: DrawTarget<Color = BinaryColor> {
 }
 
 /// Draws the screen forever.
-pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
+pub async fn run<L: Lcd>(machine: &Machine, panel: &Panel, mut lcd: L) -> ! {
     while let Some(wait_us) = lcd.start() {
         Timer::after(Duration::from_micros(u64::from(wait_us))).await;
     }
@@ -53,29 +56,36 @@ pub async fn run<L: Lcd>(machine: &Machine, mut lcd: L) -> ! {
         let now_ms = super::now_ms();
         let status = machine.status();
         let settings = machine.settings();
-        let menu = machine.menu();
-        let running = drawn.follow(menu.run(), status.position, PenLift::of(&settings).draws(machine.pen()));
-        let live = Live {
-            now_ms,
-            speed_mm_per_min: machine.speed_mm_per_min(&settings),
-            work_offset_mm: machine.work_offset_mm(),
-            drawn: Some(&drawn.path),
-        };
-        let view = screen::view(&menu, &status, &settings, &live);
         let since_frame_ms = now_ms.wrapping_sub(last_frame_ms);
-        let mut wait_ms = if running { PREVIEW_SAMPLE_MS } else { LCD_POLL_MS };
-        if shown.as_ref() != Some(&view) {
-            if u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none() {
+        let frame_due = u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none();
+        // The frame is worked out, and drawn into the picture if it is new and due, in one borrow.
+        let (running, new_frame) = panel.read(|menu| {
+            let running = drawn.follow(menu.run(), status.position, PenLift::of(&settings).draws(machine.pen()));
+            let live = Live {
+                now_ms,
+                speed_mm_per_min: machine.speed_mm_per_min(&settings),
+                work_offset_mm: machine.work_offset_mm(),
+                drawn: Some(&drawn.path),
+            };
+            let view = screen::view(menu, &status, &settings, &live);
+            let new_frame = shown.as_ref() != Some(&view);
+            if new_frame && frame_due {
                 let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn.path), &mut lcd);
-                show(&mut lcd).await;
                 shown = Some(view);
+            }
+            (running, new_frame)
+        });
+        let mut wait_ms = if running { PREVIEW_SAMPLE_MS } else { LCD_POLL_MS };
+        if new_frame {
+            if frame_due {
+                show(&mut lcd).await;
                 last_frame_ms = now_ms;
             } else {
                 // Shown once the frame time has passed.
                 wait_ms = wait_ms.min(LCD_FRAME_MIN_MS - u64::from(since_frame_ms));
             }
         }
-        select(machine.changed(), Timer::after(Duration::from_millis(wait_ms))).await;
+        select3(machine.changed(), panel.changed(), Timer::after(Duration::from_millis(wait_ms))).await;
     }
 }
 

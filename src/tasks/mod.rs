@@ -6,6 +6,7 @@ pub mod homing;
 pub mod keypad;
 pub mod lcd;
 pub mod motion;
+pub mod panel;
 pub mod serial;
 pub mod servo;
 
