@@ -1,11 +1,11 @@
 //! The state the tasks share: queues between them, the position counters and the settings.
 //!
 //! One `Machine` exists per plotter (a `static` on target, a local in the simulator). Tasks
-//! receive `&Machine` and talk only through it: the job queue (inputs → motion), the control
-//! slot (inputs → motion), the counters of the step queue (the queue itself, motion → pulses,
-//! is a lock-free single-producer single-consumer ring owned by its two ends), the position
-//! counters (written only by the pulse engine) and a change signal that wakes the LCD. The
-//! keypad menu is not here: the keypad and LCD tasks share it in thread mode
+//! receive `&Machine` and talk only through it: the job queue (inputs → motion, [`jobs`]), the
+//! control slot (inputs → motion), the counters of the step queue (the queue itself, motion →
+//! pulses, is a lock-free single-producer single-consumer ring owned by its two ends), the
+//! position counters (written only by the pulse engine) and a change signal that wakes the LCD.
+//! The keypad menu is not here: the keypad and LCD tasks share it in thread mode
 //! ([`crate::tasks::panel`]).
 //!
 //! The machine also owns the rule that keeps the inputs' planned positions true: a job is
@@ -26,15 +26,15 @@
 //! Everything here is shared across priorities: every lock is a critical section that only
 //! copies a value in or out, and every counter has a single writer.
 
+mod job_queue;
+mod jobs;
 mod settings;
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
 
-use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
-use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
@@ -47,6 +47,7 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
+use job_queue::JobQueue;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -57,6 +58,10 @@ pub const JOB_QUEUE_LEN: usize = 4;
 pub const STEP_QUEUE_MAX_US: u32 = 20_000;
 /// The same in pulse timer ticks.
 pub const STEP_QUEUE_MAX_TICKS: u32 = STEP_QUEUE_MAX_US * (TICK_HZ / 1_000_000);
+
+/// The tasks that may wait at once to hand over a job: the host link and the homing task (the
+/// keypad's is refused when the queue is full). More are woken to look again, not lost.
+pub const JOB_SUBMITTERS: usize = 2;
 
 /// The aborts counted when a position was planned: positions planned in an earlier epoch lead
 /// from points the pen never reached.
@@ -89,7 +94,7 @@ const STATE_ALARM: u8 = 4;
 /// Everything the tasks share.
 pub struct Machine {
     /// Jobs handed over, each with the epoch it was planned in.
-    jobs: Channel<CriticalSectionRawMutex, (PlanEpoch, Job), JOB_QUEUE_LEN>,
+    jobs: JobQueue<(PlanEpoch, Job), JOB_QUEUE_LEN, JOB_SUBMITTERS>,
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
     /// Wakes the motion task when a control is requested or an override changes.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
@@ -101,8 +106,6 @@ pub struct Machine {
     faults: Signal<CriticalSectionRawMutex, MotionFault>,
     /// Counts aborts (a control, a curve stopped part way): the current [`PlanEpoch`].
     aborts: AtomicU32,
-    /// Wakes whoever waits to hand over a job when an abort happens.
-    aborted: Signal<CriticalSectionRawMutex, ()>,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
     /// The host link is in check mode (`$C`): reported as [`RunState::Check`] while idle.
@@ -176,14 +179,13 @@ impl Machine {
     pub fn new(settings: Settings) -> Self {
         let locked = settings.homing;
         Machine {
-            jobs: Channel::new(),
+            jobs: JobQueue::new(),
             control: Mutex::new(Cell::new(None)),
             control_requested: Signal::new(),
             overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
             pulses_done: Signal::new(),
             aborts: AtomicU32::new(0),
-            aborted: Signal::new(),
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
             door: AtomicBool::new(false),
@@ -676,70 +678,6 @@ impl Machine {
     /// The fault that ended the last job early, if any.
     pub fn fault(&self) -> Option<MotionFault> {
         self.fault.lock(|f| f.get())
-    }
-
-    /// The epoch positions are planned in now: until the next abort, a job planned from the
-    /// end of the jobs before it starts where the pen will be.
-    pub fn plan_epoch(&self) -> PlanEpoch {
-        PlanEpoch(self.aborts.load(Ordering::Acquire))
-    }
-
-    /// Hands `job`, planned in `epoch`, to the motion task, waiting for room. An abort before
-    /// or while it waits refuses it: it was planned from a point the pen will not reach.
-    pub async fn submit(&self, job: Job, epoch: PlanEpoch) -> Result<(), Stale> {
-        let mut send = core::pin::pin!(self.jobs.send((epoch, job)));
-        loop {
-            if self.plan_epoch() != epoch {
-                return Err(Stale);
-            }
-            match select(send.as_mut(), self.aborted.wait()).await {
-                Either::First(()) => break,
-                Either::Second(()) => continue,
-            }
-        }
-        // Queued just as an abort came, the motion task drops it.
-        if self.plan_epoch() != epoch { Err(Stale) } else { Ok(()) }
-    }
-
-    /// Hands `job`, planned in `epoch`, to the motion task if there is room now.
-    pub fn try_submit(&self, job: Job, epoch: PlanEpoch) -> Result<(), Refused> {
-        if self.plan_epoch() != epoch {
-            return Err(Refused::Stale);
-        }
-        self.jobs.try_send((epoch, job)).map_err(|_| Refused::Full)
-    }
-
-    /// Jobs handed over and not yet taken by the motion task.
-    pub fn queued_jobs(&self) -> usize {
-        self.jobs.len()
-    }
-
-    /// Waits until a job is queued (it may already be). For the motion task.
-    pub async fn job_ready(&self) {
-        self.jobs.ready_to_receive().await
-    }
-
-    /// The next job queued in the current epoch, dropping those planned before an abort (their
-    /// senders were refused, or the abort's message covers them). Only the motion task calls
-    /// this.
-    pub fn next_job(&self) -> Option<Job> {
-        loop {
-            let (epoch, job) = self.jobs.try_receive().ok()?;
-            if epoch == self.plan_epoch() {
-                // Taken, it is planned before anything else may look: nothing has stopped.
-                self.plan_empty.store(false, Ordering::Release);
-                return Some(job);
-            }
-            warn!("job planned before an abort dropped");
-        }
-    }
-
-    /// An abort: drops every queued job and starts a new epoch, so that jobs planned before it
-    /// are refused. Only the motion task calls this, once its planner has dropped its plan.
-    pub fn abort_plan(&self) {
-        while self.jobs.try_receive().is_ok() {}
-        self.aborts.fetch_add(1, Ordering::AcqRel);
-        self.aborted.signal(());
     }
 
     /// Whether the planner holds anything. Only the motion task calls this.
