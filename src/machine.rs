@@ -4,9 +4,9 @@
 //! receive `&Machine` and talk only through it: the job queue (inputs → motion, [`jobs`]), the
 //! control slot (inputs → motion), the counters of the step queue (the queue itself, motion →
 //! pulses, is a lock-free single-producer single-consumer ring owned by its two ends), the
-//! position counters (written only by the pulse engine) and a change signal that wakes the LCD.
-//! The keypad menu is not here: the keypad and LCD tasks share it in thread mode
-//! ([`crate::tasks::panel`]).
+//! position counters (written only by the pulse engine), the settings ([`settings`]) and a
+//! change signal that wakes the LCD. The keypad menu is not here: the keypad and LCD tasks share
+//! it in thread mode ([`crate::tasks::panel`]).
 //!
 //! The machine also owns the rule that keeps the inputs' planned positions true: a job is
 //! planned from where the jobs before it end, and an abort drops those. Every job is handed
@@ -28,9 +28,10 @@
 
 mod job_queue;
 mod jobs;
+mod published;
 mod settings;
 
-use core::cell::{Cell, RefCell};
+use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::Mutex;
@@ -48,6 +49,7 @@ use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
 use job_queue::JobQueue;
+use published::Published;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -139,7 +141,7 @@ pub struct Machine {
     underruns: AtomicU32,
     /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
     drawing: AtomicU8,
-    settings: Mutex<CriticalSectionRawMutex, RefCell<Settings>>,
+    settings: Published<Settings>,
     /// Wakes the serial task, which keeps the settings in flash, after they changed.
     settings_changed: Signal<CriticalSectionRawMutex, ()>,
     fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
@@ -203,7 +205,7 @@ impl Machine {
             work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
             underruns: AtomicU32::new(0),
             drawing: AtomicU8::new(0),
-            settings: Mutex::new(RefCell::new(settings)),
+            settings: Published::new(settings),
             settings_changed: Signal::new(),
             fault: Mutex::new(Cell::new(None)),
             halted: AtomicBool::new(false),

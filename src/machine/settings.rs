@@ -1,5 +1,6 @@
-//! The settings as the tasks share them: read as a copy and changed in one place, which wakes
-//! whoever shows or keeps them.
+//! The settings as the tasks share them: written in thread mode (the host link, the keypad),
+//! read from every priority (the motion task and the pulse engine too), each read a copy taken
+//! without masking interrupts ([`Published`](super::published::Published)).
 
 use super::Machine;
 use crate::settings::Settings;
@@ -8,13 +9,14 @@ impl Machine {
     /// A copy of the current settings. Out of line: a dozen places read them, none per step.
     #[inline(never)]
     pub fn settings(&self) -> Settings {
-        self.settings.lock(|s| *s.borrow())
+        self.settings.get()
     }
 
     /// Changes the settings through `f`; the planner picks them up for the next job, the LCD
-    /// shows them, and the serial task keeps them in flash.
+    /// shows them, and the serial task keeps them in flash. Only thread-mode tasks call this
+    /// (see [`Published`](super::published::Published)).
     pub fn update_settings<R>(&self, f: impl FnOnce(&mut Settings) -> R) -> R {
-        let r = self.settings.lock(|s| f(&mut s.borrow_mut()));
+        let r = self.settings.update(f);
         self.changed.signal(());
         self.settings_changed.signal(());
         r
