@@ -23,8 +23,19 @@
 //! The overrides (GRBL's feed, rapid and spindle percentages) are one shared word: the host link
 //! sets them, the motion task hands them to its planner, reports and the LCD show them.
 //!
-//! Everything here is shared across priorities: every lock is a critical section that only
-//! copies a value in or out, and every counter has a single writer.
+//! Everything here is shared across priorities, up to the pulse interrupt, which every critical
+//! section holds off. Every counter is an atomic with a single writer; the jobs (648 bytes) and
+//! the settings (116) are handed over without a lock ([`job_queue`], [`published`]). The
+//! critical sections left each copy at most [`LOCKED_VALUE_MAX_BYTES`] in or out (checked
+//! below, at compile time) and wake at most the tasks that wait there:
+//! - `control`: the control requested and not yet taken (1 byte);
+//! - `work_offset_mm`: the work offset, two `f32`;
+//! - `fault`: an `Option<MotionFault>`; `trip` and `switch_found`: an `Option<Trip>`;
+//! - the signals `control_requested`, `changed`, `pulses_done`, `homing_requested`,
+//!   `settings_changed` and `faults`: the waiting task's waker, or what was signalled (`()`, a
+//!   `MotionFault`);
+//! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
+//!   for room (taken out, and woken outside the lock).
 
 mod job_queue;
 mod jobs;
@@ -33,6 +44,7 @@ mod settings;
 
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
+use core::task::Waker;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -64,6 +76,22 @@ pub const STEP_QUEUE_MAX_TICKS: u32 = STEP_QUEUE_MAX_US * (TICK_HZ / 1_000_000);
 /// The tasks that may wait at once to hand over a job: the host link and the homing task (the
 /// keypad's is refused when the queue is full). More are woken to look again, not lost.
 pub const JOB_SUBMITTERS: usize = 2;
+
+/// The most a critical section here copies in or out, bytes: the pulse interrupt waits for it,
+/// and 64 bytes take at most some 40 instructions (a third of a microsecond) on the F407.
+pub const LOCKED_VALUE_MAX_BYTES: usize = 64;
+
+const _: () = {
+    use core::mem::size_of;
+    assert!(size_of::<Option<Control>>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<[f32; 2]>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<Option<MotionFault>>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<Option<Trip>>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<Signal<CriticalSectionRawMutex, MotionFault>>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<Signal<CriticalSectionRawMutex, ()>>() <= LOCKED_VALUE_MAX_BYTES);
+    // The job queue's waiters: a list of wakers each.
+    assert!(size_of::<heapless::Vec<Waker, JOB_SUBMITTERS>>() <= LOCKED_VALUE_MAX_BYTES);
+};
 
 /// The aborts counted when a position was planned: positions planned in an earlier epoch lead
 /// from points the pen never reached.
