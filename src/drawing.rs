@@ -5,8 +5,10 @@
 //!
 //! A drawing holds the built curve, ready for the planner, its start and its exact end on the
 //! step lattice, and the box its lattice path covers. Both come from the curve itself: the
-//! builder walks a copy of the curve once, step by step, before anything moves (a few
-//! milliseconds of the input's time on the board for the largest curves). So:
+//! builder walks a copy of the curve once, step by step, before anything moves (a straight line
+//! excepted, whose path its ends give). The walk of a long curve takes a large share of a second
+//! on the board, so the front ends walk it a slice at a time with [`Builder`], the other tasks
+//! running between slices; [`build`] walks it in one go. So:
 //!
 //! - the next drawing starts where this one really ends, not where millimetre arithmetic says;
 //! - nothing is queued that would leave the travel (`$130`, `$131`): the box is exact;
@@ -30,10 +32,14 @@
 //!
 //! A sine or function shorter than one step along X draws nothing.
 
+mod builder;
+
+pub use builder::{BUILD_SLICE_STEPS, Builder, Slice, build, from_shape};
+
 use crate::expr::Expr;
-use crate::geom::{Axis, Point, Rotation, Step};
+use crate::geom::{Axis, Point, Rotation};
 use crate::interp::sine::{fits_jump_limit, sin_range};
-use crate::interp::{Curve, CurveError, CurveSetupError, Filled, Interpolator, Shape, ShapeKind};
+use crate::interp::{Curve, CurveError, CurveSetupError, Shape, ShapeKind};
 use crate::settings::Settings;
 
 /// Largest radius or semi-axis of an arc or ellipse, mm.
@@ -45,9 +51,6 @@ pub const SINE_MIN_STEPS_PER_WAVE: f32 = 8.0;
 /// How far a lattice path may reach beyond its ideal curve's box, steps: the interpolator's
 /// error (at most one step) plus the rounding of the centre and of the semi-axes.
 pub const LATTICE_SLACK_STEPS: f32 = 2.0;
-
-/// Steps the builder walks at a time when it traces a copy of the curve.
-const TRACE_BATCH_STEPS: usize = 64;
 
 /// An elliptic (or circular) arc, or the whole ellipse; see the module documentation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -157,6 +160,7 @@ impl Extent {
 // No heap: a function carries its expression by value, so it is the largest.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum Request {
     /// A straight line to the lattice point `to` (absolute).
     Straight {
@@ -271,24 +275,32 @@ impl Drawing {
     /// Walks the lattice path again (`settings` as it was built with) and hands `at` its start,
     /// every `every`-th point and its end.
     pub fn sample_path(&self, settings: &Settings, every: u64, at: &mut dyn FnMut(Point)) {
-        let Ok(copy) = Curve::new(&self.shape, self.start, settings) else { return };
         at(self.start);
-        let mut n = 0u64;
+        if let Shape::Straight { to } = self.shape {
+            // Straight: its two ends say it all.
+            return at(to);
+        }
+        let Ok(mut walk) = Builder::of_shape(self.shape.clone(), None, self.start, settings) else { return };
+        let (mut n, mut last) = (0u64, self.start);
         // Counted down to each sample rather than `n % every`: no 64-bit division (see
         // `crate::wide`). An `every` of 0 samples no point between the ends.
         let mut to_sample = every;
-        let walked = walk(copy, self.start, |p| {
-            n += 1;
-            to_sample = to_sample.wrapping_sub(1);
-            if to_sample == 0 {
-                to_sample = every;
-                if n != self.steps {
-                    at(p);
+        while !walk
+            .advance_with(u32::MAX, &mut |p| {
+                n += 1;
+                last = p;
+                to_sample = to_sample.wrapping_sub(1);
+                if to_sample == 0 {
+                    to_sample = every;
+                    if n != self.steps {
+                        at(p);
+                    }
                 }
-            }
-        });
+            })
+            .done
+        {}
         if n > 0 {
-            at(walked.unwrap_or_else(|(p, _)| p));
+            at(last);
         }
     }
 }
@@ -325,53 +337,6 @@ impl PartialEq for Drawing {
     }
 }
 
-/// Builds `request` from the pen at `start`: `Ok(None)` when it is shorter than a step and draws
-/// nothing, an error when it cannot be drawn as asked (nothing moves).
-pub fn build(request: &Request, start: Point, settings: &Settings) -> Result<Option<Drawing>, DrawError> {
-    let Some((shape, ideal)) = shape(request, start, settings)? else { return Ok(None) };
-    if let Some(ideal) = ideal
-        && !ideal_within_travel(&ideal, settings)
-    {
-        return Err(DrawError::Travel);
-    }
-    checked(shape, ideal, start, settings).map(Some)
-}
-
-/// A drawing of a shape already in steps (a benchmark's, say), checked as [`build`] checks a
-/// request's, but for the ideal box, which a shape does not give.
-pub fn from_shape(shape: Shape, start: Point, settings: &Settings) -> Result<Drawing, DrawError> {
-    checked(shape, None, start, settings)
-}
-
-/// Sets the curve up, traces it, and checks its lattice path against the ideal box (where
-/// known) and the travel.
-fn checked(shape: Shape, ideal: Option<IdealBox>, start: Point, settings: &Settings) -> Result<Drawing, DrawError> {
-    let curve = Curve::new(&shape, start, settings)?;
-    // Where a function's x starts, for the x of its errors.
-    let x0_mm = match &shape {
-        Shape::Function { x0_mm, .. } => *x0_mm,
-        _ => 0.0,
-    };
-    // The trace walks a second curve set up the same way: the same steps as the one kept.
-    let (end, bounds, steps) =
-        trace(Curve::new(&shape, start, settings)?, start).map_err(|(at, error)| match error {
-            // The ideal curve is inside the travel, its lattice path is not: it strays from the
-            // curve.
-            CurveError::Travel if ideal.is_some_and(|i| i.within(settings.travel_steps(), 0.0)) => DrawError::TooFine,
-            CurveError::Travel => DrawError::Travel,
-            _ => DrawError::Fails { x_mm: x0_mm + settings.steps_to_mm(Axis::X, at.x - start.x), error },
-        })?;
-    if let Some(ideal) = ideal
-        && !follows(&bounds, &ideal)
-    {
-        return Err(DrawError::TooFine);
-    }
-    if !bounds.within_travel(settings) {
-        return Err(DrawError::Travel);
-    }
-    Ok(Drawing { curve, shape, start, end, bounds, steps })
-}
-
 /// The ideal curve's box in absolute steps (fractional).
 #[derive(Clone, Copy, Debug)]
 struct IdealBox {
@@ -388,9 +353,7 @@ impl IdealBox {
             max: [at[0] + e.max_mm[0] * spm[0], at[1] + e.max_mm[1] * spm[1]],
         }
     }
-}
 
-impl IdealBox {
     /// True when the box lies within ±`limit` steps and `slack`. NaN is outside.
     fn within(&self, limit: [i32; 2], slack: f32) -> bool {
         (0..2).all(|i| {
@@ -398,50 +361,13 @@ impl IdealBox {
             self.min[i] >= -l && self.max[i] <= l
         })
     }
-}
 
-/// An early refusal, before the curve is traced: the ideal box beyond the travel by more than
-/// the lattice's slack.
-fn ideal_within_travel(ideal: &IdealBox, settings: &Settings) -> bool {
-    ideal.within(settings.travel_steps(), LATTICE_SLACK_STEPS)
-}
-
-/// True when the lattice path's box lies within the ideal box and its slack.
-fn follows(bounds: &Bounds, ideal: &IdealBox) -> bool {
-    let (min, max) = ([bounds.min.x, bounds.min.y], [bounds.max.x, bounds.max.y]);
-    (0..2).all(|i| {
-        min[i] as f32 >= ideal.min[i] - LATTICE_SLACK_STEPS && max[i] as f32 <= ideal.max[i] + LATTICE_SLACK_STEPS
-    })
-}
-
-/// Walks `copy`, a curve from `start`, to its end: the end, the box and the number of steps,
-/// or where it fails and why.
-fn trace(copy: Curve, start: Point) -> Result<(Point, Bounds, u64), (Point, CurveError)> {
-    let mut bounds = Bounds::at(start);
-    let mut steps = 0u64;
-    let end = walk(copy, start, |p| {
-        bounds.add(p);
-        steps += 1;
-    })?;
-    Ok((end, bounds, steps))
-}
-
-/// Walks `copy`, a curve from `start`, handing `at` every lattice point after the start: where
-/// it ends, or where it fails and why.
-fn walk(mut copy: Curve, start: Point, mut at: impl FnMut(Point)) -> Result<Point, (Point, CurveError)> {
-    let mut p = start;
-    let mut buf = [Step::new(0, 0); TRACE_BATCH_STEPS];
-    loop {
-        let Filled { steps, end, .. } = copy.fill(&mut buf);
-        for step in &buf[..steps] {
-            p = p.stepped(*step);
-            at(p);
-        }
-        match end {
-            None => {}
-            Some(Ok(())) => return Ok(p),
-            Some(Err(e)) => return Err((p, e)),
-        }
+    /// True when the lattice path's box `bounds` lies within this box and its slack.
+    fn follows(&self, bounds: &Bounds) -> bool {
+        let (min, max) = ([bounds.min.x, bounds.min.y], [bounds.max.x, bounds.max.y]);
+        (0..2).all(|i| {
+            min[i] as f32 >= self.min[i] - LATTICE_SLACK_STEPS && max[i] as f32 <= self.max[i] + LATTICE_SLACK_STEPS
+        })
     }
 }
 
@@ -519,7 +445,7 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
             let dx = settings.mm_to_steps(Axis::X, x1_mm - x0_mm);
             let x = [start.x as f32, (start.x + dx) as f32];
             let ideal_x = IdealBox { min: [x[0].min(x[1]), start.y as f32], max: [x[0].max(x[1]), start.y as f32] };
-            if !ideal_within_travel(&ideal_x, settings) {
+            if !ideal_x.within(settings.travel_steps(), LATTICE_SLACK_STEPS) {
                 return Err(DrawError::Travel);
             }
             Some((Shape::Function { expr: expr.clone(), x0_mm: *x0_mm, x1_mm: *x1_mm }, None))

@@ -4,6 +4,8 @@
 extern crate std;
 
 use super::*;
+use crate::geom::Step;
+use crate::interp::{Interpolator, Method};
 use proptest::prelude::*;
 
 fn settings() -> Settings {
@@ -185,4 +187,95 @@ proptest! {
             prop_assert_eq!(*points.last().unwrap(), d.end());
         }
     }
+}
+
+/// Builds `request` from `start` in slices of `slice` steps' worth, handing each slice to `each`
+/// with the lattice points it walked.
+fn sliced(
+    request: &Request,
+    start: Point,
+    slice: u32,
+    mut each: impl FnMut(&Slice, &[Point]),
+) -> Result<Option<Drawing>, DrawError> {
+    let Some(mut builder) = Builder::new(request, start, &settings())? else { return Ok(None) };
+    loop {
+        let mut points = std::vec![];
+        let s = builder.advance_with(slice, &mut |p| points.push(p));
+        each(&s, &points);
+        if s.done {
+            return builder.finish().map(Some);
+        }
+    }
+}
+
+#[test]
+fn slices_build_what_one_go_builds() {
+    let start = Point::new(-1234, 567);
+    for request in [
+        ellipse(20.0, 20.0, 30.0, 250.0),
+        ellipse(30.0, 15.0, 0.0, 360.0),
+        sine(10.0, 0.3, 60.0),
+        function("20*exp(-x^2/200)", -30.0, 30.0),
+        function("sqrt(1-x)", 0.0, 2.0),
+        ellipse(150.0, 0.009, 0.0, -30.0),
+    ] {
+        let whole = build(&request, start, &settings());
+        for slice in [1, 7, 64, 2048] {
+            let mut path = std::vec![start];
+            let built = sliced(&request, start, slice, |_, points| path.extend_from_slice(points));
+            assert_eq!(built, whole, "{request:?} in slices of {slice}");
+            if let Ok(Some(d)) = &built {
+                assert_eq!((path.len() as u64 - 1, *path.last().unwrap()), (d.steps(), d.end()));
+                assert_eq!(&path, &walk(d), "{request:?}: every lattice point, in order");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_slice_does_about_as_much_work_whatever_it_walks() {
+    // A step is worth one; an X step of a function one more per operation of its expression
+    // (8 here), of a sine four more: a slice of 2,048 steps' worth walks many steps of a steep
+    // curve and few of a flat one.
+    let cases = [
+        (function("20*exp(-x^2/200)", -30.0, 30.0), 8),
+        (function("sin(x/2)*100", -30.0, 30.0), 6),
+        (sine(10.0, 0.3, 60.0), 4),
+        (ellipse(30.0, 15.0, 0.0, 360.0), 0),
+    ];
+    for (request, evaluation) in cases {
+        let mut slices = 0;
+        sliced(&request, Point::ORIGIN, BUILD_SLICE_STEPS, |s, _| {
+            slices += 1;
+            let work = s.steps + s.x_steps * evaluation;
+            // The last batch of a slice may reach one step's worth past it.
+            assert!(work <= BUILD_SLICE_STEPS + 1 + evaluation, "{request:?}: {s:?}");
+            assert!(s.done || work >= BUILD_SLICE_STEPS, "{request:?}: a slice cut short: {s:?}");
+            assert!(s.x_steps <= s.steps);
+        })
+        .unwrap()
+        .unwrap();
+        assert!(slices > 2, "{request:?}");
+    }
+}
+
+#[test]
+fn a_line_is_checked_from_its_ends_without_a_walk() {
+    let s = settings();
+    for (to, method, steps) in
+        [(Point::new(300, -400), Method::Classic, 700), (Point::new(300, -400), Method::Diagonal, 400)]
+    {
+        let s = Settings { method, ..s };
+        let mut builder = Builder::new(&Request::Straight { to }, Point::ORIGIN, &s).unwrap().unwrap();
+        let slice = builder.advance(1);
+        assert!(slice.done && slice.steps == 0, "{slice:?}");
+        let d = builder.finish().unwrap();
+        assert_eq!((d.steps(), d.end()), (steps, to));
+        assert_eq!(d.steps(), walk(&d).len() as u64 - 1, "as many steps as its curve takes");
+        assert_eq!(d.bounds(), Bounds { min: Point::new(0, -400), max: Point::new(300, 0) });
+        // Spent: finishing it again is refused.
+        assert!(builder.finish().is_err());
+    }
+    let beyond = Builder::new(&Request::Straight { to: Point::new(0, 20_001) }, Point::ORIGIN, &s);
+    assert_eq!(beyond.unwrap().unwrap().finish().err(), Some(DrawError::Travel));
 }
