@@ -139,7 +139,7 @@ async fn serial(
     host: (board::HostRx, board::HostTx),
     second_link: (board::LinkRx, board::LinkTx),
 ) -> ! {
-    tasks::serial::run(machine, store, loaded, host, second_link).await
+    tasks::serial::run(machine, store, loaded, host, second_link, tasks::slices::Yield).await
 }
 
 #[embassy_executor::task]

@@ -121,8 +121,9 @@ pub use modal::{
 pub use offsets::{KEPT_OFFSETS, Offsets, StoredPosition};
 
 use super::GrblError;
-use crate::drawing::{self, Request};
+use crate::drawing::{self, Builder, Request, Slice};
 use crate::geom::{Axis, Point};
+use crate::interp::ShapeKind;
 use crate::job::{Feed, Job, JobKind};
 use crate::pen::{self, Pen};
 use crate::protocol::startup::StartupLine;
@@ -145,6 +146,74 @@ pub struct Commands {
     via: Option<Command>,
     main: Option<Command>,
     stop: Option<ProgramStop>,
+    /// While the line is parsed: the curve that becomes `main` once it is built.
+    curve: Option<LineCurve>,
+}
+
+/// The curve of a line (G2/G3, `$E`, `$O`, `$S`, `$F`) as parsed, to be built from the planned
+/// position, and the job it becomes.
+#[derive(Clone, Debug, PartialEq)]
+struct LineCurve {
+    request: Request,
+    feed: Feed,
+    pen: Option<Pen>,
+    /// The G-code target (G2/G3), in millimetres: the planned position afterwards when the
+    /// curve ends on the step it rounds to.
+    target_mm: Option<[f32; 2]>,
+}
+
+/// A line parsed and checked, its curve (if it has one) not yet built: see
+/// [`GcodeState::parse`]. It holds the parser state the line leads to, kept only by
+/// [`GcodeState::commit`]. It is large (a curve and two jobs): the serial task keeps one and
+/// parses every line into it.
+pub struct Pending {
+    /// The parser state once the line has run, but for the planned position after its curve.
+    next: GcodeState,
+    commands: Commands,
+    /// The line's curve, being built.
+    curve: Option<Building>,
+    /// Check mode: the line is built and checked, and nothing of it runs.
+    check: bool,
+}
+
+/// A line's curve being built, and the job it becomes.
+struct Building {
+    builder: Builder,
+    feed: Feed,
+    pen: Option<Pen>,
+    target_mm: Option<[f32; 2]>,
+}
+
+impl Default for Pending {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Pending {
+    /// No line.
+    pub fn new() -> Pending {
+        Pending { next: GcodeState::new(), commands: Commands::default(), curve: None, check: false }
+    }
+
+    /// Drops the line held.
+    fn clear(&mut self) {
+        self.commands = Commands::default();
+        self.curve = None;
+    }
+
+    /// Walks at most `max_steps` more of the line's curve; a line without one is done at once.
+    pub fn advance(&mut self, max_steps: u32) -> Slice {
+        match &mut self.curve {
+            Some(curve) => curve.builder.advance(max_steps),
+            None => Slice { kind: ShapeKind::Straight, expr_ops: 0, steps: 0, x_steps: 0, done: true },
+        }
+    }
+
+    /// True when the line asks nothing of the machine (it only changes modes).
+    pub fn is_empty(&self) -> bool {
+        self.curve.is_none() && self.commands.is_empty()
+    }
 }
 
 impl Commands {
@@ -170,15 +239,6 @@ impl Commands {
         if self.stop == Some(ProgramStop::Pause) {
             self.stop = None;
         }
-    }
-
-    fn one(command: Command) -> Self {
-        Commands::main(Some(command))
-    }
-
-    /// Just `main`, if any.
-    fn main(main: Option<Command>) -> Self {
-        Commands { main, ..Commands::default() }
     }
 }
 
@@ -407,70 +467,158 @@ impl GcodeState {
     }
 
     /// Executes one line (without its line end) against `settings` while the machine is in
-    /// `state`. On success the state has advanced and the commands say what to do; on error
-    /// nothing has changed.
+    /// `state`, building its curve in one go. On success the state has advanced and the
+    /// commands say what to do; on error nothing has changed. The serial task builds a curve a
+    /// slice at a time instead: [`parse`](Self::parse), [`Pending::advance`],
+    /// [`commit`](Self::commit).
     pub fn execute(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+        let mut pending = Pending::new();
+        self.parse(line, settings, state, &mut pending)?;
+        self.commit(&mut pending, settings)?;
+        Ok(core::mem::take(&mut pending.commands))
+    }
+
+    /// Parses and checks one line (without its line end) against `settings` while the machine
+    /// is in `state`, into `pending` (whatever it held before is dropped), and sets its curve
+    /// up; changes nothing. The curve is then walked with [`Pending::advance`], and
+    /// [`commit`](Self::commit) keeps the line.
+    pub fn parse(
+        &self,
+        line: &str,
+        settings: &Settings,
+        state: RunState,
+        pending: &mut Pending,
+    ) -> Result<(), GrblError> {
+        pending.clear();
         if state == RunState::Sleep {
             // Asleep (`$SLP`), the servos are off: every line waits for a reset.
             return Err(GrblError::Locked);
         }
-        // The line runs on a copy, kept only on success: an error line changes nothing.
-        let mut next = *self;
-        let mut commands = next.parse_line(line, settings, state)?;
-        *self = next;
-        if state == RunState::Check {
-            // Check mode: the line was parsed and its drawing built and checked; nothing runs.
-            commands.keep_checked();
+        // The line runs on a copy, kept only by `commit`: an error line changes nothing.
+        pending.next = *self;
+        pending.check = state == RunState::Check;
+        pending.next.parse_line(line, settings, state, &mut pending.commands)?;
+        if let Some(LineCurve { request, feed, pen, target_mm }) = &pending.commands.curve {
+            let next = &mut pending.next;
+            match Builder::new(request, next.position, settings)? {
+                Some(builder) => {
+                    pending.curve = Some(Building { builder, feed: *feed, pen: *pen, target_mm: *target_mm })
+                }
+                // Shorter than a step, it draws nothing: the pen is planned at its G-code
+                // target, if it has one.
+                None => next.position_mm = target_mm.unwrap_or(next.position_mm),
+            }
+            pending.commands.curve = None;
         }
-        Ok(commands)
+        Ok(())
     }
 
-    fn parse_line(&mut self, line: &str, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+    /// Keeps the line `pending` holds from [`parse`](Self::parse) (with the same `settings`),
+    /// once its curve is built (whatever is left of it is walked now, in one go): the state
+    /// advances to the line's, and the commands say what to do. A curve refused as it was
+    /// walked is the line's error, and nothing changes.
+    pub fn commit<'p>(&mut self, pending: &'p mut Pending, settings: &Settings) -> Result<&'p mut Commands, GrblError> {
+        if let Some(Building { builder, feed, pen, target_mm }) = &mut pending.curve {
+            let drawing = builder.finish()?;
+            let (job, target_mm) =
+                (Job { drawing, feed: *feed, kind: JobKind::Draw, pen: *pen, raise_after: false }, *target_mm);
+            pending.next.plan(job, target_mm, settings, &mut pending.commands.main);
+            pending.curve = None;
+        }
+        *self = pending.next;
+        if pending.check {
+            // Check mode: the line was parsed and its drawing built and checked; nothing runs.
+            pending.commands.keep_checked();
+        }
+        Ok(&mut pending.commands)
+    }
+
+    /// Runs a startup block: a line that moves nothing (checked when it is stored, with this
+    /// very rule): one that would move, dwell or stop is refused (error 3), and changes nothing.
+    pub fn run_startup_block(&mut self, line: &str, settings: &Settings) -> Result<(), GrblError> {
+        let mut pending = Pending::new();
+        self.parse(line, settings, RunState::Idle, &mut pending)?;
+        if !pending.is_empty() {
+            return Err(GrblError::InvalidStatement);
+        }
+        self.commit(&mut pending, settings).map(|_| ())
+    }
+
+    fn parse_line(
+        &mut self,
+        line: &str,
+        settings: &Settings,
+        state: RunState,
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let text = line.trim_ascii_start();
         if let Some(rest) = text.strip_prefix('$') {
-            return self.system(line, rest, settings, state);
+            return self.system(line, rest, settings, state, out);
         }
         let compact = compact(text, true)?;
         if compact.is_empty() || compact.as_slice() == b"%" {
-            return Ok(Commands::default());
+            return Ok(());
         }
         if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
             return Err(GrblError::Locked);
         }
-        self.run_block(parse_block(&compact)?, settings)
+        self.run_block(parse_block(&compact)?, settings, out)
     }
 }
 
 impl GcodeState {
-    /// Builds `request` from the planned position and plans the pen at its end: `target_mm`
-    /// (the G-code target, kept in millimetres so relative moves never drift by rounding) when
-    /// the curve ends on the step it rounds to, else the curve's own last lattice point.
-    fn draw(
+    /// A straight move to the lattice point `to` from the planned position into `slot`, built at
+    /// once (a line needs no walk), with the pen planned at its end: `target_mm` (the G-code
+    /// target, kept in millimetres so relative moves never drift by rounding; `to` is the step
+    /// it rounds to). Nothing when it ends on the step it starts from.
+    fn straight(
         &mut self,
-        request: Request,
+        to: Point,
+        target_mm: [f32; 2],
         feed: Feed,
         kind: JobKind,
+        settings: &Settings,
+        slot: &mut Option<Command>,
+    ) -> Result<(), GrblError> {
+        let built = drawing::build(&Request::Straight { to }, self.position, settings)?;
+        self.position_mm = target_mm;
+        if let Some(drawing) = built {
+            let pen = match kind {
+                JobKind::Draw => pen::for_move(settings, feed == Feed::Rapid, self.spindle != Spindle::Off),
+                JobKind::Jog | JobKind::Home => None,
+            };
+            self.plan(Job { drawing, feed, kind, pen, raise_after: false }, Some(target_mm), settings, slot);
+        }
+        Ok(())
+    }
+
+    /// The line's curve: drawn from the planned position at `feed`; `target_mm` is its G-code
+    /// target, if it has one (G2/G3). It is set up once the line is parsed, built by the slices
+    /// of [`Pending::advance`] and planned by [`commit`](Self::commit).
+    fn curve(
+        &self,
+        request: Request,
+        feed: Feed,
         target_mm: Option<[f32; 2]>,
         settings: &Settings,
-    ) -> Result<Option<Command>, GrblError> {
-        let built = drawing::build(&request, self.position, settings)?;
-        let Some(drawing) = built else {
-            if let Some(target) = target_mm {
-                self.position_mm = target;
-            }
-            return Ok(None);
-        };
-        let end = drawing.end();
+        out: &mut Commands,
+    ) {
+        let pen = pen::for_move(settings, false, self.spindle != Spindle::Off);
+        out.curve = Some(LineCurve { request, feed, pen, target_mm });
+    }
+
+    /// Puts `job` into `slot` and plans the pen at the end of its drawing: `target_mm` (its
+    /// G-code target, kept in millimetres so relative moves never drift by rounding) when the
+    /// drawing ends on the step it rounds to (as a line always does), else its own last lattice
+    /// point.
+    fn plan(&mut self, job: Job, target_mm: Option<[f32; 2]>, settings: &Settings, slot: &mut Option<Command>) {
+        let end = job.drawing.end();
         self.position_mm = match target_mm {
             Some(target) if drawing::line_target(target, settings) == Some(end) => target,
             _ => [settings.steps_to_mm(Axis::X, end.x), settings.steps_to_mm(Axis::Y, end.y)],
         };
         self.position = end;
-        let pen = match kind {
-            JobKind::Draw => pen::for_move(settings, feed == Feed::Rapid, self.spindle != Spindle::Off),
-            JobKind::Jog | JobKind::Home => None,
-        };
-        Ok(Some(Command::Job(Job { drawing, feed, kind, pen, raise_after: false })))
+        *slot = Some(Command::Job(job));
     }
 }
 

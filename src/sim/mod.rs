@@ -226,6 +226,7 @@ pub fn run(config: SimConfig) -> SimReport {
                 loaded,
                 (serial.clone(), serial.clone()),
                 (usb.clone(), usb.clone()),
+                tasks::slices::Yield,
             ),
             tasks::lcd::run(&machine, &panel, lcd),
         ),

@@ -9,6 +9,7 @@ pub mod motion;
 pub mod panel;
 pub mod serial;
 pub mod servo;
+pub mod slices;
 
 use embassy_time::{Instant, TICK_HZ};
 

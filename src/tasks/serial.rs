@@ -21,6 +21,11 @@
 //! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions and
 //! overrides.
 //!
+//! A line's curve is built a slice at a time ([`crate::drawing::Builder`]), the other tasks and
+//! the links' receivers running between slices, so a `?` is answered and the watchdog fed while
+//! a long curve is built; the line is kept by the parser, and its jobs queued, only once its
+//! curve is built. A reset on the line's link meanwhile abandons it, unanswered.
+//!
 //! Every line gets exactly one answer, in order, on its own link, whatever the sender does. A
 //! sender that ignores GRBL's flow control and sends more than its pipe holds while the machine
 //! is busy loses whole lines, never parts of them: from the byte that found no room up to the
@@ -49,6 +54,7 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
+use crate::drawing::BUILD_SLICE_STEPS;
 use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
@@ -56,7 +62,7 @@ use crate::overrides::Overrides;
 use crate::pen::{Pen, PenLift};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
-use crate::protocol::gcode::Offsets;
+use crate::protocol::gcode::{Offsets, Pending};
 use crate::protocol::refresh::Refresh;
 use crate::protocol::report::{Reply, StatusFields};
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
@@ -64,6 +70,7 @@ use crate::protocol::{Command, GcodeState, GrblError, Report};
 use crate::settings::Settings;
 use crate::status::RunState;
 use crate::store::{Record, Store, StoreError};
+use crate::tasks::slices::BetweenSlices;
 use link::{CLOSED_MARK, Intake, Link, RESET_MARK, write_answers};
 pub use link::{
     SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
@@ -89,13 +96,14 @@ struct Host<'m> {
 
 /// Speaks GRBL on two host links forever, each given as its receiving and its sending end,
 /// keeping what a power cycle keeps in `store` (the board's, in static storage); `loaded` says
-/// whether power-on read it back.
+/// whether power-on read it back. `between` is the pause between two slices of a build.
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     machine: &Machine,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
     first: (R1, W1),
     second: (R2, W2),
+    between: impl BetweenSlices,
 ) -> ! {
     let host = Host {
         machine,
@@ -109,7 +117,7 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     }
     let [a, b] = &host.links;
     join(
-        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host, store, loaded)),
+        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host, store, loaded, between)),
         join3(write_answers(a, first.1), write_answers(b, second.1), faults(&host)),
     )
     .await;
@@ -266,9 +274,15 @@ enum Unfinished {
 
 /// Says why the flash store gave the defaults, if it did, and runs the startup blocks; then
 /// takes the links' bytes in turn and carries out their lines, answering each on its own link.
-async fn lines<F: NorFlash>(host: &Host<'_>, store: &mut Store<F>, loaded: Result<(), StoreError>) -> ! {
+async fn lines<F: NorFlash>(
+    host: &Host<'_>,
+    store: &mut Store<F>,
+    loaded: Result<(), StoreError>,
+    between: impl BetweenSlices,
+) -> ! {
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
-    let mut parser = Parser { host, gcode, store, epoch: host.machine.plan_epoch(), restart_after_answer: false };
+    let epoch = host.machine.plan_epoch();
+    let mut parser = Parser { host, gcode, store, epoch, restart_after_answer: false, between };
     let links = [&host.links[0], &host.links[1]];
     if let Err(e) = loaded {
         for link in links {
@@ -321,16 +335,18 @@ async fn lines<F: NorFlash>(host: &Host<'_>, store: &mut Store<F>, loaded: Resul
 
 /// The one parser every link's lines go through, and the epoch it plans in: after an abort,
 /// its planned position is stale until the machine stops.
-struct Parser<'h, 'm, F: NorFlash> {
+struct Parser<'h, 'm, F: NorFlash, B: BetweenSlices> {
     host: &'h Host<'m>,
     gcode: GcodeState,
     store: &'h mut Store<F>,
     epoch: PlanEpoch,
     /// The line being answered left check mode: the parser starts over once it is answered.
     restart_after_answer: bool,
+    /// The pause between two slices of a line's curve.
+    between: B,
 }
 
-impl<F: NorFlash> Parser<'_, '_, F> {
+impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     /// Takes one byte of `link`'s lines, assembled by `assembler`; answers the line it ends.
     async fn byte(&mut self, link: &Link, assembler: &mut LineAssembler, byte: u8) {
         match byte {
@@ -408,7 +424,7 @@ impl<F: NorFlash> Parser<'_, '_, F> {
                 }
                 // Checked when stored: a startup block changes modes and offsets, and moves
                 // nothing.
-                let result = self.gcode.execute(line, &settings, RunState::Idle).map(|_| ());
+                let result = self.gcode.run_startup_block(line, &settings);
                 for link in links {
                     link.send(Reply::StartupResult(line, result)).await;
                 }
@@ -471,7 +487,23 @@ impl<F: NorFlash> Parser<'_, '_, F> {
             // lines it checked.)
             self.gcode.sync_position(machine.position(), &settings);
         }
-        let commands = self.gcode.execute(line, &settings, state).map_err(Unfinished::Error)?;
+        let mut pending = Pending::new();
+        self.gcode.parse(line, &settings, state, &mut pending).map_err(Unfinished::Error)?;
+        // The line's curve, a slice at a time; the other tasks and the links' receivers run
+        // between slices. A reset on the link drops the line unanswered, the parser unchanged.
+        loop {
+            let slice = pending.advance(BUILD_SLICE_STEPS);
+            if slice.steps > 0 {
+                self.between.after(&slice).await;
+            }
+            if link.resetting() {
+                return Err(Unfinished::Reset);
+            }
+            if slice.done {
+                break;
+            }
+        }
+        let commands = self.gcode.commit(&mut pending, &settings).map_err(Unfinished::Error)?;
         // A refused line changed no offset.
         machine.set_work_offset_mm(self.gcode.work_offset_mm());
         for command in commands {

@@ -4,7 +4,7 @@
 
 use super::offsets::StoredPosition;
 use super::words::{NonModal, Words};
-use super::{Command, Distance, GcodeState, WORK_SYSTEMS, WorkSystem};
+use super::{Commands, Distance, GcodeState, WORK_SYSTEMS, WorkSystem};
 use crate::job::Feed;
 use crate::protocol::GrblError;
 use crate::settings::Settings;
@@ -111,23 +111,24 @@ impl GcodeState {
 
     /// G28 / G30: rapid to the stored position (machine coordinates), first through the
     /// intermediate point the axis words give (work coordinates, G90/G91 as set). With axis words
-    /// only the axes they name go on to the stored position, as in GRBL. Returns the two moves,
-    /// either `None` where it goes nowhere.
+    /// only the axes they name go on to the stored position, as in GRBL. The two moves go into
+    /// `out` (its `via` and `main`), either none where it goes nowhere.
     pub(super) fn go_to_stored(
         &mut self,
         which: StoredPosition,
         axis: [Option<f32>; 2],
         has_axis: bool,
         settings: &Settings,
-    ) -> Result<(Option<Command>, Option<Command>), GrblError> {
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let stored = self.offsets.stored_mm(which);
         if !has_axis {
-            return Ok((None, self.line(stored, Feed::Rapid, settings)?));
+            return self.line(stored, Feed::Rapid, settings, &mut out.main);
         }
         let start = self.position_mm;
         let via = self.target_mm(axis, self.distance, false);
         let end = [0, 1].map(|i| if axis[i].is_some() { stored[i] } else { start[i] });
-        let via = self.line(via, Feed::Rapid, settings)?;
-        Ok((via, self.line(end, Feed::Rapid, settings)?))
+        self.line(via, Feed::Rapid, settings, &mut out.via)?;
+        self.line(end, Feed::Rapid, settings, &mut out.main)
     }
 }

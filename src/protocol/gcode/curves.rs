@@ -2,30 +2,37 @@
 //! [`Request`] for the builder.
 
 use super::words::{WordIter, Words, compact, no_unused, positive};
-use super::{Command, Commands, GcodeState};
+use super::{Commands, GcodeState};
 use crate::drawing::{EllipseParams, Request, SineParams};
-use crate::job::{Feed, JobKind};
+use crate::job::Feed;
 use crate::protocol::GrblError;
 use crate::settings::Settings;
 
 impl GcodeState {
-    /// `$E`, `$O`, `$S` with their words in `body` (compacted, after the command letter).
-    pub(super) fn plotter_curve(&mut self, which: u8, body: &[u8], settings: &Settings) -> Result<Commands, GrblError> {
+    /// `$E`, `$O`, `$S` with their words in `body` (compacted, after the command letter): the
+    /// line's curve, into `out`.
+    pub(super) fn plotter_curve(
+        &mut self,
+        which: u8,
+        body: &[u8],
+        settings: &Settings,
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let (mut words, feed) = self.curve_words(body, settings)?;
         let start_deg = words.take(b'S').unwrap_or(0.0);
-        let command = match which {
+        match which {
             b'E' => {
                 let a = positive(words.take(b'A'))?;
                 let b = positive(words.take(b'B'))?;
                 let sweep = words.take(b'W');
                 no_unused(&words)?;
-                self.ellipse([a, b], start_deg, sweep, feed, settings)?
+                self.ellipse([a, b], start_deg, sweep, feed, settings, out)
             }
             b'O' => {
                 let r = positive(words.take(b'R'))?;
                 let sweep = words.take(b'W');
                 no_unused(&words)?;
-                self.ellipse([r, r], start_deg, sweep, feed, settings)?
+                self.ellipse([r, r], start_deg, sweep, feed, settings, out)
             }
             _ => {
                 let amplitude = words.take(b'A').ok_or(GrblError::ValueWordMissing)?;
@@ -37,14 +44,12 @@ impl GcodeState {
                     return Err(GrblError::UnusedWords);
                 }
                 no_unused(&words)?;
-                self.sine(
-                    SineParams { amplitude_mm: amplitude, omega_rad_per_mm: omega, phase_deg, length_mm: length },
-                    feed,
-                    settings,
-                )?
+                let sine =
+                    SineParams { amplitude_mm: amplitude, omega_rad_per_mm: omega, phase_deg, length_mm: length };
+                self.curve(Request::Sine(sine), feed, None, settings, out);
+                Ok(())
             }
-        };
-        Ok(Commands::main(command))
+        }
     }
 
     /// The words of a curve command in `body` (compacted, after the command letter) but its F
@@ -68,35 +73,39 @@ impl GcodeState {
 
     /// `$E` / `$O`: the pen is at parametric angle `start_deg`; `sweep_deg` omitted is a full turn.
     fn ellipse(
-        &mut self,
+        &self,
         semi_axes_mm: [f32; 2],
         start_deg: f32,
         sweep_deg: Option<f32>,
         feed: Feed,
         settings: &Settings,
-    ) -> Result<Option<Command>, GrblError> {
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let sweep_deg = sweep_deg.unwrap_or(360.0);
         if !(sweep_deg.abs() <= 360.0) || !start_deg.is_finite() {
             return Err(GrblError::InvalidTarget);
         }
         if sweep_deg == 0.0 {
-            return Ok(None);
+            return Ok(());
         }
         let [a_mm, b_mm] = semi_axes_mm;
         // Whole turns off (a start angle names a direction). Not `%`: f32 remainder links 650 B
         // of soft-float code for this one use.
         let start_deg = start_deg - 360.0 * crate::math::trunc(start_deg / 360.0);
         let ellipse = EllipseParams { a_mm, b_mm, start_deg, sweep_deg };
-        self.draw(Request::Ellipse(ellipse), feed, JobKind::Draw, None, settings)
+        self.curve(Request::Ellipse(ellipse), feed, None, settings, out);
+        Ok(())
     }
 
-    /// `$S`: see [`crate::drawing`].
-    fn sine(&mut self, sine: SineParams, feed: Feed, settings: &Settings) -> Result<Option<Command>, GrblError> {
-        self.draw(Request::Sine(sine), feed, JobKind::Draw, None, settings)
-    }
-
-    /// `$F X<x0> U<x1> [F] Y=<expr>`; `rest` follows the `$` and is a suffix of `line`.
-    pub(super) fn function(&mut self, line: &str, rest: &str, settings: &Settings) -> Result<Commands, GrblError> {
+    /// `$F X<x0> U<x1> [F] Y=<expr>`, the line's curve, into `out`; `rest` follows the `$` and
+    /// is a suffix of `line`.
+    pub(super) fn function(
+        &mut self,
+        line: &str,
+        rest: &str,
+        settings: &Settings,
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         // The expression starts after the first `Y=` (spaces allowed around the `=`); a `Y` with
         // no `=` after it is a malformed value.
         // Indices below fall on ASCII bytes, so on char boundaries; `get` says so without a
@@ -131,6 +140,7 @@ impl GcodeState {
         // Undefined at its first point: say why, with the x.
         expr.eval(x0_mm).map_err(|error| GrblError::FunctionUndefined { x_mm: x0_mm, error })?;
         let request = Request::Function { expr, x0_mm, x1_mm };
-        Ok(Commands::main(self.draw(request, feed, JobKind::Draw, None, settings)?))
+        self.curve(request, feed, None, settings, out);
+        Ok(())
     }
 }

@@ -17,8 +17,9 @@ use crate::protocol::GrblError;
 use crate::settings::Settings;
 
 impl GcodeState {
-    /// Executes a parsed block on `self` (a copy [`GcodeState::execute`] keeps only on success).
-    pub(super) fn run_block(&mut self, block: Block, settings: &Settings) -> Result<Commands, GrblError> {
+    /// Executes a parsed block on `self` (a copy [`GcodeState::commit`] keeps only on success),
+    /// its commands into `out`.
+    pub(super) fn run_block(&mut self, block: Block, settings: &Settings, out: &mut Commands) -> Result<(), GrblError> {
         let mut words = block.words;
         if let Some(n) = words.take(b'N')
             && n > LINE_NUMBER_MAX
@@ -54,7 +55,6 @@ impl GcodeState {
             self.tool = t as u8; // 0..=255, checked when parsed
         }
 
-        let mut out = Commands::default();
         if let Some(s) = block.spindle
             && PenLift::of(settings) != PenLift::None
         {
@@ -97,11 +97,13 @@ impl GcodeState {
         } else if axis_command == AxisCommand::Motion {
             let machine = block.non_modal == Some(NonModal::MachineCoords);
             let target = self.target_mm(axis, self.distance, machine);
-            let motion = match self.motion {
-                MotionMode::Rapid if has_xy => self.line(target, Feed::Rapid, settings)?,
+            match self.motion {
+                MotionMode::Rapid if has_xy => self.line(target, Feed::Rapid, settings, &mut out.main)?,
                 MotionMode::Linear => {
                     let feed = self.checked_feed(settings)?;
-                    if has_xy { self.line(target, Feed::MmPerMin(feed), settings)? } else { None }
+                    if has_xy {
+                        self.line(target, Feed::MmPerMin(feed), settings, &mut out.main)?;
+                    }
                 }
                 MotionMode::ArcCw | MotionMode::ArcCcw => {
                     let feed = self.checked_feed(settings)?;
@@ -124,14 +126,13 @@ impl GcodeState {
                     };
                     let rotation =
                         if self.motion == MotionMode::ArcCw { Rotation::Clockwise } else { Rotation::CounterClockwise };
-                    self.arc(target, rotation, form, feed, settings)?
+                    self.arc(target, rotation, form, feed, settings, out)?;
                 }
-                _ => None,
-            };
-            out.main = motion;
+                _ => {}
+            }
         }
         if let Some(NonModal::GoToStored(which)) = block.non_modal {
-            (out.via, out.main) = self.go_to_stored(which, axis, has_axis, settings)?;
+            self.go_to_stored(which, axis, has_axis, settings, out)?;
         }
 
         if axis_command != AxisCommand::None {
@@ -153,7 +154,7 @@ impl GcodeState {
             self.coolant = Coolant::Off;
         }
         out.stop = block.stop;
-        Ok(out)
+        Ok(())
     }
 
     /// The feed rate for a feed move; zero (an explicit F0) is GRBL's undefined feed rate.
@@ -162,26 +163,29 @@ impl GcodeState {
         if feed > 0.0 { Ok(feed) } else { Err(GrblError::UndefinedFeedRate) }
     }
 
-    /// A straight move to `target_mm`; `None` when it ends on the step it starts from.
+    /// A straight move to `target_mm` into `slot`; nothing when it ends on the step it starts
+    /// from.
     pub(super) fn line(
         &mut self,
         target_mm: [f32; 2],
         feed: Feed,
         settings: &Settings,
-    ) -> Result<Option<Command>, GrblError> {
+        slot: &mut Option<Command>,
+    ) -> Result<(), GrblError> {
         let to = drawing::line_target(target_mm, settings).ok_or(GrblError::TravelExceeded)?;
-        self.draw(Request::Straight { to }, feed, JobKind::Draw, Some(target_mm), settings)
+        self.straight(to, target_mm, feed, JobKind::Draw, settings, slot)
     }
 
-    /// G2/G3 from the planned position to `end` (mm).
+    /// G2/G3 from the planned position to `end` (mm): the line's curve, into `out`.
     fn arc(
-        &mut self,
+        &self,
         end: [f32; 2],
         rotation: Rotation,
         form: ArcForm,
         feed_mm_per_min: f32,
         settings: &Settings,
-    ) -> Result<Option<Command>, GrblError> {
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let start = self.position_mm;
         let (dx, dy) = (end[0] - start[0], end[1] - start[1]);
         let (center, radius) = match form {
@@ -225,7 +229,8 @@ impl GcodeState {
             _ => {}
         }
         let circle = EllipseParams::circle(radius, crate::math::atan2(sy, sx).to_degrees(), sweep.to_degrees());
-        self.draw(Request::Ellipse(circle), Feed::MmPerMin(feed_mm_per_min), JobKind::Draw, Some(end), settings)
+        self.curve(Request::Ellipse(circle), Feed::MmPerMin(feed_mm_per_min), Some(end), settings, out);
+        Ok(())
     }
 }
 

@@ -4,7 +4,7 @@
 use super::offsets::Offsets;
 use super::words::{Group, NonModal, compact, parse_block, parse_number};
 use super::{Command, Commands, GcodeState, Report};
-use crate::drawing::{self, Request};
+use crate::drawing;
 use crate::job::{Feed, JobKind};
 use crate::protocol::GrblError;
 use crate::protocol::startup::{STARTUP_LINES, ascii_line};
@@ -12,14 +12,16 @@ use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
 
 impl GcodeState {
-    /// A line starting with `$`; `rest` follows the `$` and is a suffix of `line`.
+    /// A line starting with `$`, its command into `out`; `rest` follows the `$` and is a suffix
+    /// of `line`.
     pub(super) fn system(
         &mut self,
         line: &str,
         rest: &str,
         settings: &Settings,
         state: RunState,
-    ) -> Result<Commands, GrblError> {
+        out: &mut Commands,
+    ) -> Result<(), GrblError> {
         let c = compact(rest, true)?;
         let command = match c.as_slice() {
             b"" => Command::Report(Report::Help),
@@ -46,31 +48,33 @@ impl GcodeState {
             b"SLP" if matches!(state, RunState::Idle | RunState::Alarm) => Command::Sleep,
             b"SLP" => return Err(GrblError::NotIdle),
             b"N" => Command::Report(Report::StartupLines),
-            [b'N', index @ b'0'..=b'9', b'=', body @ ..] => {
-                return self.startup_line(*index - b'0', body, settings, state);
-            }
-            [b'R', b'S', b'T', b'=', what] => return self.restore(*what, settings, state),
-            [b'J', b'=', body @ ..] => return self.jog(body, settings, state),
-            [b'0'..=b'9', ..] => return self.set_setting(&c, settings, state),
+            [b'N', index @ b'0'..=b'9', b'=', body @ ..] => self.startup_line(*index - b'0', body, settings, state)?,
+            [b'R', b'S', b'T', b'=', what] => match self.restore(*what, settings, state)? {
+                Some(command) => command,
+                None => return Ok(()),
+            },
+            [b'J', b'=', body @ ..] => return self.jog(body, settings, state, &mut out.main),
+            [b'0'..=b'9', ..] => self.set_setting(&c, settings, state)?,
             [which @ (b'E' | b'O' | b'S'), ..] => {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                return self.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings);
+                return self.plotter_curve(*which, c.get(1..).unwrap_or(&[]), settings, out);
             }
             [b'F', ..] => {
                 if matches!(state, RunState::Alarm | RunState::Jog | RunState::Home) {
                     return Err(GrblError::Locked);
                 }
-                return self.function(line, rest, settings);
+                return self.function(line, rest, settings, out);
             }
             _ => return Err(GrblError::InvalidStatement),
         };
-        Ok(Commands::one(command))
+        out.main = Some(command);
+        Ok(())
     }
 
     /// `$id=value`.
-    fn set_setting(&mut self, c: &[u8], settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+    fn set_setting(&mut self, c: &[u8], settings: &Settings, state: RunState) -> Result<Command, GrblError> {
         if !matches!(state, RunState::Idle | RunState::Alarm) {
             return Err(GrblError::NotIdle);
         }
@@ -88,19 +92,13 @@ impl GcodeState {
             SettingError::Unknown | SettingError::OutOfRange => GrblError::InvalidStatement,
         })?;
         self.rescale(&next);
-        Ok(Commands::one(Command::SetSetting { id, value }))
+        Ok(Command::SetSetting { id, value })
     }
 
     /// `$Nn=line`: `line` (compacted) is checked as a line run at rest, and stored if it parses
     /// and moves nothing: a startup block runs after every reset, when no one may expect the pen
     /// to move. An empty line clears the block.
-    fn startup_line(
-        &self,
-        index: u8,
-        body: &[u8],
-        settings: &Settings,
-        state: RunState,
-    ) -> Result<Commands, GrblError> {
+    fn startup_line(&self, index: u8, body: &[u8], settings: &Settings, state: RunState) -> Result<Command, GrblError> {
         if state != RunState::Idle {
             return Err(GrblError::NotIdle);
         }
@@ -115,15 +113,13 @@ impl GcodeState {
                 return Err(GrblError::InvalidStatement);
             }
             let mut trial = *self;
-            if !trial.execute(text, settings, RunState::Idle)?.is_empty() {
-                return Err(GrblError::InvalidStatement);
-            }
+            trial.run_startup_block(text, settings)?;
         }
-        Ok(Commands::one(Command::StoreStartupLine { index, line }))
+        Ok(Command::StoreStartupLine { index, line })
     }
 
-    /// `$RST=$`, `$RST=#`, `$RST=*`.
-    fn restore(&mut self, what: u8, settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+    /// `$RST=$`, `$RST=#`, `$RST=*`; `None` when only the coordinate data is cleared.
+    fn restore(&mut self, what: u8, settings: &Settings, state: RunState) -> Result<Option<Command>, GrblError> {
         if !matches!(what, b'$' | b'#' | b'*') {
             return Err(GrblError::InvalidStatement);
         }
@@ -135,13 +131,13 @@ impl GcodeState {
             self.offsets = Offsets::new();
         }
         if what == b'#' {
-            return Ok(Commands::default());
+            return Ok(None);
         }
         let defaults = Settings::default();
         if defaults.steps_per_mm != settings.steps_per_mm {
             self.rescale(&defaults);
         }
-        Ok(Commands::one(Command::RestoreSettings { startup_lines: what == b'*' }))
+        Ok(Some(Command::RestoreSettings { startup_lines: what == b'*' }))
     }
 
     /// Keeps the planned position on the same step when steps/mm change.
@@ -150,8 +146,14 @@ impl GcodeState {
         self.sync_position(position, next);
     }
 
-    /// `$J=` followed by `body` (compacted).
-    fn jog(&mut self, body: &[u8], settings: &Settings, state: RunState) -> Result<Commands, GrblError> {
+    /// `$J=` followed by `body` (compacted): the jog into `slot`.
+    fn jog(
+        &mut self,
+        body: &[u8],
+        settings: &Settings,
+        state: RunState,
+        slot: &mut Option<Command>,
+    ) -> Result<(), GrblError> {
         if !matches!(state, RunState::Idle | RunState::Jog) {
             return Err(GrblError::NotIdle);
         }
@@ -176,12 +178,11 @@ impl GcodeState {
         }
         if axis == [None, None] {
             // A Z-only jog (a sender's Z buttons) moves nothing.
-            return if has_z { Ok(Commands::default()) } else { Err(GrblError::NoAxisWords) };
+            return if has_z { Ok(()) } else { Err(GrblError::NoAxisWords) };
         }
         let machine = block.non_modal == Some(NonModal::MachineCoords);
         let target = self.target_mm(axis.map(|v| v.map(|v| v * units.mm_per_unit())), distance, machine);
         let to = drawing::line_target(target, settings).ok_or(GrblError::TravelExceeded)?;
-        let jog = self.draw(Request::Straight { to }, Feed::MmPerMin(feed), JobKind::Jog, Some(target), settings)?;
-        Ok(Commands::main(jog))
+        self.straight(to, target, Feed::MmPerMin(feed), JobKind::Jog, settings, slot)
     }
 }

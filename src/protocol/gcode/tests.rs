@@ -796,5 +796,5 @@ fn random_gcode_blocks_keep_the_plan_consistent() {
     assert!(accepted > 500, "only {accepted} lines accepted: the generator tests too little");
 }
 
-// Work coordinate systems, G10, G28 / G30 and G92 on top of them.
 mod coordinates;
+mod pending;
