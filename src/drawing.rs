@@ -271,38 +271,6 @@ impl Drawing {
     pub fn steps(&self) -> u64 {
         self.steps
     }
-
-    /// Walks the lattice path again (`settings` as it was built with) and hands `at` its start,
-    /// every `every`-th point and its end.
-    pub fn sample_path(&self, settings: &Settings, every: u64, at: &mut dyn FnMut(Point)) {
-        at(self.start);
-        if let Shape::Straight { to } = self.shape {
-            // Straight: its two ends say it all.
-            return at(to);
-        }
-        let Ok(mut walk) = Builder::of_shape(self.shape.clone(), None, self.start, settings) else { return };
-        let (mut n, mut last) = (0u64, self.start);
-        // Counted down to each sample rather than `n % every`: no 64-bit division (see
-        // `crate::wide`). An `every` of 0 samples no point between the ends.
-        let mut to_sample = every;
-        while !walk
-            .advance_with(u32::MAX, &mut |p| {
-                n += 1;
-                last = p;
-                to_sample = to_sample.wrapping_sub(1);
-                if to_sample == 0 {
-                    to_sample = every;
-                    if n != self.steps {
-                        at(p);
-                    }
-                }
-            })
-            .done
-        {}
-        if n > 0 {
-            at(last);
-        }
-    }
 }
 
 #[cfg(target_os = "none")]

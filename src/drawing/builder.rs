@@ -102,7 +102,7 @@ impl Builder {
     }
 
     /// Sets `shape` up from the pen at `start`, `ideal` its box where known.
-    pub(super) fn of_shape(
+    fn of_shape(
         shape: Shape,
         ideal: Option<IdealBox>,
         start: Point,

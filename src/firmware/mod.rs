@@ -128,7 +128,7 @@ async fn keypad(
     columns: [board::Column; 4],
     rows: [board::Row; 4],
 ) -> ! {
-    tasks::keypad::run(machine, panel, columns, rows).await
+    tasks::keypad::run(machine, panel, columns, rows, tasks::slices::Yield).await
 }
 
 #[embassy_executor::task]

@@ -219,7 +219,7 @@ pub fn run(config: SimConfig) -> SimReport {
         join5(
             step_timer::run(&machine, &mut engine, &kicks),
             tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
-            tasks::keypad::run(&machine, &panel, columns, rows),
+            tasks::keypad::run(&machine, &panel, columns, rows, tasks::slices::Yield),
             tasks::serial::run(
                 &machine,
                 &mut store,

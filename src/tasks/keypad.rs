@@ -1,17 +1,22 @@
 //! The keypad task: scans the 4x4 matrix every `KEYPAD_SCAN_PERIOD_MS`, decodes key events and
 //! hands them to the menu (changed in place, in the [`Panel`] it shares with the LCD task), then
-//! carries out what the menu asks for.
+//! carries out what the menu asks for. A drawing the menu asks for is built here a slice at a
+//! time between the scans (see [`crate::tasks::slices`]), so keys are still read while it is
+//! built (`D` drops it).
 
+use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Ticker, Timer};
 use embedded_hal::digital::{InputPin, OutputPin};
 
+use crate::drawing::BUILD_SLICE_STEPS;
 use crate::job::{Control, Job};
 use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
 use crate::machine::Machine;
 use crate::pen::{Pen, PenLift};
 use crate::tasks::panel::Panel;
+use crate::tasks::slices::BetweenSlices;
 use crate::ui::MenuAction;
-use crate::ui::menu::UiError;
+use crate::ui::menu::{Building, UiError};
 
 /// Time for a row input to settle after its column is driven low.
 pub const KEYPAD_SETTLE_US: u64 = 10;
@@ -19,24 +24,42 @@ pub const KEYPAD_SETTLE_US: u64 = 10;
 /// Scans the keypad forever. Columns are open-drain outputs driven low one at a time and released
 /// (`set_high`) after, never driven high, so keys pressed together never join two driven
 /// outputs; rows are inputs with pull-ups, read low where a pressed key joins them to the driven
-/// column.
+/// column. `between` is the pause between two slices of a build.
 pub async fn run<C: OutputPin, R: InputPin>(
     machine: &Machine,
     panel: &Panel,
     mut columns: [C; 4],
     mut rows: [R; 4],
+    mut between: impl BetweenSlices,
 ) -> ! {
     let mut decoder = KeypadDecoder::new();
     let mut ticker = Ticker::every(Duration::from_millis(KEYPAD_SCAN_PERIOD_MS as u64));
+    // The drawing the menu asked for, built between the scans.
+    let mut building: Option<Building> = None;
     loop {
-        ticker.next().await;
+        if let Some(b) = &mut building {
+            let slice = async {
+                let slice = b.advance(BUILD_SLICE_STEPS);
+                between.after(&slice).await;
+                slice.done
+            };
+            // The scan comes first when it is due.
+            if let Either::Second(done) = select(ticker.next(), slice).await {
+                if done {
+                    built(machine, panel, &mut building);
+                }
+                continue;
+            }
+        } else {
+            ticker.next().await;
+        }
         let raw = scan(&mut columns, &mut rows).await;
         let now_ms = super::now_ms();
         for event in decoder.update(raw, now_ms) {
             let status = machine.status();
             let settings = machine.settings();
             let action = panel.update(|menu| menu.handle(event, &status, &settings));
-            act(machine, panel, action);
+            act(machine, panel, action, &mut building);
         }
         // The run screen follows the machine between keys.
         let status = machine.status();
@@ -60,17 +83,41 @@ async fn scan<C: OutputPin, R: InputPin>(columns: &mut [C; 4], rows: &mut [R; 4]
     raw
 }
 
-/// Carries out a menu action: queue a job, or pass a control to the motion task.
-fn act(machine: &Machine, panel: &Panel, action: MenuAction) {
+/// Hands the menu the drawing it asked for, walked to its end, and carries out what it asks
+/// for then; the building is spent unless the menu starts it.
+fn built(machine: &Machine, panel: &Panel, building: &mut Option<Building>) {
+    let Some(b) = building.as_mut() else { return };
+    let status = machine.status();
+    let settings = machine.settings();
+    let action = panel.update(|menu| menu.built(b, &status, &settings));
+    if !matches!(action, MenuAction::Start(_)) {
+        // Shown, or refused.
+        *building = None;
+    }
+    act(machine, panel, action, building);
+}
+
+/// Carries out a menu action: start or drop a build, queue a job, or pass a control to the
+/// motion task.
+fn act(machine: &Machine, panel: &Panel, action: MenuAction, building: &mut Option<Building>) {
     match action {
         MenuAction::None => {}
-        MenuAction::Start(mut job) => {
-            // A pen lift lowers the pen for a keypad drawing and raises it once it is drawn.
-            if PenLift::of(&machine.settings()) != PenLift::None {
-                job.pen = Some(Pen::Down);
-                job.raise_after = true;
+        MenuAction::Build(request) => {
+            if let Err(why) = Building::start(building, &request, machine.status().position, &machine.settings()) {
+                refuse(panel, why);
             }
-            queue(machine, panel, job)
+        }
+        MenuAction::DropBuild => *building = None,
+        MenuAction::Start(feed) => {
+            if let Some(mut job) = building.as_mut().and_then(|b| b.job(feed)) {
+                // A pen lift lowers the pen for a keypad drawing and raises it once it is drawn.
+                if PenLift::of(&machine.settings()) != PenLift::None {
+                    job.pen = Some(Pen::Down);
+                    job.raise_after = true;
+                }
+                queue(machine, panel, job);
+            }
+            *building = None;
         }
         MenuAction::JogStart(direction) => {
             // At the edge already, a jog outwards goes nowhere.

@@ -17,6 +17,9 @@
 //!   builds the drawing and shows its preview. A value that is refused shows why and stays for
 //!   correction.
 //! - Preview: the whole planned path; `#` starts the drawing, `D` goes back to the form.
+//! - While a drawing is built (after the last `#` of a form, or `#` on the preview: the keypad
+//!   task builds it a slice at a time, see [`MenuAction::Build`]), `D` drops it and the screen
+//!   stays as it was; every other key waits for it.
 //! - While drawing: `#` steps through the run screen's pages ([`RunPage`]). Once the machine
 //!   comes to rest, the run screen stays, with the plot time, until a key is pressed; that key
 //!   does nothing else.
@@ -44,6 +47,7 @@ use crate::status::{RunState, Status};
 use crate::ui::run::{Plan, Run, RunPage};
 
 mod action;
+mod building;
 mod error;
 mod form;
 mod list;
@@ -54,6 +58,7 @@ mod tests;
 
 pub use crate::unit::Unit;
 pub use action::MenuAction;
+pub use building::Building;
 pub use error::UiError;
 pub use form::{
     ARC_START_RANGE_DEG, ARC_SWEEP_RANGE_DEG, CIRCLE_RADIUS_RANGE_MM, ELLIPSE_SEMI_AXIS_RANGE_MM, FORM_MAX_FIELDS,
@@ -189,6 +194,60 @@ impl Menu {
     pub fn refuse(&mut self, why: UiError) {
         self.message = Some(why);
         self.run = None;
+        if let Some(form) = self.form_mut() {
+            form.building = false;
+        }
+    }
+
+    /// True while the menu waits for a drawing it asked to be built: the form's (its last `#`)
+    /// or the preview's (`#` there).
+    pub fn building(&self) -> bool {
+        match &self.screen {
+            Screen::Form(form) | Screen::Preview { form, .. } => form.building,
+            _ => false,
+        }
+    }
+
+    /// The form on the screen, itself or under its preview.
+    fn form_mut(&mut self) -> Option<&mut Form> {
+        match &mut self.screen {
+            Screen::Form(form) | Screen::Preview { form, .. } => Some(form),
+            _ => None,
+        }
+    }
+
+    /// The drawing asked for with [`MenuAction::Build`] is walked (`built`): shows its preview,
+    /// or starts it, if the machine is still free for it and the pen where it was built from.
+    /// A drawing the menu no longer waits for is dropped.
+    #[inline(never)]
+    pub fn built(&mut self, built: &mut Building, status: &Status, settings: &Settings) -> MenuAction {
+        if !self.building() {
+            return MenuAction::None;
+        }
+        let result = match &mut self.screen {
+            Screen::Form(form) => match form.plan(built, status, settings) {
+                Ok(plan) => {
+                    self.screen = Screen::Preview { form: form.clone(), plan };
+                    Ok(MenuAction::None)
+                }
+                Err(e) => Err(e),
+            },
+            Screen::Preview { form, plan } => match form.started(built, status, settings) {
+                Ok(feed) => {
+                    let plan = Plan { first_step: status.emitted_steps, ..core::mem::take(plan) };
+                    self.run = Some(Run { plan: Some(plan), started_ms: None, ended_ms: None });
+                    self.run_page = RunPage::Numbers;
+                    self.screen = Screen::Form(form.clone());
+                    Ok(MenuAction::Start(feed))
+                }
+                Err(e) => Err(e),
+            },
+            _ => Ok(MenuAction::None),
+        };
+        result.unwrap_or_else(|e| {
+            self.message = Some(e);
+            MenuAction::None
+        })
     }
 
     /// Follows the machine between keys: a run starts when the machine draws (a keypad drawing's
@@ -256,7 +315,7 @@ impl Menu {
     /// True when a held `key` repeats on the current screen: only moves through lists and
     /// deleting characters, never anything that starts motion or leaves a screen.
     fn repeats(&self, key: Key, status: &Status) -> bool {
-        if self.is_busy(status) {
+        if self.is_busy(status) || self.building() {
             return false;
         }
         match &self.screen {
@@ -274,6 +333,14 @@ impl Menu {
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
         self.message = None;
+        if let Some(form) = self.form_mut().filter(|f| f.building) {
+            // A drawing is being built: `D` drops it, the rest waits for it.
+            if key != Key::D {
+                return MenuAction::None;
+            }
+            form.building = false;
+            return MenuAction::DropBuild;
+        }
         if self.run.as_ref().is_some_and(|r| r.ended_ms.is_some()) {
             // The end screen: the key only puts it away.
             self.run = None;
@@ -334,24 +401,12 @@ impl Menu {
                 None => Ok(MenuAction::None),
             },
             Screen::Form(form) => match form.press(key, repeated, status, settings) {
-                Ok(Some(plan)) => {
-                    self.screen = Screen::Preview { form: form.clone(), plan };
-                    Ok(MenuAction::None)
-                }
+                Ok(Some(request)) => Ok(MenuAction::Build(request)),
                 Ok(None) => Ok(MenuAction::None),
                 Err(e) => Err(e),
             },
-            Screen::Preview { form, plan } => match key {
-                Key::Hash => {
-                    let start = form.start(status, settings);
-                    if start.is_ok() {
-                        let plan = Plan { first_step: status.emitted_steps, ..core::mem::take(plan) };
-                        self.run = Some(Run { plan: Some(plan), started_ms: None, ended_ms: None });
-                        self.run_page = RunPage::Numbers;
-                        self.screen = Screen::Form(form.clone());
-                    }
-                    start
-                }
+            Screen::Preview { form, .. } => match key {
+                Key::Hash => form.start(status, settings).map(MenuAction::Build),
                 _ => Ok(MenuAction::None),
             },
         };

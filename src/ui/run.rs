@@ -12,12 +12,11 @@
 
 use heapless::String;
 
-use crate::drawing::Drawing;
 use crate::geom::{Axis, Point};
 use crate::job::Feed;
 use crate::planner::Limits;
 use crate::settings::Settings;
-use crate::ui::trail::{TRAIL_POINTS, Trail};
+use crate::ui::trail::Trail;
 
 /// Longest name of a drawing on the run screen ("Ellipse 30x15").
 pub const JOB_NAME_CHARS: usize = 16;
@@ -37,12 +36,10 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The plan of `drawing`, named `name`, drawn at `feed`: its path sampled evenly along its
-    /// steps, and the time that path takes at the planner's cruise speed.
-    pub fn of(drawing: &Drawing, name: String<JOB_NAME_CHARS>, feed: Feed, settings: &Settings) -> Plan {
-        let mut path = Trail::new();
-        let every = crate::wide::div_rem(drawing.steps(), TRAIL_POINTS as u16 - 2).0.max(1);
-        drawing.sample_path(settings, every, &mut |p| path.push(p, true));
+    /// The plan of a drawing of `steps` steps, named `name`, drawn at `feed`: `path`, its path
+    /// as the builder walked it ([`Trail::sample`] at every step), and the time that path takes
+    /// at the planner's cruise speed.
+    pub fn of(steps: u64, path: Trail, name: String<JOB_NAME_CHARS>, feed: Feed, settings: &Settings) -> Plan {
         let limits = Limits::from_settings(settings);
         let [vx, vy] = limits.max_speed_mm_per_s();
         let speed_mm_per_s = limits.requested_speed_mm_per_s(feed).min(vx).min(vy);
@@ -57,7 +54,7 @@ impl Plan {
             .sum();
         // Saturating: a plan longer than 49 days shows as that.
         let estimate_ms = (length_mm / speed_mm_per_s * 1000.0) as u32;
-        Plan { name, path, steps: u32::try_from(drawing.steps()).unwrap_or(u32::MAX), estimate_ms, first_step: 0 }
+        Plan { name, path, steps: u32::try_from(steps).unwrap_or(u32::MAX), estimate_ms, first_step: 0 }
     }
 }
 

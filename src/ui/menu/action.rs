@@ -1,18 +1,28 @@
 //! What the menu asks the machine to do: the one [`MenuAction`] each key event gives.
 
+use crate::drawing::Request;
 use crate::geom::Step;
-use crate::job::{Control, Job};
+use crate::job::{Control, Feed};
 use crate::settings::presets::SpeedPreset;
 
 /// What the menu asks the machine to do.
-// A started job carries its curve by value (no heap).
+// A drawing to build carries its expression by value (no heap).
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum MenuAction {
     None,
-    /// Queue a job.
-    Start(Job),
+    /// Build this drawing from the pen, a slice at a time, and hand it to [`Menu::built`]
+    /// (or, refused, to [`Menu::refuse`]).
+    ///
+    /// [`Menu::built`]: super::Menu::built
+    /// [`Menu::refuse`]: super::Menu::refuse
+    Build(Request),
+    /// Drop the drawing being built: the menu no longer waits for it.
+    DropBuild,
+    /// Queue the job of the drawing just built ([`Building::job`](super::Building::job)), at
+    /// this feed: only [`Menu::built`](super::Menu::built) asks for it.
+    Start(Feed),
     /// Hold, resume or abort the motion in progress.
     Control(Control),
     /// Start jogging in one of the 8 step directions until [`MenuAction::JogStop`].

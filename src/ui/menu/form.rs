@@ -1,6 +1,7 @@
 //! The forms of the drawing modes: the ranges of their parameters, the fields each mode asks
-//! for, and [`Form`], which takes the keys of a form, checks the values and builds the job from
-//! the pen, with the [`Plan`] its preview and run screen show.
+//! for, and [`Form`], which takes the keys of a form, checks the values and says what to build
+//! from the pen ([`Request`], built by the keypad task a slice at a time), then turns what was
+//! built into the [`Plan`] its preview and run screen show, or into the job.
 
 use core::fmt::Write;
 use core::ops::RangeInclusive;
@@ -8,7 +9,7 @@ use core::ops::RangeInclusive;
 use core::f32::consts::TAU;
 use heapless::String;
 
-use super::action::MenuAction;
+use super::building::Building;
 use super::error::UiError;
 use super::list;
 use super::mode::Mode;
@@ -16,7 +17,7 @@ use crate::decimal::Num;
 use crate::drawing::{self, DrawError, EllipseParams, Request, SineParams};
 use crate::expr::Expr;
 use crate::geom::{Axis, Point};
-use crate::job::{Feed, Job};
+use crate::job::Feed;
 use crate::keypad::Key;
 use crate::language::Language;
 use crate::settings::Settings;
@@ -163,6 +164,9 @@ pub struct Form {
     /// The form started its drawing: it stays as typed (no empty form flashes up before the
     /// drawing shows) until the next key starts a new one.
     started: bool,
+    /// Its drawing is being built (see [`MenuAction::Build`](super::MenuAction::Build)): for
+    /// the preview, or, on the preview, to start it.
+    pub(super) building: bool,
 }
 
 impl Form {
@@ -174,6 +178,7 @@ impl Form {
             preset: FunctionPreset::Parabola,
             typed: None,
             started: false,
+            building: false,
         }
     }
 
@@ -216,15 +221,14 @@ impl Form {
         self.typed = None;
     }
 
-    /// Takes a key; `#` on the last field builds the drawing and gives its plan, for the
-    /// preview.
+    /// Takes a key; `#` on the last field gives the drawing to build for the preview.
     pub(super) fn press(
         &mut self,
         key: Key,
         repeated: bool,
         status: &Status,
         settings: &Settings,
-    ) -> Result<Option<Plan>, UiError> {
+    ) -> Result<Option<Request>, UiError> {
         if self.started {
             *self = Form { preset: self.preset, typed: self.typed.take(), ..Form::new(self.mode) };
         }
@@ -255,8 +259,8 @@ impl Form {
         Ok(None)
     }
 
-    /// `#`: checks the field, then moves on or, after the last one, builds the job.
-    fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<Option<Plan>, UiError> {
+    /// `#`: checks the field, then moves on or, after the last one, gives the drawing to build.
+    fn confirm(&mut self, status: &Status, settings: &Settings) -> Result<Option<Request>, UiError> {
         match self.field() {
             Some(Field::Number(spec)) => {
                 spec.value(self.entry())?;
@@ -270,19 +274,31 @@ impl Form {
             self.field += 1;
             return Ok(None);
         }
-        let job = self.job(status, settings);
-        job.map(|job| Some(Plan::of(&job.drawing, self.name(settings.language), job.feed, settings)))
+        self.ask_build(status, settings).map(Some)
     }
 
-    /// `#` on the preview: the job, built again from the pen (still where the preview was
-    /// built: the machine is at rest), if the machine is still free for it. The form then stays
-    /// as typed until the next key.
-    pub(super) fn start(&mut self, status: &Status, settings: &Settings) -> Result<MenuAction, UiError> {
-        let job = self.job(status, settings);
-        if job.is_ok() {
-            self.started = true;
-        }
-        job.map(MenuAction::Start)
+    /// `#` on the preview: the drawing to build again from the pen (still where the preview was
+    /// built: the machine is at rest), if the machine is still free for it.
+    pub(super) fn start(&mut self, status: &Status, settings: &Settings) -> Result<Request, UiError> {
+        self.ask_build(status, settings)
+    }
+
+    /// The preview's plan of the drawing [`confirm`](Self::confirm) asked for, now built.
+    pub(super) fn plan(&mut self, built: &mut Building, status: &Status, settings: &Settings) -> Result<Plan, UiError> {
+        self.building = false;
+        free(status)?;
+        built.check(status)?;
+        Ok(Plan::of(built.steps(), built.take_path(), self.name(settings.language), feed(settings), settings))
+    }
+
+    /// Starts the drawing [`start`](Self::start) asked for, now built: at the feed returned.
+    /// The form then stays as typed until the next key.
+    pub(super) fn started(&mut self, built: &Building, status: &Status, settings: &Settings) -> Result<Feed, UiError> {
+        self.building = false;
+        free(status)?;
+        built.check(status)?;
+        self.started = true;
+        Ok(feed(settings))
     }
 
     /// The function's text: typed, or the preset's.
@@ -343,14 +359,13 @@ impl Form {
         })
     }
 
-    /// The job the form describes, from the pen at `status.position`.
-    fn job(&self, status: &Status, settings: &Settings) -> Result<Job, UiError> {
+    /// The drawing the form describes, to build from the pen at `status.position`, if the
+    /// machine is free for it: the form now waits for it.
+    fn ask_build(&mut self, status: &Status, settings: &Settings) -> Result<Request, UiError> {
         free(status)?;
-        let feed = Feed::MmPerMin(settings.default_feed_mm_per_min);
         let request = self.request(status.position, settings)?;
-        let drawing = drawing::build(&request, status.position, settings).map_err(UiError::Drawing)?;
-        // Shorter than a step: nothing to draw.
-        Ok(Job::draw(drawing.ok_or(UiError::Zero)?, feed))
+        self.building = true;
+        Ok(request)
     }
 
     /// The drawing's name on the run screen: the mode and its main figures.
@@ -378,6 +393,11 @@ impl Form {
         }
         name
     }
+}
+
+/// A keypad drawing's feed: the default feed rate (`$203`).
+fn feed(settings: &Settings) -> Feed {
+    Feed::MmPerMin(settings.default_feed_mm_per_min)
 }
 
 /// The keypad starts a drawing only at rest with nothing queued, so it starts at the pen.

@@ -3,7 +3,7 @@
 
 extern crate std;
 use super::*;
-use crate::drawing::{DrawError, Request};
+use crate::drawing::{BUILD_SLICE_STEPS, DrawError, Request};
 use crate::geom::{Point, Rotation};
 use crate::interp::Shape;
 use crate::job::{Feed, Job};
@@ -25,26 +25,56 @@ fn key(ch: char) -> Key {
     }
 }
 
-/// Presses each key of `keys` (spaces ignored); returns the actions other than `None`. A
-/// drawing's preview is confirmed with `#` at once, and a drawing started is drawn at once, as
-/// if between two keys: the machine runs and comes to rest, and a key puts the end screen away.
-fn type_keys(menu: &mut Menu, keys: &str, status: &Status) -> Vec<MenuAction> {
+/// What the keypad task ends up doing after a key: what the menu asked for, or a job it started
+/// (the drawing it asked for, built and checked).
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, PartialEq)]
+enum Did {
+    Act(MenuAction),
+    Start(Job),
+}
+
+/// What the keypad task does with `action`: a drawing asked for is built, in one go (as if
+/// between two keys), and handed to the menu; what follows.
+fn carried_out(menu: &mut Menu, action: MenuAction, status: &Status) -> Did {
+    let MenuAction::Build(request) = action else { return Did::Act(action) };
     let s = Settings::default();
-    let mut actions = Vec::new();
+    let mut slot = None;
+    if let Err(why) = Building::start(&mut slot, &request, status.position, &s) {
+        menu.refuse(why);
+        return Did::Act(MenuAction::None);
+    }
+    let built = slot.as_mut().unwrap();
+    while !built.advance(BUILD_SLICE_STEPS).done {}
+    match menu.built(built, status, &s) {
+        MenuAction::Start(feed) => Did::Start(built.job(feed).expect("a drawing started is checked")),
+        other => Did::Act(other),
+    }
+}
+
+/// Presses each key of `keys` (spaces ignored); returns what was done but nothing. A drawing
+/// asked for is built at once, its preview confirmed with `#` at once, and a drawing started is
+/// drawn at once, as if between two keys: the machine runs and comes to rest, and a key puts the
+/// end screen away.
+fn type_keys(menu: &mut Menu, keys: &str, status: &Status) -> Vec<Did> {
+    let s = Settings::default();
+    let mut done = Vec::new();
     for c in keys.chars().filter(|c| !c.is_whitespace()) {
-        let mut action = menu.handle(KeyEvent::Press(key(c)), status, &s);
+        let action = menu.handle(KeyEvent::Press(key(c)), status, &s);
+        let mut did = carried_out(menu, action, status);
         if matches!(menu.screen(), Screen::Preview { .. }) {
-            action = menu.handle(KeyEvent::Press(Key::Hash), status, &s);
+            let action = menu.handle(KeyEvent::Press(Key::Hash), status, &s);
+            did = carried_out(menu, action, status);
         }
-        if let MenuAction::Start(_) = action {
+        if let Did::Start(_) = did {
             draw_to_the_end(menu);
             menu.handle(KeyEvent::Press(Key::Star), &idle(), &s);
         }
-        if action != MenuAction::None {
-            actions.push(action);
+        if did != Did::Act(MenuAction::None) {
+            done.push(did);
         }
     }
-    actions
+    done
 }
 
 /// The machine draws what the menu started and comes to rest: the run ends.
@@ -60,12 +90,12 @@ fn idle() -> Status {
 }
 
 /// A line started from the pen at `from` to (`x`, `y`) steps.
-fn line_from(from: Point, x: i32, y: i32) -> MenuAction {
+fn line_from(from: Point, x: i32, y: i32) -> Did {
     let drawing = crate::drawing::build(&Request::Straight { to: Point::new(x, y) }, from, &Settings::default());
-    MenuAction::Start(Job::draw(drawing.unwrap().unwrap(), Feed::MmPerMin(3_000.0)))
+    Did::Start(Job::draw(drawing.unwrap().unwrap(), Feed::MmPerMin(3_000.0)))
 }
 
-fn line(x: i32, y: i32) -> MenuAction {
+fn line(x: i32, y: i32) -> Did {
     line_from(Point::ORIGIN, x, y)
 }
 
@@ -166,12 +196,12 @@ fn run_hold_resume_abort() {
     type_keys(&mut m, "2 1", &idle());
     let run = Status { state: RunState::Run, ..Status::default() };
     let hold = Status { state: RunState::Hold, ..Status::default() };
-    assert_eq!(type_keys(&mut m, "C", &run), [MenuAction::Control(Control::Hold)]);
-    assert_eq!(type_keys(&mut m, "C", &hold), [MenuAction::Control(Control::Resume)]);
+    assert_eq!(type_keys(&mut m, "C", &run), [Did::Act(MenuAction::Control(Control::Hold))]);
+    assert_eq!(type_keys(&mut m, "C", &hold), [Did::Act(MenuAction::Control(Control::Resume))]);
     // Digits and # do nothing while a job runs; D aborts and leaves the form as it was.
     assert_eq!(type_keys(&mut m, "5#", &run), []);
-    assert_eq!(type_keys(&mut m, "D", &run), [MenuAction::Control(Control::Abort)]);
-    assert_eq!(type_keys(&mut m, "D", &hold), [MenuAction::Control(Control::Abort)]);
+    assert_eq!(type_keys(&mut m, "D", &run), [Did::Act(MenuAction::Control(Control::Abort))]);
+    assert_eq!(type_keys(&mut m, "D", &hold), [Did::Act(MenuAction::Control(Control::Abort))]);
     assert_eq!(form(&m).entry().digits(), "1");
     assert_eq!(m.message(), Some(UiError::Aborted), "an abort is said until the next key");
     // Idle again: D goes back to the mode list.
@@ -256,7 +286,7 @@ fn a_setting_is_typed_checked_and_handed_on() {
     // Out of range (1..60000): said, and the value stays to be corrected.
     assert_eq!(type_keys(&mut m, "7 0 0 0 0 #", &idle()), []);
     assert_eq!(m.message(), Some(UiError::OutOfRange { min: 1.0, max: 60_000.0, unit: Unit::MmPerMin }));
-    assert_eq!(type_keys(&mut m, "B #", &idle()), [MenuAction::SetSetting { id: 110, value: 7000.0 }]);
+    assert_eq!(type_keys(&mut m, "B #", &idle()), [Did::Act(MenuAction::SetSetting { id: 110, value: 7000.0 })]);
     // A whole-number setting ($1) refuses a fraction; D drops the value, then leaves.
     type_keys(&mut m, &"A".repeat(15), &idle());
     assert_eq!(type_keys(&mut m, "2 * 5 #", &idle()), []);
@@ -271,17 +301,17 @@ fn a_setting_is_typed_checked_and_handed_on() {
 #[test]
 fn a_speed_preset_is_picked_and_handed_on() {
     let mut m = Menu::new();
-    assert_eq!(type_keys(&mut m, "9 B B B #", &idle()), [MenuAction::Preset(SpeedPreset::FastDraft)]);
-    assert_eq!(type_keys(&mut m, "2 #", &idle()), [MenuAction::Preset(SpeedPreset::FeltTip)]);
+    assert_eq!(type_keys(&mut m, "9 B B B #", &idle()), [Did::Act(MenuAction::Preset(SpeedPreset::FastDraft))]);
+    assert_eq!(type_keys(&mut m, "2 #", &idle()), [Did::Act(MenuAction::Preset(SpeedPreset::FeltTip))]);
     // Not while the machine draws.
     let drawing = Status { state: RunState::Run, ..Status::default() };
     assert_eq!(type_keys(&mut m, "1 #", &drawing), []);
 }
 
-/// The shape (in steps) and start of the drawing an action starts.
-fn curve(action: &MenuAction) -> (Shape, Point) {
-    match action {
-        MenuAction::Start(job) => (job.drawing.shape().clone(), job.drawing.start()),
+/// The shape (in steps) and start of the drawing a key started.
+fn curve(did: &Did) -> (Shape, Point) {
+    match did {
+        Did::Start(job) => (job.drawing.shape().clone(), job.drawing.start()),
         a => panic!("not a drawing: {a:?}"),
     }
 }
@@ -425,4 +455,69 @@ fn drawings_are_named_by_their_figures_in_either_language() {
         assert_eq!(form(&m).name(Language::English).as_str(), english, "{keys}");
         assert_eq!(readable(&form(&m).name(Language::Chinese)), chinese, "{keys}");
     }
+}
+
+/// Types `keys` (spaces ignored) without carrying out what they ask for; the last action.
+fn press_keys(menu: &mut Menu, keys: &str, status: &Status) -> MenuAction {
+    let s = Settings::default();
+    let mut last = MenuAction::None;
+    for c in keys.chars().filter(|c| !c.is_whitespace()) {
+        last = menu.handle(KeyEvent::Press(key(c)), status, &s);
+    }
+    last
+}
+
+/// The drawing `action` asks for, walked to its end from the pen at `status.position`.
+fn walked(action: MenuAction, status: &Status) -> Building {
+    let MenuAction::Build(request) = action else { panic!("no drawing asked for: {action:?}") };
+    let mut slot = None;
+    Building::start(&mut slot, &request, status.position, &Settings::default()).unwrap();
+    let mut built = slot.unwrap();
+    while !built.advance(BUILD_SLICE_STEPS).done {}
+    built
+}
+
+#[test]
+fn while_its_drawing_is_built_the_form_waits_and_d_drops_it() {
+    let s = Settings::default();
+    let mut m = Menu::new();
+    let asked = press_keys(&mut m, "3 10# # #", &idle());
+    assert!(matches!(asked, MenuAction::Build(Request::Ellipse(_))), "{asked:?}");
+    assert!(m.building());
+    // Every key but D waits for the drawing: the form stays as it was.
+    assert_eq!(press_keys(&mut m, "5 B C A #", &idle()), MenuAction::None);
+    assert_eq!(m.handle(KeyEvent::Repeat(Key::B), &idle(), &s), MenuAction::None);
+    assert_eq!((form(&m).field_index(), form(&m).entry().digits()), (2, ""));
+    // D drops it; should it be built after all, the menu no longer takes it.
+    assert_eq!(press_keys(&mut m, "D", &idle()), MenuAction::DropBuild);
+    assert!(!m.building());
+    let mut late = walked(asked, &idle());
+    assert_eq!(m.built(&mut late, &idle(), &s), MenuAction::None);
+    assert!(matches!(m.screen(), Screen::Form(_)), "no preview");
+    // The form is as typed: its last # asks again.
+    assert!(matches!(press_keys(&mut m, "#", &idle()), MenuAction::Build(_)));
+}
+
+#[test]
+fn a_drawing_built_while_the_host_moved_the_pen_is_refused() {
+    let s = Settings::default();
+    let mut m = Menu::new();
+    let asked = press_keys(&mut m, "3 10# # #", &idle());
+    let mut built = walked(asked, &idle());
+    let moved = Status { position: Point::new(100, 0), ..idle() };
+    assert_eq!(m.built(&mut built, &moved, &s), MenuAction::None);
+    assert_eq!(m.message(), Some(UiError::Busy));
+    assert!(matches!(m.screen(), Screen::Form(_)), "no preview");
+    // Built from where the pen is, the preview shows; its # builds the drawing again and starts
+    // it, from the pen.
+    let asked = press_keys(&mut m, "#", &moved);
+    let mut built = walked(asked, &moved);
+    assert_eq!(m.built(&mut built, &moved, &s), MenuAction::None);
+    assert!(matches!(m.screen(), Screen::Preview { .. }));
+    let again = press_keys(&mut m, "#", &moved);
+    let mut built = walked(again, &moved);
+    assert_eq!(m.built(&mut built, &moved, &s), MenuAction::Start(Feed::MmPerMin(s.default_feed_mm_per_min)));
+    let job = built.job(Feed::MmPerMin(s.default_feed_mm_per_min)).unwrap();
+    assert_eq!((job.drawing.start(), job.drawing.end()), (moved.position, moved.position), "a full circle");
+    assert!(m.run().is_some_and(|r| r.plan.is_some()), "the run screen has the preview's plan");
 }
