@@ -50,6 +50,9 @@ MODEL_HEADER = """\
 # Per step: the motion task all-in (interpolator, planner, task), the most costly case of each kind.
 # Per pulse: the step timer's interrupt. Cycles per instruction: an estimate for the STM32F407 at
 # 168 MHz running from flash through its ART accelerator (five wait states).
+# A function: per step, plus per X step (where it evaluates the curve) `per_x_step` and
+# `per_x_step_op` per operation of its expression. `build`: the drawing builder's walk per step,
+# plus per X step of a sine or a function `per_x_step`, and for a function `per_x_step_op`.
 """
 # How far the model may be from what is counted before --check-model fails.
 MODEL_TOLERANCE = 0.05
@@ -124,12 +127,16 @@ def run(only, profile):
     overhead = marks[1] - marks[0]
     # Lines of the same measure, case and method add up (the motion task reports every poll).
     measured = {}
+    # The builder's slices also count one by one: the longest of each case.
+    longest = {}
     for k, (_, what, case, method, count) in enumerate(results):
         instructions = marks[2 * k + 3] - marks[2 * k + 2] - overhead
         total, steps = measured.get((case, method, what), (0, 0))
         measured[(case, method, what)] = (total + instructions, steps + int(count))
+        if what == "slice":
+            longest[(case, method)] = max(longest.get((case, method), 0), instructions)
     blocks = [l.split() for l in lines if l.startswith("block ")]
-    return measured, blocks, syms
+    return measured, blocks, syms, (done.stdout, longest)
 
 
 def print_profile(blocks, syms):
@@ -155,12 +162,152 @@ def model_from(measured, per_pulse):
         return None
     lines.append(f"pulse {round(per_pulse)}")
     for kind, cases in MODEL_KINDS.items():
+        if kind == "function":
+            # Fitted by the size of the expression: see build_model.
+            continue
         for method in ("classic", "diagonal"):
             costs = [measured[(c, method, "task")] for c in cases if (c, method, "task") in measured]
             if len(costs) != len(cases):
                 return None
             lines.append(f"{kind} {method} {round(max(n / s for n, s in costs))}")
     return "\n".join(lines) + "\n"
+
+
+# The builder, and a function's cost by the size of its expression (`src/build.rs`): the cases
+# each figure of the model is fitted to. The motion task and the builder cost `s` per step and,
+# for sines and functions, `c` per X step (where the curve is evaluated), a function's `c` being
+# `c0 + c1 * ops`; each fit is by least squares over its cases. An operation costs what it
+# costs in the usual mix (arithmetic, sin, cos, exp, sqrt, small powers): a function whose
+# operations are mostly sines costs up to a fifth more than the model says, one of mostly
+# arithmetic a fifth less. b-fn-heavy, all general powers, costs three times as much per
+# operation: it is counted for the longest slice, not fitted.
+MOTION_FUNCTION_CASES = ["gauss", "cubic", "sinx", "m-fn3", "m-fn10", "m-fn18", "m-fn30"]
+BUILD_KINDS = {
+    "arc": ["b-circle", "b-arc"],
+    "ellipse": ["b-ellipse"],
+    "sine": ["b-sine-flat", "b-sine", "b-sine-steep"],
+    "function": ["b-fn3", "b-fn6", "b-fn9", "b-fn-steep", "b-fn18", "b-fn30"],
+}
+# The front ends' slice (src/drawing/builder.rs, BUILD_SLICE_STEPS), and the longest a slice may
+# take on the board.
+BUILD_SLICE_STEPS = 2048
+BUILD_SLICE_BUDGET_MS = 2.0
+
+
+def least_squares(rows, values):
+    """The x minimising |rows·x - values|: the normal equations, by elimination."""
+    n = len(rows[0])
+    a = [[sum(r[i] * r[j] for r in rows) for j in range(n)] + [sum(r[i] * v for r, v in zip(rows, values))]
+         for i in range(n)]
+    for i in range(n):
+        p = max(range(i, n), key=lambda k: abs(a[k][i]))
+        a[i], a[p] = a[p], a[i]
+        for k in range(n):
+            if k != i and a[i][i]:
+                f = a[k][i] / a[i][i]
+                a[k] = [x - f * y for x, y in zip(a[k], a[i])]
+    return [a[i][n] / a[i][i] if a[i][i] else 0.0 for i in range(n)]
+
+
+def walked(output):
+    """The build cases' and the motion task's function cases' X steps and expression sizes."""
+    facts = {}
+    for line in output.splitlines():
+        words = line.split()
+        if words[:1] == ["walked"]:
+            _, case, method, kind, x_steps, ops = words
+            facts[(case, method)] = (kind, int(x_steps), int(ops))
+        elif words[:1] == ["motion"]:
+            _, case, method, x_steps, ops = words
+            facts[(case, method)] = ("function", int(x_steps), int(ops))
+    return facts
+
+
+def build_model(measured, facts):
+    """The builder's figures and the motion task's function figures, by method: name -> value;
+    None if a case is missing."""
+    out = {}
+    for method in ("classic", "diagonal"):
+        rows, values = [], []
+        for case in MOTION_FUNCTION_CASES:
+            if (case, method, "task") not in measured or (case, method) not in facts:
+                return None
+            n, steps = measured[(case, method, "task")]
+            _, x_steps, ops = facts[(case, method)]
+            rows.append([steps, x_steps, x_steps * ops])
+            values.append(n)
+        x = least_squares(rows, values)
+        out[f"function {method}"], out[f"function {method} per_x_step"] = x[0], x[1]
+        out[f"function {method} per_x_step_op"] = x[2]
+        for kind, cases in BUILD_KINDS.items():
+            rows, values = [], []
+            for case in cases:
+                if (case, method, "slice") not in measured or (case, method) not in facts:
+                    return None
+                n, steps = measured[(case, method, "slice")]
+                _, x_steps, ops = facts[(case, method)]
+                rows.append({"sine": [steps, x_steps], "function": [steps, x_steps, x_steps * ops]}.get(kind, [steps]))
+                values.append(n)
+            if kind in ("arc", "ellipse"):
+                out[f"build {kind} {method}"] = max(v / r[0] for r, v in zip(rows, values))
+                continue
+            x = least_squares(rows, values)
+            out[f"build {kind} {method}"], out[f"build {kind} {method} per_x_step"] = x[0], x[1]
+            if kind == "function":
+                out[f"build function {method} per_x_step_op"] = x[2]
+    return out
+
+
+def build_model_lines(figures):
+    """The model's lines for `figures`: the motion task's function figures, then the builder's."""
+    order = [n for n in figures if n.startswith("function ")] + [n for n in figures if n.startswith("build ")]
+    return [f"{n} {figures[n]:.1f}" if figures[n] < 10 else f"{n} {round(figures[n])}" for n in order]
+
+
+def print_functions(measured, facts, figures):
+    """The motion task's functions: their cost per step, and what the model makes of it."""
+    rows = [(c, m) for c in MOTION_FUNCTION_CASES for m in ("classic", "diagonal") if (c, m, "task") in measured]
+    if not rows or not figures:
+        return
+    print("\nThe motion task's functions, by the size of their expressions:\n")
+    print("| case | method | steps | X steps | ops | instr/step | model (instr/step) |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for case, method in rows:
+        n, steps = measured[(case, method, "task")]
+        _, x_steps, ops = facts.get((case, method), ("?", 0, 0))
+        c = figures[f"function {method} per_x_step"] + figures[f"function {method} per_x_step_op"] * ops
+        model = (figures[f"function {method}"] * steps + c * x_steps) / steps
+        print(f"| {case} | {method} | {steps} | {x_steps} | {ops} | {n / steps:.1f} | {model:.1f} |")
+
+
+def print_builds(measured, facts, figures, longest):
+    """The builder's cost per case, what the model makes of it, and its longest slice; returns the
+    longest slice of all, ms on the F407."""
+    rows = [(c, m) for (c, m, what) in measured if what == "slice"]
+    if not rows:
+        return None
+    print(f"\nThe builder, walking each case in slices of {BUILD_SLICE_STEPS} steps' worth:\n")
+    print("| case | method | steps | X steps | ops | instr/step | instr/X step | model (instr/step) "
+          "| longest slice (instructions) | (ms) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    worst = 0.0
+    for case, method in rows:
+        n, steps = measured[(case, method, "slice")]
+        kind, x_steps, ops = facts.get((case, method), ("?", 0, 0))
+        model = ""
+        if figures:
+            s = figures.get(f"build {kind} {method}", 0.0)
+            c = (figures.get(f"build {kind} {method} per_x_step", 0.0)
+                 + figures.get(f"build {kind} {method} per_x_step_op", 0.0) * ops)
+            model = f"{(s * steps + c * x_steps) / steps:.1f}"
+        per_x = f"{n / x_steps:.0f}" if x_steps else ""
+        slice_n = longest.get((case, method), 0)
+        slice_ms = slice_n * CYCLES_PER_INSTRUCTION / CLOCK_HZ * 1000
+        worst = max(worst, slice_ms)
+        print(f"| {case} | {method} | {steps} | {x_steps} | {ops} | {n / steps:.1f} | {per_x} | {model} "
+              f"| {slice_n} | {slice_ms:.2f} |")
+    print(f"\nLongest slice: {worst:.2f} ms on the F407 (budget {BUILD_SLICE_BUDGET_MS} ms).")
+    return worst
 
 
 def figures(text):
@@ -299,10 +446,10 @@ def main():
         return
     if not args.no_build:
         build()
-    measured, blocks, syms = run(args.only, args.profile)
+    measured, blocks, syms, output = run(args.only, args.profile)
     cases = []
     for case, method, what in measured:
-        if what != "pulse" and (case, method) not in cases:
+        if what == "interp" and (case, method) not in cases:
             cases.append((case, method))
 
     def per_step(case, method, what):
@@ -333,7 +480,16 @@ def main():
     if per_pulse is not None:
         print(f"\nPulse path: {per_pulse:.1f} instructions per pulse (the step timer's interrupt, entry to "
               f"return, with the sleep around it); alone it tops out at {khz(per_pulse)} kHz.")
+    output, longest = output
+    facts = walked(output)
+    figures = build_model(measured, facts)
+    print_functions(measured, facts, figures)
+    slice_ms = print_builds(measured, facts, figures, longest)
     model = model_from(measured, per_pulse)
+    if model is not None and figures is not None:
+        model += "\n".join(build_model_lines(figures)) + "\n"
+    else:
+        model = None
     if args.write_model:
         with open(args.write_model, "w") as f:
             f.write(model)
@@ -342,6 +498,9 @@ def main():
         check_model(args.check_model, model)
     if args.check_budgets:
         check_budgets(measured, per_pulse)
+        if slice_ms is not None and slice_ms > BUILD_SLICE_BUDGET_MS:
+            sys.exit(f"a slice of the builder takes {slice_ms:.2f} ms, budget {BUILD_SLICE_BUDGET_MS} ms")
+        print(f"every slice of the builder within its budget ({BUILD_SLICE_BUDGET_MS} ms)")
     if args.profile:
         print_profile(blocks, syms)
 

@@ -4,6 +4,7 @@
 #![no_std]
 #![no_main]
 
+mod build;
 mod pulse_path;
 mod shared;
 mod task;
@@ -52,7 +53,7 @@ const INTERP_BATCH_STEPS: usize = 16;
 /// takes them.
 const PLANNER_BATCH_STEPS: usize = servoplot::pulse::STEP_QUEUE_LEN / 2;
 
-fn cases() -> [(&'static str, Shape); 10] {
+pub fn cases() -> [(&'static str, Shape); 10] {
     let f = |src: &str| match servoplot::expr::parse(src) {
         Ok(e) => e,
         Err(_) => panic!("expression"),
@@ -196,6 +197,7 @@ fn main() -> ! {
     if "shared".contains(only) || only.is_empty() {
         shared::run();
     }
+    build::runs(only);
     debug::exit(debug::EXIT_SUCCESS);
     halt()
 }

@@ -1,17 +1,23 @@
-//! The board's processor, modelled for the simulator: how long the motion task's work takes on
-//! the STM32F407, and how much of the processor the step timer's interrupt takes meanwhile. The
-//! figures are the instructions the cost harness counts on a Cortex-M4F (`cost/f407.txt`). With
-//! the model in place the motion task publishes a batch of steps only once the chip would have
-//! computed it, so the pulses wait for it, and an underrun is counted, exactly where the board
-//! would fall behind.
+//! The board's processor, modelled for the simulator: how long the motion task's work and the
+//! builds of drawings take on the STM32F407, and how much of the processor the step timer's
+//! interrupt takes meanwhile. The figures are the instructions the cost harness counts on a
+//! Cortex-M4F (`cost/f407.txt`).
+//!
+//! With the model in place the motion task publishes a batch of steps only once the chip would
+//! have computed it, so the pulses wait for it, and an underrun is counted, exactly where the
+//! board would fall behind. The motion task runs at interrupt priority on the board, so its work
+//! holds up no other task here either.
 
+use core::future::Future;
+use std::collections::BTreeMap;
 use std::string::String;
 
 use embassy_time::{Duration, Timer};
 
+use crate::drawing::{Drawing, Slice};
 use crate::geom::TICK_HZ;
 use crate::interp::Method;
-use crate::interp::ShapeKind;
+use crate::interp::{Shape, ShapeKind};
 use crate::machine::Machine;
 use crate::planner::Emitted;
 use crate::tasks::motion::WorkTime;
@@ -23,15 +29,31 @@ const F407_TABLE: &str = include_str!("../../cost/f407.txt");
 /// interrupt alone would take the whole processor.
 const MAX_BATCH_SECONDS: f32 = 1.0;
 
-/// A processor's speed and the cost of the motion path on it.
+/// The methods in a model's table, in the order of its figures.
+const METHODS: [(&str, Method); 2] = [("classic", Method::Classic), ("diagonal", Method::Diagonal)];
+
+/// A processor's speed and the cost of the motion path and of the builder on it. Figures per
+/// kind of curve are by [`ShapeKind`] and method (classic, diagonal).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CpuModel {
     pub clock_hz: f32,
     pub cycles_per_instruction: f32,
     /// Instructions of the step timer's interrupt per pulse.
     pub pulse_instructions: f32,
-    /// Instructions of the motion task per step, by [`ShapeKind`] and method (classic, diagonal).
+    /// Instructions of the motion task per step; for a function, besides its X steps'.
     pub step_instructions: [[f32; 2]; 5],
+    /// Instructions of the motion task per X step of a function (where the planner evaluates
+    /// it), besides `function_x_step_op`.
+    pub function_x_step_instructions: [f32; 2],
+    /// The same per operation of the function's expression.
+    pub function_x_step_op_instructions: [f32; 2],
+    /// Instructions of the builder per step walked (a line is not walked: 0).
+    pub build_step_instructions: [[f32; 2]; 5],
+    /// Instructions of the builder per X step of a sine or a function, besides the step: the
+    /// evaluation of the curve at a column; for a function, besides `build_function_op`.
+    pub build_x_step_instructions: [[f32; 2]; 5],
+    /// Instructions of the builder per X step of a function, per operation of its expression.
+    pub build_function_op_instructions: [f32; 2],
 }
 
 impl CpuModel {
@@ -40,61 +62,92 @@ impl CpuModel {
         CpuModel::parse(F407_TABLE)
     }
 
-    /// A model from its table: `clock_hz`, `cycles_per_instruction`, `pulse N`, and
-    /// `<kind> <method> N` for every kind and method; `#` starts a comment.
+    /// A model from its table: `clock_hz`, `cycles_per_instruction`, `pulse N`, and for every
+    /// kind and method `<kind> <method> N` (the motion task per step), `function <method>
+    /// per_x_step N` and `function <method> per_x_step_op N`, and `build <kind> <method> N`
+    /// (the builder per step walked) for every kind but the line, `build <kind> <method>
+    /// per_x_step N` for the sine and the function, and `build function <method>
+    /// per_x_step_op N`; `#` starts a comment.
     pub fn parse(text: &str) -> Result<CpuModel, String> {
-        let (mut clock, mut cpi, mut pulse) = (None, None, None);
-        let mut steps = [[None; 2]; 5];
+        let mut figures = BTreeMap::new();
         for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
             let words: std::vec::Vec<&str> = line.split_whitespace().collect();
-            let number = |w: &str| w.parse::<f32>().map_err(|_| std::format!("not a number: {line}"));
-            match words[..] {
-                ["clock_hz", v] => clock = Some(number(v)?),
-                ["cycles_per_instruction", v] => cpi = Some(number(v)?),
-                ["pulse", v] => pulse = Some(number(v)?),
-                [kind, method, v] => {
-                    let k = ShapeKind::ALL
-                        .iter()
-                        .position(|k| kind_name(*k) == kind)
-                        .ok_or_else(|| std::format!("unknown curve kind: {line}"))?;
-                    let m = match method {
-                        "classic" => 0,
-                        "diagonal" => 1,
-                        _ => return Err(std::format!("unknown method: {line}")),
-                    };
-                    steps[k][m] = Some(number(v)?);
+            let Some((value, name)) = words.split_last() else { continue };
+            let value = value.parse::<f32>().map_err(|_| std::format!("not a number: {line}"))?;
+            let known = match name {
+                ["clock_hz"] | ["cycles_per_instruction"] | ["pulse"] => true,
+                [kind, method]
+                | ["build", kind, method]
+                | [kind, method, "per_x_step" | "per_x_step_op"]
+                | ["build", kind, method, "per_x_step" | "per_x_step_op"] => {
+                    kind_of(kind).is_some() && method_of(method).is_some()
                 }
-                _ => return Err(std::format!("cannot read: {line}")),
+                _ => false,
+            };
+            if !known {
+                return Err(std::format!("cannot read: {line}"));
             }
+            figures.insert(name.join(" "), value);
         }
-        let clock_hz = clock.ok_or("no clock_hz")?;
-        let cycles_per_instruction = cpi.ok_or("no cycles_per_instruction")?;
-        let pulse_instructions = pulse.ok_or("no pulse cost")?;
-        let mut step_instructions = [[0.0; 2]; 5];
-        for (k, row) in steps.iter().enumerate() {
-            for (m, v) in row.iter().enumerate() {
-                step_instructions[k][m] = v.ok_or_else(|| {
-                    std::format!("no cost for {} {}", kind_name(ShapeKind::ALL[k]), ["classic", "diagonal"][m])
-                })?;
+        let get = |name: &str| figures.get(name).copied().ok_or_else(|| std::format!("no {name}"));
+        let mut model = CpuModel {
+            clock_hz: get("clock_hz")?,
+            cycles_per_instruction: get("cycles_per_instruction")?,
+            pulse_instructions: get("pulse")?,
+            step_instructions: [[0.0; 2]; 5],
+            function_x_step_instructions: [0.0; 2],
+            function_x_step_op_instructions: [0.0; 2],
+            build_step_instructions: [[0.0; 2]; 5],
+            build_x_step_instructions: [[0.0; 2]; 5],
+            build_function_op_instructions: [0.0; 2],
+        };
+        for (m, (method, _)) in METHODS.iter().enumerate() {
+            for (k, kind) in ShapeKind::ALL.iter().enumerate() {
+                let name = kind_name(*kind);
+                model.step_instructions[k][m] = get(&std::format!("{name} {method}"))?;
+                if *kind != ShapeKind::Straight {
+                    model.build_step_instructions[k][m] = get(&std::format!("build {name} {method}"))?;
+                }
+                if matches!(kind, ShapeKind::Sine | ShapeKind::Function) {
+                    model.build_x_step_instructions[k][m] = get(&std::format!("build {name} {method} per_x_step"))?;
+                }
             }
+            model.function_x_step_instructions[m] = get(&std::format!("function {method} per_x_step"))?;
+            model.function_x_step_op_instructions[m] = get(&std::format!("function {method} per_x_step_op"))?;
+            model.build_function_op_instructions[m] = get(&std::format!("build function {method} per_x_step_op"))?;
         }
-        Ok(CpuModel { clock_hz, cycles_per_instruction, pulse_instructions, step_instructions })
+        Ok(model)
     }
 
     fn seconds(&self, instructions: f32) -> f32 {
         instructions * self.cycles_per_instruction / self.clock_hz
     }
 
-    /// Seconds the motion task takes per step of `kind` with `method`.
-    pub fn step_seconds(&self, kind: ShapeKind, method: Method) -> f32 {
-        let k = ShapeKind::ALL.iter().position(|&x| x == kind).unwrap_or(0);
-        let m = usize::from(method == Method::Diagonal);
-        self.seconds(self.step_instructions[k][m])
+    /// Seconds the motion task takes for `steps` steps of `kind` with `method`, `x_steps` of
+    /// them along X; `expr_ops` is the size of a function's expression (a function is evaluated
+    /// once per X step).
+    pub fn steps_seconds(&self, kind: ShapeKind, method: Method, expr_ops: u8, steps: u32, x_steps: u32) -> f32 {
+        let (k, m) = (kind_index(kind), method_index(method));
+        let per_x_step = match kind {
+            ShapeKind::Function => {
+                self.function_x_step_instructions[m] + self.function_x_step_op_instructions[m] * f32::from(expr_ops)
+            }
+            _ => 0.0,
+        };
+        self.seconds(self.step_instructions[k][m] * steps as f32 + per_x_step * x_steps as f32)
     }
 
     /// Seconds the step timer's interrupt takes per pulse.
     pub fn pulse_seconds(&self) -> f32 {
         self.seconds(self.pulse_instructions)
+    }
+
+    /// Seconds the builder takes for `slice`, walked with `method`.
+    pub fn build_seconds(&self, slice: &Slice, method: Method) -> f32 {
+        let (k, m) = (kind_index(slice.kind), method_index(method));
+        let ops = if slice.kind == ShapeKind::Function { f32::from(slice.expr_ops) } else { 0.0 };
+        let per_x_step = self.build_x_step_instructions[k][m] + self.build_function_op_instructions[m] * ops;
+        self.seconds(self.build_step_instructions[k][m] * slice.steps as f32 + per_x_step * slice.x_steps as f32)
     }
 }
 
@@ -109,6 +162,30 @@ pub fn kind_name(kind: ShapeKind) -> &'static str {
     }
 }
 
+fn kind_of(name: &str) -> Option<ShapeKind> {
+    ShapeKind::ALL.into_iter().find(|k| kind_name(*k) == name)
+}
+
+fn method_of(name: &str) -> Option<Method> {
+    METHODS.iter().find(|(n, _)| *n == name).map(|(_, m)| *m)
+}
+
+fn kind_index(kind: ShapeKind) -> usize {
+    ShapeKind::ALL.iter().position(|&k| k == kind).unwrap_or(0)
+}
+
+fn method_index(method: Method) -> usize {
+    usize::from(method == Method::Diagonal)
+}
+
+/// The size of a function's expression (0 for the other curves).
+fn expr_ops(drawing: &Drawing) -> u8 {
+    match drawing.shape() {
+        Shape::Function { expr, .. } => u8::try_from(expr.op_count()).unwrap_or(u8::MAX),
+        _ => 0,
+    }
+}
+
 /// The simulator's [`WorkTime`]: with a model, each batch of steps takes its time on the
 /// modelled processor; without one, no time at all.
 pub struct SimCpu<'m> {
@@ -117,40 +194,43 @@ pub struct SimCpu<'m> {
     /// The kinds of job taken since the pulses last stopped: a batch is charged as the most
     /// costly of them (a batch may hold steps of several jobs).
     kinds: [bool; 5],
+    /// The largest expression among the functions planned since the pulses last stopped.
+    expr_ops: u8,
 }
 
 impl<'m> SimCpu<'m> {
     pub fn new(model: Option<CpuModel>, machine: &'m Machine) -> Self {
-        SimCpu { model, machine, kinds: [false; 5] }
+        SimCpu { model, machine, kinds: [false; 5], expr_ops: 0 }
     }
 }
 
 impl WorkTime for SimCpu<'_> {
+    fn planned(&mut self, drawing: &Drawing) {
+        let ops = expr_ops(drawing);
+        self.expr_ops = if self.machine.pulses_idle() { ops } else { self.expr_ops.max(ops) };
+    }
+
     fn took(&mut self, emitted: &Emitted) -> impl Future<Output = ()> {
         let seconds = match (&self.model, self.machine.drawing()) {
             (Some(model), Some(kind)) if emitted.steps > 0 => {
                 if self.machine.pulses_idle() {
                     self.kinds = [false; 5];
                 }
-                if let Some(i) = ShapeKind::ALL.iter().position(|&k| k == kind) {
-                    self.kinds[i] = true;
-                }
+                self.kinds[kind_index(kind)] = true;
                 let method = self.machine.settings().method;
-                let per_step = ShapeKind::ALL
+                // A function moves X one way: its X steps are how far the batch moved along X.
+                let (steps, x_steps) = (emitted.steps as u32, emitted.moved.x.unsigned_abs());
+                let work = ShapeKind::ALL
                     .iter()
                     .zip(self.kinds)
                     .filter(|(_, taken)| *taken)
-                    .map(|(&k, _)| model.step_seconds(k, method))
+                    .map(|(&k, _)| model.steps_seconds(k, method, self.expr_ops, steps, x_steps))
                     .fold(0.0, f32::max);
                 // Meanwhile the pulses go on at the batch's own rate, each taking the interrupt's
                 // time from the motion task.
                 let interval_s = emitted.ticks as f32 / TICK_HZ as f32 / emitted.steps as f32;
                 let left_for_motion = 1.0 - model.pulse_seconds() / interval_s;
-                if left_for_motion > 0.0 {
-                    (per_step * emitted.steps as f32 / left_for_motion).min(MAX_BATCH_SECONDS)
-                } else {
-                    MAX_BATCH_SECONDS
-                }
+                if left_for_motion > 0.0 { (work / left_for_motion).min(MAX_BATCH_SECONDS) } else { MAX_BATCH_SECONDS }
             }
             _ => 0.0,
         };
@@ -173,14 +253,42 @@ mod tests {
         assert_eq!(model.clock_hz, 168e6);
         assert!(model.pulse_instructions > 0.0);
         assert!(model.step_instructions.iter().flatten().all(|&v| v > 0.0));
+        assert!(model.function_x_step_op_instructions.iter().all(|&v| v > 0.0));
+        // Every kind but the line is walked by the builder.
+        assert!(model.build_step_instructions[1..].iter().flatten().all(|&v| v > 0.0));
         // 168 MHz at 1.3 cycles per instruction: a 100-instruction step takes 0.77 µs.
-        let line = model.step_seconds(ShapeKind::Straight, Method::Diagonal);
+        let line = model.steps_seconds(ShapeKind::Straight, Method::Diagonal, 0, 1, 1);
         assert!((line - model.step_instructions[0][1] * 1.3 / 168e6).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_slice_of_a_build_takes_its_steps_x_steps_and_operations_time() {
+        let model = CpuModel::f407().unwrap();
+        let slice = |kind, expr_ops, steps, x_steps| Slice { kind, expr_ops, steps, x_steps, done: false };
+        let d = Method::Diagonal;
+        let seconds = |instructions: f32| instructions * 1.3 / 168e6;
+        let arc = model.build_seconds(&slice(ShapeKind::Arc, 0, 1000, 700), d);
+        assert!(
+            (arc - seconds(1000.0 * model.build_step_instructions[1][1])).abs() < 1e-9,
+            "X steps cost an arc nothing"
+        );
+        // A function's X step evaluates its expression: each operation adds to it.
+        let short = model.build_seconds(&slice(ShapeKind::Function, 3, 100, 100), d);
+        let long = model.build_seconds(&slice(ShapeKind::Function, 30, 100, 100), d);
+        let per_op = seconds(100.0 * 27.0 * model.build_function_op_instructions[1]);
+        assert!((long - short - per_op).abs() < 1e-9);
+        // Steep: most steps walk without an evaluation.
+        let steep = model.build_seconds(&slice(ShapeKind::Function, 3, 2000, 10), d);
+        assert!(steep < 2000.0 / 100.0 * short, "a step without an evaluation is cheaper");
+        // The motion task's steps of a function too.
+        let f = ShapeKind::Function;
+        assert!(model.steps_seconds(f, d, 30, 100, 100) > model.steps_seconds(f, d, 3, 100, 100));
     }
 
     #[test]
     fn a_bad_table_is_refused_with_the_line() {
         assert!(CpuModel::parse("clock_hz 1\n").unwrap_err().contains("cycles_per_instruction"));
+        assert!(CpuModel::parse("build line sideways 3\n").unwrap_err().contains("build line sideways 3"));
         assert!(CpuModel::parse("line sideways 3\n").unwrap_err().contains("line sideways 3"));
         assert!(CpuModel::parse("pulse fast\n").unwrap_err().contains("pulse fast"));
     }

@@ -19,6 +19,7 @@ use core::sync::atomic::{Ordering, fence};
 use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 
+use crate::drawing::Drawing;
 use crate::geom::Point;
 use crate::inputs::Trip;
 use crate::interp::{Curve, CurveError};
@@ -69,6 +70,10 @@ struct Queued {
 /// and there is nothing to do ([`RealTime`]); the simulator's virtual time stands still while
 /// code runs, and a model of the board's CPU spends it here.
 pub trait WorkTime {
+    /// `drawing` is planned: its steps come next (a model of the processor may charge them by
+    /// its kind and size).
+    fn planned(&mut self, _drawing: &Drawing) {}
+
     /// `emitted` was computed: the future ends once the processor would have done so.
     fn took(&mut self, emitted: &Emitted) -> impl Future<Output = ()>;
 }
@@ -139,6 +144,7 @@ pub async fn run(
             if planner.is_idle() {
                 planner.set_limits(Limits::from_settings(&settings));
             }
+            work.planned(&job.drawing);
             moving = plan(machine, planner, job, &settings);
         }
         if machine.pulses_idle() && !planner.is_idle() && !ready_to_start(machine) {
