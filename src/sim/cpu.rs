@@ -7,12 +7,18 @@
 //! have computed it, so the pulses wait for it, and an underrun is counted, exactly where the
 //! board would fall behind. The motion task runs at interrupt priority on the board, so its work
 //! holds up no other task here either.
+//!
+//! A slice of a build runs in thread mode, which the board's one core shares between the host
+//! link, the keypad, the LCD, the servo and homing tasks: while it is charged ([`SimSlices`]) the
+//! simulator polls none of them ([`ThreadLevel`]), so a build delays a status report, a key or
+//! the watchdog's food as it would on the board, while the pulses and the motion go on.
 
+use core::cell::Cell;
 use core::future::Future;
 use std::collections::BTreeMap;
 use std::string::String;
 
-use embassy_time::{Duration, Timer};
+use embassy_time::{Duration, Instant, Timer};
 
 use crate::drawing::{Drawing, Slice};
 use crate::geom::TICK_HZ;
@@ -21,6 +27,7 @@ use crate::interp::{Shape, ShapeKind};
 use crate::machine::Machine;
 use crate::planner::Emitted;
 use crate::tasks::motion::WorkTime;
+use crate::tasks::slices::BetweenSlices;
 
 /// The measured cost of the motion path on the STM32F407 (see the file's header).
 const F407_TABLE: &str = include_str!("../../cost/f407.txt");
@@ -238,6 +245,62 @@ impl WorkTime for SimCpu<'_> {
         async move {
             if ticks > 0 {
                 Timer::after(Duration::from_ticks(ticks)).await;
+            }
+        }
+    }
+}
+
+/// The board's thread mode: until `busy_until_us` it is taken by work charged there, and the
+/// simulator polls none of its tasks; see the module documentation.
+#[derive(Debug, Default)]
+pub struct ThreadLevel {
+    busy_until_us: Cell<u64>,
+}
+
+impl ThreadLevel {
+    /// Until when thread mode is taken (in the past: it is free).
+    pub fn busy_until_us(&self) -> u64 {
+        self.busy_until_us.get()
+    }
+
+    /// True while thread mode is taken.
+    pub fn busy(&self) -> bool {
+        Instant::now().as_ticks() < self.busy_until_us.get()
+    }
+
+    /// Takes thread mode until `t_us`.
+    fn hold_until(&self, t_us: u64) {
+        self.busy_until_us.set(self.busy_until_us.get().max(t_us));
+    }
+}
+
+/// The simulator's [`BetweenSlices`]: with a model, each slice of a build takes thread mode for
+/// its time on the modelled processor; without one it takes no time, and the other tasks have
+/// their turn.
+pub struct SimSlices<'a> {
+    model: Option<CpuModel>,
+    machine: &'a Machine,
+    thread: &'a ThreadLevel,
+}
+
+impl<'a> SimSlices<'a> {
+    pub fn new(model: Option<CpuModel>, machine: &'a Machine, thread: &'a ThreadLevel) -> Self {
+        SimSlices { model, machine, thread }
+    }
+}
+
+impl BetweenSlices for SimSlices<'_> {
+    fn after(&mut self, slice: &Slice) -> impl Future<Output = ()> {
+        let seconds = self.model.as_ref().map_or(0.0, |m| m.build_seconds(slice, self.machine.settings().method));
+        let ticks = (seconds * TICK_HZ as f32).ceil() as u64;
+        // Taken from now, even should the future be dropped: the work is done.
+        let until = Instant::now().as_ticks() + ticks;
+        self.thread.hold_until(until);
+        async move {
+            if ticks > 0 {
+                Timer::at(Instant::from_ticks(until)).await;
+            } else {
+                embassy_futures::yield_now().await;
             }
         }
     }

@@ -6,6 +6,10 @@
 //! standard input, and the LCD is a model of the ST7920 fed by the real driver. A run ends when every input is used up and the
 //! machine has come to rest. [`cli`] is the simulator's command line: what the firmware binary
 //! runs when built for the host.
+//!
+//! As on the board, the tasks run at two levels: the step timer and the motion task at
+//! interrupt level, polled whenever they are woken; the others in thread mode, polled only
+//! while no work charged there (a slice of a build, see [`cpu::ThreadLevel`]) holds it.
 
 pub mod cli;
 pub mod clock;
@@ -39,7 +43,7 @@ use crate::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
 use crate::tasks::{self, lcd::St7920Lcd, panel::Panel};
-use cpu::{CpuModel, SimCpu};
+use cpu::{CpuModel, SimCpu, SimSlices, ThreadLevel};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 use flash::SimFlash;
@@ -98,6 +102,8 @@ pub struct SimReport {
     pub lcd_writes_too_soon: u32,
     /// Everything the firmware answered on the UART link.
     pub serial_out: Vec<u8>,
+    /// The same, line by line, each with the virtual time it was written, µs.
+    pub serial_lines: Vec<(u64, std::string::String)>,
     /// Everything the firmware answered on the USB link.
     pub usb_out: Vec<u8>,
     /// Position counted by the pulse task.
@@ -215,57 +221,71 @@ pub fn run(config: SimConfig) -> SimReport {
     let lcd =
         St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), spi.delay(), SIM_LCD_SPI_HZ);
 
-    let firmware = join(
-        join5(
-            step_timer::run(&machine, &mut engine, &kicks),
-            tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu, &machine)),
-            tasks::keypad::run(&machine, &panel, columns, rows, tasks::slices::Yield),
-            tasks::serial::run(
-                &machine,
-                &mut store,
-                loaded,
-                (serial.clone(), serial.clone()),
-                (usb.clone(), usb.clone()),
-                tasks::slices::Yield,
-            ),
-            tasks::lcd::run(&machine, &panel, lcd),
-        ),
-        join(
-            tasks::servo::run(
-                &machine,
-                son.clone(),
-                || inputs.levels(),
-                pen.clone(),
-                [led.clone(), buzzer.clone()],
-                || watchdog.feed(),
-            ),
-            tasks::homing::run(&machine),
-        ),
+    // The board's interrupts: the step timer, and the motion task on its interrupt executor.
+    let interrupts = join(
+        step_timer::run(&machine, &mut engine, &kicks),
+        tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu.clone(), &machine)),
     );
-    let mut firmware = pin!(firmware);
-    let flag = Arc::new(FlagWaker(AtomicBool::new(true)));
-    let waker = Waker::from(flag.clone());
-    let mut cx = Context::from_waker(&waker);
+    // Thread mode: polled only while no work charged there takes it (see `cpu::ThreadLevel`).
+    let thread = ThreadLevel::default();
+    let threads = join5(
+        tasks::keypad::run(&machine, &panel, columns, rows, SimSlices::new(cpu.clone(), &machine, &thread)),
+        tasks::serial::run(
+            &machine,
+            &mut store,
+            loaded,
+            (serial.clone(), serial.clone()),
+            (usb.clone(), usb.clone()),
+            SimSlices::new(cpu, &machine, &thread),
+        ),
+        tasks::lcd::run(&machine, &panel, lcd),
+        tasks::servo::run(
+            &machine,
+            son.clone(),
+            || inputs.levels(),
+            pen.clone(),
+            [led.clone(), buzzer.clone()],
+            || watchdog.feed(),
+        ),
+        tasks::homing::run(&machine),
+    );
+    let (mut interrupts, mut threads) = (pin!(interrupts), pin!(threads));
+    let (irq_flag, thread_flag) =
+        (Arc::new(FlagWaker(AtomicBool::new(true))), Arc::new(FlagWaker(AtomicBool::new(true))));
+    let (irq_waker, thread_waker) = (Waker::from(irq_flag.clone()), Waker::from(thread_flag.clone()));
+    let (mut irq_cx, mut thread_cx) = (Context::from_waker(&irq_waker), Context::from_waker(&thread_waker));
     let mut rest_since: Option<u64> = None;
     let mut timed_out = false;
     loop {
-        if flag.0.swap(false, Ordering::AcqRel) {
-            if let Poll::Ready(never) = firmware.as_mut().poll(&mut cx) {
+        // The interrupts first, whenever they are woken, as their priority has them on the board.
+        if irq_flag.0.swap(false, Ordering::AcqRel) {
+            if let Poll::Ready(never) = interrupts.as_mut().poll(&mut irq_cx) {
                 match never {}
             }
             continue;
         }
-        // Every task waits: the run may end, take live input, or jump to the next deadline.
+        if !thread.busy() && thread_flag.0.swap(false, Ordering::AcqRel) {
+            if let Poll::Ready((never, ..)) = threads.as_mut().poll(&mut thread_cx) {
+                match never {}
+            }
+            continue;
+        }
+        // Every task waits (or thread mode is taken): the run may end, take live input, or jump
+        // to the next deadline.
         serial.pump_live(std::time::Duration::ZERO);
-        if flag.0.load(Ordering::Acquire) {
+        let woken = |flag: &FlagWaker| flag.0.load(Ordering::Acquire);
+        let runnable = || woken(&irq_flag) || (woken(&thread_flag) && !thread.busy());
+        if runnable() {
             continue;
         }
         let now = clock::now_ticks();
+        // Thread mode taken: nothing there is at rest, and it takes its tasks up again once free.
+        let thread_free_at = thread.busy().then(|| thread.busy_until_us());
         let input_done = links.iter().all(|l| l.input_done());
-        if !matrix.started() && input_done && machine.at_rest() {
+        if !matrix.started() && input_done && thread_free_at.is_none() && machine.at_rest() {
             matrix.start();
         }
-        let at_rest = input_done && matrix.script_done() && machine.at_rest();
+        let at_rest = input_done && matrix.script_done() && thread_free_at.is_none() && machine.at_rest();
         if at_rest {
             let since = *rest_since.get_or_insert(now);
             if now >= since + SIM_SETTLE_US {
@@ -274,12 +294,17 @@ pub fn run(config: SimConfig) -> SimReport {
         } else {
             rest_since = None;
         }
+        // Thread mode taken with a task of it woken: it is polled once free.
+        let next_deadline = match (clock::next_deadline(), thread_free_at.filter(|_| woken(&thread_flag))) {
+            (Some(d), Some(free)) => Some(d.min(free)),
+            (d, free) => d.or(free),
+        };
         if serial.is_live() {
             // A person is at the terminal: let time pass as it does for them (so a `!` typed
             // mid-move lands mid-move), waiting for their input up to the next deadline.
-            let wait_us = clock::next_deadline().map_or(u64::MAX, |d| d.saturating_sub(now));
+            let wait_us = next_deadline.map_or(u64::MAX, |d| d.saturating_sub(now));
             serial.pump_live(std::time::Duration::from_micros(wait_us));
-            if flag.0.load(Ordering::Acquire) {
+            if runnable() {
                 continue;
             }
         } else if now >= SIM_MAX_VIRTUAL_US {
@@ -288,11 +313,12 @@ pub fn run(config: SimConfig) -> SimReport {
         }
         // A timed input byte due before the next timer deadline comes first.
         let next_timed = links.iter().filter_map(|l| l.next_timed_us()).min();
-        match (next_timed, clock::next_deadline()) {
+        match (next_timed, next_deadline) {
             (Some(t), deadline) if deadline.is_none_or(|d| t < d) => {
                 clock::jump_to(t);
                 links.iter().for_each(|l| l.deliver_due());
             }
+            (_, Some(d)) if clock::next_deadline() != Some(d) => clock::jump_to(d),
             _ => {
                 if !clock::jump_to_next_deadline() {
                     break;
@@ -313,6 +339,7 @@ pub fn run(config: SimConfig) -> SimReport {
         frames,
         lcd_writes_too_soon,
         serial_out: serial.output(),
+        serial_lines: serial.timed_lines(),
         usb_out: usb.output(),
         position,
         settings,

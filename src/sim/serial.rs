@@ -33,6 +33,8 @@ struct Link {
     owed: usize,
     /// The output seen so far that does not end in a line end yet.
     partial: Vec<u8>,
+    /// Every whole line of output (without its line end), with the virtual time it ended.
+    lines: Vec<(u64, std::string::String)>,
     /// Standard input read by a helper thread, when the simulator is driven live.
     live: Option<mpsc::Receiver<Vec<u8>>>,
     live_ended: bool,
@@ -146,6 +148,11 @@ impl SimSerial {
         self.link.borrow().output.clone()
     }
 
+    /// Every whole line the firmware wrote so far, with the virtual time, µs, it was written.
+    pub fn timed_lines(&self) -> Vec<(u64, std::string::String)> {
+        self.link.borrow().lines.clone()
+    }
+
     /// True when no input is waiting and none can come any more.
     pub fn input_done(&self) -> bool {
         let l = self.link.borrow();
@@ -214,6 +221,8 @@ impl Link {
         for &b in bytes {
             if b == b'\n' {
                 let line = core::mem::take(&mut self.partial);
+                let text = std::string::String::from_utf8_lossy(&line);
+                self.lines.push((crate::sim::clock::now_ticks(), text.trim_end_matches('\r').into()));
                 if line.starts_with(b"ok") || line.starts_with(b"error:") {
                     self.owed = self.owed.saturating_sub(1);
                 } else if line.starts_with(b"Grbl ") && self.reset_sent {
