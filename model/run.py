@@ -61,10 +61,10 @@ def build():
                    cwd=ROOT, check=True)
 
 
-def qemu_command(serial):
+def qemu_command(serial, extra=()):
     return [QEMU, "-M", "mps2-an386", "-display", "none", "-icount", ICOUNT,
             "-semihosting-config", "enable=on,target=native", "-kernel", ELF,
-            "-serial", serial, "-serial", "null"]
+            "-serial", serial, "-serial", "null", *extra]
 
 
 class Link:
@@ -229,7 +229,7 @@ def check(args):
     sock_path, mon_path = os.path.join(work, "uart0"), os.path.join(work, "monitor")
     defmt_path = os.path.join(ROOT, "target", "model", "defmt.bin")
     os.makedirs(os.path.dirname(defmt_path), exist_ok=True)
-    cmd = qemu_command("chardev:host") + [
+    cmd = qemu_command("chardev:host", args.qemu_arg) + [
         "-chardev", f"socket,id=host,path={sock_path},server=on,wait=on",
         "-monitor", f"unix:{mon_path},server=on,wait=off"]
     print("model: " + " ".join(cmd))
@@ -359,6 +359,8 @@ def main():
     parser.add_argument("--gcode", default=GCODE, help="the G-code file to stream (default: model/plot.gcode)")
     parser.add_argument("--pty", action="store_true", help="serve the host link on a pseudo-terminal instead")
     parser.add_argument("--no-build", action="store_true", help="use the image as built")
+    parser.add_argument("--qemu-arg", action="append", default=[],
+                        help="one more argument for QEMU (a plugin, say: --qemu-arg=-plugin --qemu-arg=FILE)")
     args = parser.parse_args()
     if not args.no_build:
         build()

@@ -14,12 +14,10 @@
 //! with a failure, as the F407's independent watchdog would reset the board.
 
 use core::cell::{Cell, RefCell};
-use core::sync::atomic::{AtomicU32, Ordering};
 
 use critical_section::{CriticalSection, Mutex};
 use embassy_time_driver::Driver;
 use embassy_time_queue_utils::Queue;
-use servoplot::wide;
 
 use super::regs::{self, *};
 
@@ -30,17 +28,38 @@ pub const CLOCKS_PER_US: u32 = 44;
 /// set again when it fires.
 const ALARM_MAX_CLOCKS: u64 = u32::MAX as u64;
 
-/// Times the free-running counter has wrapped (written only by its interrupt).
-static WRAPS: AtomicU32 = AtomicU32::new(0);
+/// The free-running counter's wraps, in µs: whole µs up to the last wrap, and the counts past
+/// the last whole µs (written only by its interrupt, read in critical sections).
+static WRAPS: Mutex<Cell<Wraps>> = Mutex::new(Cell::new(Wraps { us: 0, rest: 0 }));
 
-/// Counts of the model's timers since the clock started: the free-running counter's, with its
-/// wraps. In a critical section, so its interrupt cannot count a wrap between the two reads.
-fn now_clocks(_cs: CriticalSection) -> u64 {
+#[derive(Clone, Copy)]
+struct Wraps {
+    us: u64,
+    rest: u32,
+}
+
+/// µs since the clock started. In a critical section, so its interrupt cannot count a wrap
+/// between the reads; 32-bit divisions by a constant only (the time driver is read often).
+fn now_us(cs: CriticalSection) -> u64 {
     let value = regs::read(TIMER0, TIMER_VALUE);
+    let mut wraps = WRAPS.borrow(cs).get();
     // A wrap its interrupt has not counted yet: the value read is after it if it is high.
-    let pending = regs::read(TIMER0, TIMER_INTCLEAR) & 1 != 0 && value > u32::MAX / 2;
-    let wraps = u64::from(WRAPS.load(Ordering::Relaxed)) + u64::from(pending);
-    (wraps << 32) | u64::from(u32::MAX - value)
+    if regs::read(TIMER0, TIMER_INTCLEAR) & 1 != 0 && value > u32::MAX / 2 {
+        wraps = wraps.after_wrap();
+    }
+    let counted = u32::MAX - value;
+    let (whole, part) = (counted / CLOCKS_PER_US, counted % CLOCKS_PER_US);
+    wraps.us + u64::from(whole) + u64::from((part + wraps.rest) / CLOCKS_PER_US)
+}
+
+impl Wraps {
+    /// One wrap (2^32 counts) later.
+    fn after_wrap(self) -> Wraps {
+        // 2^32 counts: (2^32 - 1) / CLOCKS_PER_US whole µs and the rest, plus one count.
+        let wrap_us = u64::from(u32::MAX / CLOCKS_PER_US);
+        let rest = self.rest + u32::MAX % CLOCKS_PER_US + 1;
+        Wraps { us: self.us + wrap_us + u64::from(rest / CLOCKS_PER_US), rest: rest % CLOCKS_PER_US }
+    }
 }
 
 /// The poll clock: the free-running counter's low 32 bits, [`CLOCKS_PER_US`] a µs.
@@ -62,7 +81,7 @@ embassy_time_driver::time_driver_impl!(static DRIVER: ModelTime = ModelTime {
 
 impl ModelTime {
     fn now_us(&self, cs: CriticalSection) -> u64 {
-        wide::div_rem(now_clocks(cs), CLOCKS_PER_US as u16).0
+        now_us(cs)
     }
 
     /// Sets the alarm for `at` (µs); false, and no alarm, if `at` has passed.
@@ -119,9 +138,10 @@ pub fn start() {
 
 /// Timer 0's interrupt: the free-running counter wrapped.
 pub fn on_wrap() {
-    critical_section::with(|_| {
+    critical_section::with(|cs| {
         regs::write(TIMER0, TIMER_INTCLEAR, 1);
-        WRAPS.store(WRAPS.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
+        let wraps = WRAPS.borrow(cs);
+        wraps.set(wraps.get().after_wrap());
     });
 }
 

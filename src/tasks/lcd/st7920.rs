@@ -23,6 +23,7 @@ use embedded_graphics::Pixel;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::{Dimensions, OriginDimensions, Size};
 use embedded_graphics::pixelcolor::BinaryColor;
+use embedded_graphics::primitives::Rectangle;
 
 use embedded_hal::delay::DelayNs;
 use embedded_hal::digital::OutputPin;
@@ -224,14 +225,34 @@ impl<SPI: SpiDevice, PIN: OutputPin<Error = Infallible>, D: DelayNs> DrawTarget 
     type Color = BinaryColor;
     type Error = Infallible;
 
+    /// Into the crate's buffer (128x64, the screen its top-left 122x32), a pixel at a time.
     fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(&mut self, pixels: I) -> Result<(), Self::Error> {
-        // The crate's buffer is 128x64; the screen is its top-left 122x32.
-        let screen = self.bounding_box();
-        let on_screen = pixels.into_iter().filter(|Pixel(at, _)| screen.contains(*at));
-        match self.driver.draw_iter(on_screen) {
-            Ok(()) => Ok(()),
-            Err(_) => Ok(()),
+        for Pixel(at, color) in pixels {
+            if (0..SCREEN_WIDTH_PX as i32).contains(&at.x) && (0..SCREEN_HEIGHT_PX as i32).contains(&at.y) {
+                self.driver.set_pixel_unchecked(at.x as u8, at.y as u8, u8::from(color.is_on()));
+            }
         }
+        Ok(())
+    }
+
+    /// A box of one colour: cleared a byte at a time where it reaches the screen's right edge
+    /// (the crate clears whole bytes, and the columns past 122 show nothing), else a pixel at a
+    /// time, never through a pixel iterator.
+    fn fill_solid(&mut self, area: &Rectangle, color: BinaryColor) -> Result<(), Self::Error> {
+        let area = area.intersection(&self.bounding_box());
+        let Some(end) = area.bottom_right() else { return Ok(()) };
+        let (x, y, w, h) =
+            (area.top_left.x as u8, area.top_left.y as u8, area.size.width as u8, area.size.height as u8);
+        if color.is_off() && end.x == SCREEN_WIDTH_PX as i32 - 1 {
+            let _ = self.driver.clear_buffer_region(x, y, w, h);
+            return Ok(());
+        }
+        for row in y..y + h {
+            for column in x..x + w {
+                self.driver.set_pixel_unchecked(column, row, u8::from(color.is_on()));
+            }
+        }
+        Ok(())
     }
 }
 
