@@ -117,9 +117,24 @@ pub enum Rotation {
     CounterClockwise,
 }
 
-/// Pulse timer ticks per second: `StepCmd` intervals count these. The firmware's time base
-/// (embassy-time's tick rate) is the same.
-pub const TICK_HZ: u32 = 1_000_000;
+/// Step ticks per second: the step timer counts these, and `StepCmd` intervals, pulse widths,
+/// direction set-up and hold are whole numbers of them. A quarter of a microsecond: a 2.5 µs
+/// pulse at 200 kHz is 10 ticks high and 10 low, the step timer's prescaler stays whole on the
+/// STM32F407 (TIM1 at 168 MHz, 42 clocks a tick), and its 16-bit counter still spans 16 ms a
+/// period. The tasks' clock (embassy-time) is another, coarser one: convert through
+/// [`TICKS_PER_US`].
+pub const TICK_HZ: u32 = 4_000_000;
+
+/// Step ticks per microsecond.
+pub const TICKS_PER_US: u32 = {
+    assert!(TICK_HZ.is_multiple_of(1_000_000));
+    TICK_HZ / 1_000_000
+};
+
+/// `us` microseconds as whole step ticks, rounded up (a timing that must last at least `us`).
+pub fn us_to_ticks(us: f32) -> u32 {
+    crate::math::ceil(us * TICKS_PER_US as f32) as u32
+}
 
 /// One command for the pulse task: which axes step in which direction, and how long after the
 /// previous pulse this one is due.

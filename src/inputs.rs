@@ -46,6 +46,9 @@ pub enum Trip {
     DriverAlarm(Axis),
     /// The emergency stop was pressed.
     EStop,
+    /// The step timer's interrupt came a whole period late: the timer repeated a period (see
+    /// [`crate::pulse`]).
+    MissedUpdate,
 }
 
 impl Trip {
@@ -112,7 +115,7 @@ impl InputSetup {
     pub fn pressed(&self, levels: InputLevels, trip: Trip) -> bool {
         let bit = match trip {
             Trip::Limit { axis, max } => (1 << axis.index()) << if max { 2 } else { 0 },
-            Trip::DriverAlarm(_) | Trip::EStop => return false,
+            Trip::DriverAlarm(_) | Trip::EStop | Trip::MissedUpdate => return false,
         };
         (levels ^ self.active_low) & bit != 0
     }

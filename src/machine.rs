@@ -167,6 +167,9 @@ pub struct Machine {
     /// Times the pulse engine found the queue empty while the motion was not at rest
     /// (written only by the pulse engine).
     underruns: AtomicU32,
+    /// Times the step timer's interrupt came a whole period late (written only by the pulse
+    /// engine).
+    missed_updates: AtomicU32,
     /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
     drawing: AtomicU8,
     settings: Published<Settings>,
@@ -232,6 +235,7 @@ impl Machine {
             last_step: AtomicU16::new(0),
             work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
             underruns: AtomicU32::new(0),
+            missed_updates: AtomicU32::new(0),
             drawing: AtomicU8::new(0),
             settings: Published::new(settings),
             settings_changed: Signal::new(),
@@ -460,6 +464,18 @@ impl Machine {
     pub fn count_underrun(&self) {
         self.underruns.store(self.underruns.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
         warn!("step queue underrun: the motion task fell behind the pulses");
+    }
+
+    /// The step timer's interrupt came a whole period late or later: the timer repeated a
+    /// period the engine then counted (see [`crate::pulse`]). Only the pulse engine calls this.
+    pub fn count_missed_update(&self) {
+        self.missed_updates.store(self.missed_updates.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
+        warn!("missed step timer update: the pulse interrupt came a whole period late");
+    }
+
+    /// Missed step timer updates since power-on.
+    pub fn missed_updates(&self) -> u32 {
+        self.missed_updates.load(Ordering::Relaxed)
     }
 
     /// The motion task took a job drawing `kind`. Only the motion task calls this.
@@ -691,6 +707,7 @@ impl Machine {
             fault: self.fault(),
             door: self.door.load(Ordering::Relaxed),
             underruns: self.underruns(),
+            missed_updates: self.missed_updates(),
             overrides: self.overrides(),
             emitted_steps: self.emitted_steps.load(Ordering::Acquire),
             work_left: !self.stopped(),

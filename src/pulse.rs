@@ -4,17 +4,23 @@
 //!
 //! The motion task fills the step queue ([`StepQueue`], single producer, single consumer, no lock)
 //! with step commands, and marks where its motion comes to rest. The step timer counts one *period*
-//! at a time; a period is as long as the interval before a step, and the hardware ends it with a
-//! pulse of the pulse width on the axes that step (PWM outputs), so every pulse edge is placed by
-//! the timer, not by software. The period after the current one is *preloaded*: the timer switches
-//! to it by itself. At the start of each period (an update event) [`PulseEngine::on_period`] runs:
-//! it counts the pulses of the period that just ended, drives SIGN for the pulse that ends the
-//! period now starting (so SIGN settles for nearly a whole period before its edge, and never
-//! changes under a pulse), and preloads the next period from the next command.
+//! at a time; a period ends with a pulse of the pulse width (`$0`) on the axes that step (PWM
+//! outputs), so every pulse edge is placed by the timer, not by software. The period after the
+//! current one is *preloaded*: the timer switches to it by itself. At the start of each period (an
+//! update event) [`PulseEngine::on_period`] runs: it drives the SIGN levels the period's pulse
+//! needs, if they change, counts the pulses of the period that just ended, and preloads the next
+//! period from the next command.
 //!
-//! * A command whose directions differ from the last ones gets a period of at least the pulse
-//!   width plus the direction setup (`$0`, `$200`), and no period is shorter than one period of
-//!   `$205`.
+//! * SIGN timing. A pulse's SIGN level is steady from at least the hold (`$29`) after the
+//!   previous pulse's trailing edge to at least the set-up (`$200`) before its own leading edge.
+//!   Where a command's direction differs from the levels in force, the engine puts a pulse-less
+//!   period of the hold first (it starts at the previous pulse's trailing edge, an update event),
+//!   then the period ending in the command's pulse, at whose start it writes SIGN: that period
+//!   lasts at least the timer's interrupt latency ([`StepTimer::SIGN_LATENCY_TICKS`]) plus the
+//!   set-up plus the pulse width. The two together last the command's interval, or that minimum.
+//!   Where the direction stays, SIGN is not written at all.
+//! * No period between two pulses is shorter than one period of `$205`, nor than twice the pulse
+//!   width, so PULS is low at least as long as it is high at every rate.
 //! * An interval longer than the timer counts is split into pulse-less periods before its
 //!   pulse.
 //! * When the queue runs dry while the motion is not at rest ([`StepProducer::rest`]), the
@@ -23,6 +29,13 @@
 //!   planned.
 //! * When the queue runs dry at a rest, the engine stops the timer once the last pulse is out,
 //!   and signals the motion task.
+//! * A *missed update*: should the interrupt come a whole period late (or later), the timer has
+//!   meanwhile repeated the preloaded period, pulse included, as nothing preloaded another. The
+//!   engine learns from the timer how many update events really happened
+//!   ([`StepTimer::update_count`]), counts the repeated pulses into the position with the SIGN
+//!   levels they went out with (so the position stays the pulses emitted), counts the fault
+//!   ([`Machine::count_missed_update`]), trips the machine ([`Trip::MissedUpdate`]) and lets the
+//!   timer stop once the repeat under way is out, whole.
 //!
 //! At the start of each period the engine also samples the machine's inputs ([`crate::inputs`]):
 //! the limit switches the step now starting runs towards, the drivers' alarms and the emergency
@@ -34,8 +47,8 @@
 //! the step timer's interrupt, the highest priority; in the simulator a model of the timer
 //! calls it at the virtual times the hardware would.
 
-use crate::geom::{Axis, StepCmd, TICK_HZ};
-use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, limits_toward};
+use crate::geom::{Axis, StepCmd, TICK_HZ, TICKS_PER_US, us_to_ticks};
+use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, Trip, limits_toward};
 use crate::machine::Machine;
 use crate::math;
 use crate::settings::Settings;
@@ -43,12 +56,14 @@ use crate::settings::Settings;
 pub use queue::{STEP_QUEUE_LEN, StepConsumer, StepProducer, StepQueue};
 
 mod queue;
+#[cfg(test)]
+mod tests;
 
 /// Length of a pulse-less period while the engine waits for the motion task, ticks.
-pub const UNDERRUN_WAIT_TICKS: u32 = 20 * (TICK_HZ / 1_000_000);
+pub const UNDERRUN_WAIT_TICKS: u32 = 20 * TICKS_PER_US;
 
 /// Length of the pulse-less period after the last pulse, at whose start the timer stops.
-const TAIL_TICKS: u32 = 10 * (TICK_HZ / 1_000_000);
+const TAIL_TICKS: u32 = 10 * TICKS_PER_US;
 
 /// The hardware the engine drives and watches: a timer that counts one period at a time and ends
 /// each with a pulse on the axes chosen for it, the two SIGN outputs, and the machine's input
@@ -56,6 +71,12 @@ const TAIL_TICKS: u32 = 10 * (TICK_HZ / 1_000_000);
 pub trait StepTimer {
     /// Longest period the timer counts, ticks.
     const MAX_PERIOD_TICKS: u32;
+
+    /// Longest time from an update event until a SIGN level the engine drives in that event's
+    /// interrupt is on the pin, ticks: the interrupt's worst latency (its entry, and the longest
+    /// anything else keeps interrupts masked) and the code before the write. A period that
+    /// changes SIGN lasts this much longer, so the set-up holds however late the write comes.
+    const SIGN_LATENCY_TICKS: u32;
 
     /// Drives the SIGN output of `axis` high or low.
     fn set_sign(&mut self, axis: Axis, high: bool);
@@ -76,27 +97,48 @@ pub trait StepTimer {
 
     /// The levels of the machine's input pins, read at once.
     fn input_levels(&mut self) -> InputLevels;
+
+    /// The timer's update events so far, from any origin, wrapping at 2¹⁶: every period that
+    /// ended, whether or not its interrupt ran. The engine reads it once per interrupt and
+    /// compares it with its last reading, so only the difference matters: one when the
+    /// interrupt comes in time, more when periods ended meanwhile (the timer repeats the
+    /// preloaded period and its pulse until something preloads another). The update event of
+    /// [`start`](Self::start) may count or not.
+    ///
+    /// A board with a counter clocked by the timer's update event reads it (the STM32F407
+    /// clocks TIM4 from TIM1's update). A board with only a free-running clock counts in
+    /// software: it keeps the time of the last update it counted and the lengths of the active
+    /// and the preloaded period (from [`preload`](Self::preload)), and here counts every period
+    /// that has ended by now, the active one first, then the preloaded one as often as it fits.
+    fn update_count(&mut self) -> u16;
 }
 
 /// Pulse timing, taken from the settings whenever the timer starts.
-#[derive(Clone, Copy, Debug)]
-struct Timing {
-    width_ticks: u32,
-    /// Shortest period: the pulse width plus the direction setup, where SIGN changes.
-    dir_change_ticks: u32,
-    /// Shortest period between two pulses (`$205`).
-    min_period_ticks: u32,
-    invert_mask: u8,
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Timing {
+    /// The pulse width (`$0`).
+    pub width_ticks: u32,
+    /// Shortest period ending in a pulse: one period of `$205`, and at least twice the width.
+    pub min_period_ticks: u32,
+    /// The pulse-less period after a pulse before SIGN changes (`$29`).
+    pub hold_ticks: u32,
+    /// Shortest period at whose start SIGN changes: the interrupt's latency, the set-up
+    /// (`$200`) and the pulse width.
+    pub sign_period_ticks: u32,
+    /// `$3`: the axes whose SIGN is high for backward steps.
+    pub invert_mask: u8,
 }
 
 impl Timing {
-    fn from_settings(s: &Settings) -> Timing {
-        let ticks_per_us = (TICK_HZ / 1_000_000) as f32;
-        let width_ticks = math::ceil(s.pulse_width_us * ticks_per_us) as u32;
+    /// The timing of `s` on a timer whose SIGN writes come up to `sign_latency_ticks` late.
+    pub fn new(s: &Settings, sign_latency_ticks: u32) -> Timing {
+        let width_ticks = us_to_ticks(s.pulse_width_us);
+        let rate_period_ticks = math::ceil(TICK_HZ as f32 / s.max_pulse_rate_hz) as u32;
         Timing {
             width_ticks,
-            dir_change_ticks: width_ticks + math::ceil(s.dir_setup_us * ticks_per_us) as u32,
-            min_period_ticks: math::ceil(TICK_HZ as f32 / s.max_pulse_rate_hz) as u32,
+            min_period_ticks: rate_period_ticks.max(2 * width_ticks),
+            hold_ticks: us_to_ticks(s.dir_hold_us),
+            sign_period_ticks: sign_latency_ticks + us_to_ticks(s.dir_setup_us) + width_ticks,
             invert_mask: s.dir_invert_mask,
         }
     }
@@ -116,44 +158,62 @@ impl Signs {
         moving & (!self.known | (self.high ^ high))
     }
 
-    /// The levels once the axes in `moving` are set to `high`.
+    /// The levels once the axes in `axes` are set to `high` (within `axes`).
     #[inline(always)]
-    fn set(&mut self, moving: u8, high: u8) {
-        self.high = (self.high & !moving) | high;
-        self.known |= moving;
+    fn set(&mut self, axes: u8, high: u8) {
+        self.high = (self.high & !axes) | high;
+        self.known |= axes;
     }
 }
 
-/// The axes `cmd` steps (bits, bit 0 X, bit 1 Y), and the SIGN levels it needs on them with
-/// the direction invert mask `invert` (`$3`).
+/// The axes `cmd` steps and those it steps forward (bits, bit 0 X, bit 1 Y).
 #[inline(always)]
-fn step_bits(cmd: StepCmd, invert: u8) -> (u8, u8) {
+fn step_bits(cmd: StepCmd) -> (u8, u8) {
     let s = cmd.step;
     let moving = u8::from(s.x != 0) | (u8::from(s.y != 0) << 1);
     let forward = u8::from(s.x > 0) | (u8::from(s.y > 0) << 1);
-    (moving, (forward ^ invert) & moving)
+    (moving, forward)
 }
 
-/// One period of the timer.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Period {
-    /// `ticks` long, ending with the pulse of this step.
-    Step { cmd: StepCmd, ticks: u32 },
-    /// `ticks` long, no pulse: waiting through a long interval, or for the motion task.
-    Wait { ticks: u32 },
+/// What a period is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    /// Ends with the pulse of a queued step.
+    Step,
+    /// No pulse: SIGN's hold, a long interval, or waiting for the motion task.
+    Wait,
     /// The timer stops when this period starts.
     Tail,
 }
 
+/// One period of the timer, as the engine preloads it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Period {
+    ticks: u32,
+    kind: Kind,
+    /// The step whose pulse ends the period ([`Kind::Step`]).
+    cmd: StepCmd,
+    /// The axes pulsed at its end (bit 0 X, bit 1 Y).
+    axes: u8,
+    /// SIGN levels driven as the period starts, on the axes of `sign_changes` (bits).
+    sign_high: u8,
+    sign_changes: u8,
+    /// The limit switches its motion runs towards.
+    toward: u8,
+}
+
 impl Period {
-    /// Ticks, and the axes pulsed at the end (bit 0 X, bit 1 Y).
-    #[inline(always)]
-    fn timer_load(self) -> (u32, u8) {
-        match self {
-            Period::Step { cmd, ticks } => (ticks, step_bits(cmd, 0).0),
-            Period::Wait { ticks } => (ticks, 0),
-            Period::Tail => (TAIL_TICKS, 0),
-        }
+    const TAIL: Period = Period::pulseless(TAIL_TICKS, Kind::Tail, 0);
+
+    const fn pulseless(ticks: u32, kind: Kind, toward: u8) -> Period {
+        let cmd = StepCmd { step: crate::geom::Step::NONE, interval_ticks: 0 };
+        Period { ticks, kind, cmd, axes: 0, sign_high: 0, sign_changes: 0, toward }
+    }
+
+    /// A pulse-less period of `ticks` in a motion towards the switches of `toward`: they stay
+    /// watched while it waits.
+    const fn wait(ticks: u32, toward: u8) -> Period {
+        Period::pulseless(ticks, Kind::Wait, toward)
     }
 }
 
@@ -169,8 +229,9 @@ pub struct PulseEngine<'q, T: StepTimer> {
     /// SIGN levels driven, and those in force once the preloaded period starts.
     sign: Signs,
     sign_preloaded: Signs,
-    /// A step whose interval is longer than the timer counts, and the ticks still to wait.
-    long_wait: Option<(StepCmd, u32)>,
+    /// A step whose pulse comes after pulse-less periods (SIGN's hold, an interval longer than
+    /// the timer counts), and the ticks from the end of those to its pulse.
+    pending: Option<(StepCmd, u32)>,
     /// The queue ran dry before a rest: an underrun is under way (counted once).
     starving: bool,
     /// The inputs as the settings were when the timer started, and their debounce.
@@ -178,8 +239,8 @@ pub struct PulseEngine<'q, T: StepTimer> {
     debounce: Debounce,
     /// Ticks counted (wrapping), up to the end of the preloaded period: the debounce's clock.
     clock_ticks: u32,
-    /// The limit switches the step of the active period runs towards.
-    toward: u8,
+    /// [`StepTimer::update_count`] when the engine last ran.
+    updates: u16,
 }
 
 impl<'q, T: StepTimer> PulseEngine<'q, T> {
@@ -187,18 +248,18 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         PulseEngine {
             timer,
             queue,
-            timing: Timing::from_settings(&Settings::default()),
+            timing: Timing::new(&Settings::default(), T::SIGN_LATENCY_TICKS),
             running: false,
-            active: Period::Tail,
-            preloaded: Period::Tail,
+            active: Period::TAIL,
+            preloaded: Period::TAIL,
             sign: Signs::default(),
             sign_preloaded: Signs::default(),
-            long_wait: None,
+            pending: None,
             starving: false,
             inputs: InputSetup::from_settings(&Settings::default()),
             debounce: Debounce::default(),
             clock_ticks: 0,
-            toward: 0,
+            updates: 0,
         }
     }
 
@@ -216,6 +277,11 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         self.running
     }
 
+    /// The timing in force since the timer last started.
+    pub fn timing(&self) -> Timing {
+        self.timing
+    }
+
     /// The motion task queued commands: starts the timer if it is stopped and a step is queued.
     pub fn kick(&mut self, machine: &Machine) {
         if self.running || machine.halted() {
@@ -225,7 +291,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             return;
         }
         let settings = machine.settings();
-        self.timing = Timing::from_settings(&settings);
+        self.timing = Timing::new(&settings, T::SIGN_LATENCY_TICKS);
         self.inputs = InputSetup::from_settings(&settings);
         if machine.homing() {
             // The homing cycle's approaches end at their switch.
@@ -233,54 +299,84 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         }
         self.debounce.clear();
         self.sign_preloaded = self.sign;
+        self.active = Period::TAIL;
         let first = self.next_period(machine);
-        self.active = Period::Tail;
         self.preload(first);
+        self.updates = self.timer.update_count();
         self.running = true;
         machine.set_pulsing(true);
         self.timer.start(self.timing.width_ticks);
     }
 
-    /// A period starts (the timer's update event): counts the pulses of the period that ended,
-    /// drives SIGN for this period's pulse, and preloads the next period. What it calls is
-    /// `#[inline(always)]`: the image is built for size, and this is the one path where a call
-    /// costs more than it saves (`cost/` counts it per pulse).
+    /// A period starts (the timer's update event): drives SIGN for this period's pulse if it
+    /// changes, counts the pulses of the period that ended, and preloads the next period. What
+    /// it calls on the way of every pulse is `#[inline(always)]` (`cost/` counts it per pulse).
     pub fn on_period(&mut self, machine: &Machine) {
         if !self.running {
             return;
         }
-        if let Period::Step { cmd, .. } = self.active {
-            machine.emitted(cmd);
+        let count = self.timer.update_count();
+        let updates = count.wrapping_sub(self.updates);
+        self.updates = count;
+        if updates > 1 {
+            self.missed_updates(machine, updates - 1);
+            return;
         }
-        self.active = self.preloaded;
-        // The axes this period's pulse steps, and those it steps forward.
-        let mut directions = (0, 0);
-        if let Period::Step { cmd, .. } = self.active {
-            directions = step_bits(cmd, 0);
-            self.toward = limits_toward(directions.0, directions.1);
+        // SIGN first: the sooner after the update event, the less of the set-up it takes.
+        let starting = self.preloaded;
+        if starting.sign_changes != 0 {
+            self.drive_signs(starting.sign_changes, starting.sign_high);
         }
+        if self.active.kind == Kind::Step {
+            machine.emitted(self.active.cmd);
+        }
+        self.active = starting;
         if self.tripped(machine) {
             self.timer.halt();
             self.stopped(machine);
             return;
         }
-        match self.active {
-            Period::Step { .. } => self.drive_signs(directions.0, directions.1),
-            Period::Wait { .. } => {}
-            Period::Tail => {
-                // The last pulse is out. Go on from rest if more came in behind the rest.
-                let next = self.next_period(machine);
-                if next == Period::Tail {
-                    self.timer.stop();
-                    self.stopped(machine);
-                    return;
+        let next = self.next_period(machine);
+        if starting.kind == Kind::Tail && next.kind == Kind::Tail {
+            // The last pulse is out, and nothing came in behind the rest.
+            self.timer.stop();
+            self.stopped(machine);
+            return;
+        }
+        self.preload(next);
+    }
+
+    /// The interrupt came `extra` whole periods late: see the module documentation.
+    #[cold]
+    #[inline(never)]
+    fn missed_updates(&mut self, machine: &Machine, extra: u16) {
+        if self.active.kind == Kind::Step {
+            machine.emitted(self.active.cmd);
+        }
+        // The preloaded period ran `extra` times and runs once more now. Its SIGN levels, if it
+        // was to change them, were never driven: its pulses went out with those in force.
+        let mut repeated = self.preloaded;
+        repeated.sign_changes = 0;
+        if repeated.kind == Kind::Step {
+            let forward = self.sign.high ^ self.timing.invert_mask;
+            let along = |axis: u8| -> i8 {
+                match (repeated.axes & axis != 0, forward & axis != 0) {
+                    (false, _) => 0,
+                    (true, true) => 1,
+                    (true, false) => -1,
                 }
-                self.preload(next);
-                return;
+            };
+            repeated.cmd.step = crate::geom::Step::new(along(1), along(2));
+            for _ in 0..extra {
+                machine.emitted(repeated.cmd);
             }
         }
-        let next = self.next_period(machine);
-        self.preload(next);
+        self.clock_ticks = self.clock_ticks.wrapping_add(repeated.ticks.wrapping_mul(u32::from(extra)));
+        self.active = repeated;
+        machine.count_missed_update();
+        machine.trip(Trip::MissedUpdate);
+        // Nothing more: the timer stops once the repeat under way is out.
+        self.preload(Period::TAIL);
     }
 
     /// Samples the inputs the active period watches; true once the machine has tripped, by them
@@ -288,7 +384,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     #[inline(always)]
     fn tripped(&mut self, machine: &Machine) -> bool {
         let levels = self.timer.input_levels();
-        let active = self.inputs.active(levels) & (self.toward | ALWAYS_WATCHED);
+        let active = self.inputs.active(levels) & (self.active.toward | ALWAYS_WATCHED);
         if (active != 0 || self.debounce.holding())
             && let Some(trip) = self.debounce.sample(active, self.clock_ticks, self.inputs.debounce_ticks)
         {
@@ -300,9 +396,9 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// The timer has stopped: the engine is ready for the next kick.
     fn stopped(&mut self, machine: &Machine) {
         self.running = false;
-        self.active = Period::Tail;
-        self.preloaded = Period::Tail;
-        self.long_wait = None;
+        self.active = Period::TAIL;
+        self.preloaded = Period::TAIL;
+        self.pending = None;
         self.starving = false;
         machine.set_pulsing(false);
         machine.pulses_stopped();
@@ -311,313 +407,77 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     #[inline(always)]
     fn preload(&mut self, period: Period) {
         self.preloaded = period;
-        let (ticks, axes) = period.timer_load();
         // The debounce's clock runs one period ahead: only its differences count.
-        self.clock_ticks = self.clock_ticks.wrapping_add(ticks);
-        self.timer.preload(ticks, axes);
+        self.clock_ticks = self.clock_ticks.wrapping_add(period.ticks);
+        self.timer.preload(period.ticks, period.axes);
     }
 
-    /// Drives SIGN for the axes in `moving`, those in `forward` forward.
+    /// Drives SIGN high or low as `high` says on the axes of `changes`.
     #[inline(always)]
-    fn drive_signs(&mut self, moving: u8, forward: u8) {
-        let high = (forward ^ self.timing.invert_mask) & moving;
-        let changes = self.sign.changes(moving, high);
-        if changes != 0 {
-            for axis in Axis::ALL {
-                let bit = 1 << axis.index();
-                if changes & bit != 0 {
-                    self.timer.set_sign(axis, high & bit != 0);
-                }
+    fn drive_signs(&mut self, changes: u8, high: u8) {
+        for axis in Axis::ALL {
+            let bit = 1 << axis.index();
+            if changes & bit != 0 {
+                self.timer.set_sign(axis, high & bit != 0);
             }
-            self.sign.set(moving, high);
         }
+        self.sign.set(changes, high & changes);
     }
 
     /// What follows the preloaded period.
     #[inline(always)]
     fn next_period(&mut self, machine: &Machine) -> Period {
-        if let Some((cmd, left)) = self.long_wait {
-            return self.step_period(cmd, left);
-        }
-        match self.queue.pop() {
-            Some(cmd) => {
-                self.starving = false;
-                let ticks = self.step_ticks(cmd);
-                self.step_period(cmd, ticks)
-            }
-            None if self.queue.at_rest() => Period::Tail,
-            None => {
-                if !self.starving {
-                    self.starving = true;
-                    machine.count_underrun();
+        let (cmd, ticks) = match self.pending.take() {
+            Some(pending) => pending,
+            None => match self.queue.pop() {
+                Some(cmd) => {
+                    self.starving = false;
+                    let ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
+                    let (moving, forward) = step_bits(cmd);
+                    let high = (forward ^ self.timing.invert_mask) & moving;
+                    if self.sign_preloaded.changes(moving, high) != 0 {
+                        // SIGN holds after the last pulse, then changes as the pulse's own
+                        // period starts.
+                        let hold = self.timing.hold_ticks;
+                        self.pending = Some((cmd, ticks.saturating_sub(hold).max(self.timing.sign_period_ticks)));
+                        return Period::wait(hold, limits_toward(moving, forward));
+                    }
+                    (cmd, ticks)
                 }
-                Period::Wait { ticks: UNDERRUN_WAIT_TICKS }
-            }
-        }
-    }
-
-    /// The period before `cmd`'s pulse: its interval, at least one period of the max pulse
-    /// rate, and where a direction changes, at least the pulse width plus the direction setup.
-    #[inline(always)]
-    fn step_ticks(&mut self, cmd: StepCmd) -> u32 {
-        let mut ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
-        let (moving, high) = step_bits(cmd, self.timing.invert_mask);
-        if self.sign_preloaded.changes(moving, high) != 0 {
-            ticks = ticks.max(self.timing.dir_change_ticks);
-            self.sign_preloaded.set(moving, high);
-        }
-        ticks
-    }
-
-    /// `ticks` before `cmd`'s pulse: pulse-less periods first where the timer cannot count so
-    /// far.
-    #[inline(always)]
-    fn step_period(&mut self, cmd: StepCmd, ticks: u32) -> Period {
+                None if self.queue.at_rest() => return Period::TAIL,
+                None => {
+                    if !self.starving {
+                        self.starving = true;
+                        machine.count_underrun();
+                    }
+                    return Period::wait(UNDERRUN_WAIT_TICKS, self.preloaded.toward);
+                }
+            },
+        };
         if ticks > T::MAX_PERIOD_TICKS {
             let wait = T::MAX_PERIOD_TICKS / 2;
-            self.long_wait = Some((cmd, ticks - wait));
-            return Period::Wait { ticks: wait };
+            self.pending = Some((cmd, ticks - wait));
+            let (moving, forward) = step_bits(cmd);
+            return Period::wait(wait, limits_toward(moving, forward));
         }
-        self.long_wait = None;
-        Period::Step { cmd, ticks }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    extern crate std;
-    use super::*;
-    use crate::geom::{Point, Step};
-    use std::vec::Vec;
-
-    /// What a mock timer saw: every period in the order the hardware counted them, with the
-    /// SIGN levels in force while it counted.
-    #[derive(Default)]
-    struct MockTimer {
-        preload: (u32, u8),
-        running: bool,
-        started: bool,
-        sign: [bool; 2],
-        /// (ticks, axes pulsed at the end, SIGN levels).
-        periods: Vec<(u32, u8, [bool; 2])>,
-        /// The input levels read, and from which read on (counting from 1) they change to what.
-        levels: InputLevels,
-        then: Option<(usize, InputLevels)>,
-        reads: usize,
-        halts: usize,
+        self.step_period(cmd, ticks)
     }
 
-    impl StepTimer for MockTimer {
-        const MAX_PERIOD_TICKS: u32 = 65_535;
-        fn set_sign(&mut self, axis: Axis, high: bool) {
-            self.sign[axis.index()] = high;
+    /// The period of `ticks` that ends with `cmd`'s pulse, driving the SIGN levels it needs.
+    #[inline(always)]
+    fn step_period(&mut self, cmd: StepCmd, ticks: u32) -> Period {
+        let (moving, forward) = step_bits(cmd);
+        let high = (forward ^ self.timing.invert_mask) & moving;
+        let sign_changes = self.sign_preloaded.changes(moving, high);
+        self.sign_preloaded.set(moving, high);
+        Period {
+            ticks,
+            kind: Kind::Step,
+            cmd,
+            axes: moving,
+            sign_high: high,
+            sign_changes,
+            toward: limits_toward(moving, forward),
         }
-        fn preload(&mut self, ticks: u32, axes: u8) {
-            self.preload = (ticks, axes);
-        }
-        fn start(&mut self, _width_ticks: u32) {
-            self.running = true;
-            self.started = true;
-        }
-        fn stop(&mut self) {
-            self.running = false;
-        }
-        fn halt(&mut self) {
-            self.running = false;
-            self.halts += 1;
-        }
-        fn input_levels(&mut self) -> InputLevels {
-            self.reads += 1;
-            match self.then {
-                Some((from, levels)) if self.reads >= from => levels,
-                _ => self.levels,
-            }
-        }
-    }
-
-    /// Runs the engine as the hardware would until it stops (or `max` periods): at each update
-    /// event the preloaded period becomes active and the interrupt runs. `between` runs after
-    /// each period, as the motion task could.
-    fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, mut between: impl FnMut(usize)) {
-        engine.kick(machine);
-        if !core::mem::take(&mut engine.timer_mut().started) {
-            return;
-        }
-        for k in 0..max {
-            let (ticks, axes) = engine.timer().preload;
-            engine.on_period(machine);
-            if !engine.timer().running {
-                return;
-            }
-            let sign = engine.timer().sign;
-            engine.timer_mut().periods.push((ticks, axes, sign));
-            between(k);
-        }
-    }
-
-    fn step(x: i8, y: i8, interval_ticks: u32) -> StepCmd {
-        StepCmd { step: Step::new(x, y), interval_ticks }
-    }
-
-    /// Publishes `cmds`, then a rest if `rest`.
-    fn queue(p: &mut StepProducer<'_>, cmds: &[StepCmd], rest: bool) {
-        let slots = p.free_slots();
-        slots[..cmds.len()].copy_from_slice(cmds);
-        p.publish(cmds.len());
-        if rest {
-            p.rest();
-        }
-    }
-
-    #[test]
-    fn steps_become_periods_ending_in_their_pulses_and_the_timer_stops_after_the_rest() {
-        let machine = Machine::new(Settings::default()); // 5 µs pulses, 10 µs direction setup
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &[step(1, 0, 100), step(1, 1, 60), step(0, 1, 60)], true);
-        machine.set_queued(3, 220);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        run(&mut engine, &machine, 100, |_| {});
-        let periods = &engine.timer().periods;
-        assert_eq!(periods.iter().map(|&(t, a, _)| (t, a)).collect::<Vec<_>>()[..3], [(100, 1), (60, 3), (60, 2)]);
-        // SIGN high (forward) on each moving axis for its pulse.
-        assert_eq!(periods[1].2, [true, true]);
-        assert!(!engine.is_running());
-        assert_eq!(machine.position(), Point::new(2, 2));
-        assert!(machine.pulses_idle());
-        assert_eq!(machine.underruns(), 0);
-        assert_eq!(machine.queued_ticks(), 0);
-    }
-
-    /// The ticks of the periods an engine with `settings` makes of `cmds`.
-    fn period_ticks(settings: Settings, cmds: &[StepCmd]) -> Vec<u32> {
-        let machine = Machine::new(settings);
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, cmds, true);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        run(&mut engine, &machine, 100, |_| {});
-        engine.timer().periods.iter().map(|p| p.0).collect()
-    }
-
-    #[test]
-    fn a_direction_change_gets_the_pulse_width_plus_the_direction_setup() {
-        // 5 µs pulses and 10 µs direction setup; at up to 100 kHz a reversal 10 µs after the
-        // last pulse is stretched to 15 µs, the steps after it keep their 10 µs.
-        let fast = Settings { max_pulse_rate_hz: 100_000.0, ..Settings::default() };
-        let cmds = [step(1, 0, 50), step(-1, 0, 10), step(-1, 0, 10), step(-1, 1, 10)];
-        assert_eq!(period_ticks(fast, &cmds)[..4], [50, 15, 10, 15]);
-        // At the default 20 kHz the 50 µs floor of `$205` covers the setup.
-        assert_eq!(period_ticks(Settings::default(), &cmds)[..4], [50, 50, 50, 50]);
-        // SIGN changes at the start of the period that ends with the reversed pulse.
-        let machine = Machine::new(fast);
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &cmds, true);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        run(&mut engine, &machine, 100, |_| {});
-        let signs: Vec<[bool; 2]> = engine.timer().periods.iter().map(|p| p.2).collect();
-        assert_eq!(signs[..4], [[true, false], [false, false], [false, false], [false, true]]);
-    }
-
-    #[test]
-    fn an_interval_longer_than_the_timer_counts_waits_in_pulseless_periods() {
-        let machine = Machine::new(Settings::default());
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &[step(0, -1, 600_000), step(0, -1, 100)], true);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        run(&mut engine, &machine, 100, |_| {});
-        let periods = &engine.timer().periods;
-        let until_first: u32 = periods.iter().take_while(|p| p.1 == 0).map(|p| p.0).sum::<u32>();
-        let first = periods.iter().position(|p| p.1 != 0).unwrap();
-        assert_eq!(until_first + periods[first].0, 600_000);
-        assert!(periods.iter().all(|p| p.0 <= 65_535));
-        assert_eq!(periods[first + 1], (100, 2, [false, false]));
-        assert_eq!(machine.position(), Point::new(0, -2));
-    }
-
-    #[test]
-    fn a_queue_run_dry_before_the_rest_is_one_underrun_and_never_a_burst() {
-        let machine = Machine::new(Settings::default());
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &[step(1, 0, 100); 3], false);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        // The motion task catches up only after the 10th period, then finishes.
-        run(&mut engine, &machine, 1_000, |k| {
-            if k == 10 {
-                queue(&mut p, &[step(1, 0, 100); 2], true);
-            }
-        });
-        let periods = &engine.timer().periods;
-        assert_eq!(machine.underruns(), 1);
-        assert_eq!(machine.position(), Point::new(5, 0));
-        // Every pulse comes at least its interval after the one before.
-        let mut since = 0;
-        let mut gaps = Vec::new();
-        for &(t, a, _) in periods.iter() {
-            since += t;
-            if a != 0 {
-                gaps.push(since);
-                since = 0;
-            }
-        }
-        assert!(gaps.iter().all(|&g| g >= 100), "{gaps:?}");
-        assert!(periods.iter().any(|p| p.1 == 0 && p.0 == UNDERRUN_WAIT_TICKS));
-    }
-
-    #[test]
-    fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts_until_unlocked() {
-        use crate::inputs::{LIMIT_X_MAX, LIMIT_X_MIN, LIMITS, Trip};
-        // Hard limits, no debounce; normally open switches read low when pressed.
-        let settings = Settings { hard_limits: true, input_debounce_ms: 0, ..Settings::default() };
-        let machine = Machine::new(settings);
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &[step(1, 0, 100); 10], true);
-        // The X min switch, behind the pen, is pressed from the start and never stops it; the X
-        // max switch closes at the fifth period.
-        let timer = MockTimer {
-            levels: LIMITS & !LIMIT_X_MIN,
-            then: Some((5, LIMITS & !LIMIT_X_MIN & !LIMIT_X_MAX)),
-            ..MockTimer::default()
-        };
-        let mut engine = PulseEngine::new(timer, c);
-        run(&mut engine, &machine, 100, |_| {});
-        assert_eq!(engine.timer().halts, 1);
-        assert!(machine.halted());
-        assert_eq!(machine.position(), Point::new(4, 0), "the pulses of the periods before");
-        assert_eq!(machine.take_trip(), Some(Trip::Limit { axis: Axis::X, max: true }));
-        engine.kick(&machine);
-        assert!(!engine.is_running(), "halted: no kick starts the timer");
-        machine.unlock();
-        engine.kick(&machine);
-        assert!(engine.is_running(), "unlocked, the queued steps go on");
-    }
-
-    #[test]
-    fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
-        let machine = Machine::new(Settings::default());
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        queue(&mut p, &[step(1, 0, 100)], true);
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        let mut more = Some(step(0, 1, 2_000));
-        run(&mut engine, &machine, 100, |_| {
-            if let Some(cmd) = more.take() {
-                queue(&mut p, &[cmd], true);
-            }
-        });
-        assert_eq!(machine.position(), Point::new(1, 1));
-        assert_eq!(machine.underruns(), 0);
-        assert!(!engine.is_running());
-        // A kick with nothing queued does not start the timer.
-        let mut q = StepQueue::new();
-        let (mut p, c) = q.split();
-        p.rest();
-        let mut engine = PulseEngine::new(MockTimer::default(), c);
-        engine.kick(&machine);
-        assert!(!engine.is_running());
     }
 }

@@ -95,6 +95,7 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 25, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
     SettingInfo { id: 26, unit: Unit::Ms, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
     SettingInfo { id: 27, unit: Unit::Mm, min: 0.1, max: 20.0 },
+    SettingInfo { id: 29, unit: Unit::Us, min: 5.0, max: 100.0 },
     SettingInfo { id: 100, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
     SettingInfo { id: 101, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
     SettingInfo { id: 110, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
@@ -167,8 +168,11 @@ pub struct Settings {
     pub accel_mm_per_s2: [f32; 2],
     /// Travel from the origin, either way, per axis ($130, $131).
     pub max_travel_mm: [f32; 2],
-    /// SIGN must settle this long before a PULS edge ($200).
+    /// SIGN must settle this long before a pulse's leading edge ($200).
     pub dir_setup_us: f32,
+    /// SIGN must stay this long after a pulse's trailing edge before it changes ($29; grblHAL
+    /// numbers its step pulse delay so).
+    pub dir_hold_us: f32,
     /// Speed at which motion starts and ends; servos stall above their start rate ($201).
     pub start_rate_mm_per_min: f32,
     /// Interpolation method ($202).
@@ -239,7 +243,8 @@ const DEFAULT_SETTINGS: Settings = Settings {
     max_rate_mm_per_min: [6_000.0, 6_000.0],
     accel_mm_per_s2: [500.0, 500.0],
     max_travel_mm: [200.0, 200.0],
-    dir_setup_us: 10.0,
+    dir_setup_us: 5.0,
+    dir_hold_us: 5.0,
     start_rate_mm_per_min: 300.0,
     method: Method::Diagonal,
     default_feed_mm_per_min: 3_000.0,
@@ -295,6 +300,7 @@ impl Settings {
             25 => Field::Real(&mut self.homing_seek_mm_per_min),
             26 => Field::Whole(&mut self.homing_debounce_ms),
             27 => Field::Real(&mut self.homing_pull_off_mm),
+            29 => Field::Real(&mut self.dir_hold_us),
             100 | 101 => Field::Real(&mut self.steps_per_mm[usize::from(id - 100)]),
             110 | 111 => Field::Real(&mut self.max_rate_mm_per_min[usize::from(id - 110)]),
             120 | 121 => Field::Real(&mut self.accel_mm_per_s2[usize::from(id - 120)]),
@@ -380,11 +386,18 @@ impl Settings {
     /// Rules that tie settings together.
     fn check(&self) -> Result<(), SettingError> {
         let slowest_max = self.max_rate_mm_per_min[0].min(self.max_rate_mm_per_min[1]);
-        let fits_in_period = self.pulse_width_us * 2.0 <= 1e6 / self.max_pulse_rate_hz;
-        if self.start_rate_mm_per_min > slowest_max || !fits_in_period {
+        if self.start_rate_mm_per_min > slowest_max || !self.pulse_fits_in_period() {
             return Err(SettingError::OutOfRange);
         }
         Ok(())
+    }
+
+    /// True when a pulse of `$0` and as long again with PULS low fit in one period of `$205`,
+    /// in whole step ticks as the step timer counts them: what caps `$205` (at 2.5 µs, 200 kHz).
+    pub fn pulse_fits_in_period(&self) -> bool {
+        let width_ticks = crate::geom::us_to_ticks(self.pulse_width_us);
+        let period_ticks = crate::math::ceil(crate::geom::TICK_HZ as f32 / self.max_pulse_rate_hz) as u32;
+        2 * width_ticks <= period_ticks
     }
 
     /// The travel limits in steps, either way from machine zero: the lattice points the pen may

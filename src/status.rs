@@ -69,6 +69,9 @@ pub struct Status {
     /// Times the pulses had to wait for the motion task since power-on (step-queue underruns):
     /// where the machine could not keep up with the speeds it planned.
     pub underruns: u32,
+    /// Times the step timer's interrupt came a whole period late since power-on: each stopped
+    /// the machine in an alarm (the position stays the pulses emitted).
+    pub missed_updates: u32,
     /// The feed, rapid and spindle overrides in force.
     pub overrides: Overrides,
     /// Steps emitted since power-on (wrapping): how far the motion has come.

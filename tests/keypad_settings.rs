@@ -33,7 +33,7 @@ fn settings_screen_at(n: usize) -> String {
 
 #[test]
 fn a_setting_typed_on_the_keypad_is_used_reported_and_kept_across_a_power_cycle() {
-    let first = power_on(SimFlash::default(), &format!("{} 4 5 0 0 # wait:500", settings_screen_at(17)), "");
+    let first = power_on(SimFlash::default(), &format!("{} 4 5 0 0 # wait:500", settings_screen_at(18)), "");
     assert_eq!(first.settings.max_rate_mm_per_min, [4500.0, 6000.0]);
     let (_, last) = first.frames.last().unwrap();
     assert_eq!((text(last, 1, 24), text(last, 2, 24)), ("$110 X max rate".into(), "4500 mm/min".into()));
@@ -59,7 +59,7 @@ fn a_speed_preset_writes_its_speeds_and_they_are_kept() {
 #[test]
 fn a_clashing_setting_changes_nothing_and_says_why() {
     // $201, the start rate, above the axes' top speed of 6000 mm/min.
-    let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(24)), "");
+    let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(25)), "");
     let (_, last) = report.frames.last().unwrap();
     assert_eq!(text(last, 1, 24), "$201 Start rate");
     assert_eq!(text(last, 3, 24), "Clashes with $201 or $0");

@@ -9,7 +9,7 @@ use core::pin::pin;
 use core::task::{Context, Poll, Waker};
 
 use servoplot::drawing::{self, Request};
-use servoplot::geom::Point;
+use servoplot::geom::{Point, TICKS_PER_US};
 use servoplot::interp::Curve;
 use servoplot::job::{Feed, Job};
 use servoplot::machine::{Machine, MotionFault, Refused};
@@ -62,7 +62,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
         }
         // The pulse side emits everything queued, each step after its interval.
         while let Some(cmd) = consumer.pop() {
-            clock::jump_to(clock::now_ticks() + u64::from(cmd.interval_ticks));
+            clock::jump_to(clock::now_ticks() + u64::from(cmd.interval_ticks.div_ceil(TICKS_PER_US)));
             machine.emitted(cmd);
             path.push(machine.position());
         }

@@ -237,9 +237,9 @@ fn pulse_path_runs() {
     }
 }
 
-/// Interval between pulses in the pulse path's runs, ticks: long enough that no interrupt of
+/// Interval between pulses in the pulse path's runs, 100 µs: long enough that no interrupt of
 /// the model comes late.
-const PULSE_INTERVAL_TICKS: u32 = 100;
+const PULSE_INTERVAL_TICKS: u32 = 100 * servoplot::geom::TICKS_PER_US;
 
 /// The device's interrupt vectors (cortex-m-rt's `device` feature, enabled through the
 /// firmware's HAL, expects them): the model's timer 0 runs the pulse engine.

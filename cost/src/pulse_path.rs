@@ -6,12 +6,10 @@
 //! harness sleeps (WFI) meanwhile. Two runs of different lengths give the cost per pulse: from
 //! the timer's interrupt entry to its return, and the sleep loop around it.
 
-use core::cell::RefCell;
-use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::ptr::{addr_of, addr_of_mut, null_mut, read_volatile, write_volatile};
+use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 
-use critical_section::Mutex;
-use servoplot::geom::{Axis, StepCmd};
+use servoplot::geom::{Axis, StepCmd, TICKS_PER_US};
 use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
 use servoplot::pulse::{PulseEngine, StepQueue, StepTimer};
@@ -27,14 +25,18 @@ const TIMER_ENABLE: u32 = 1;
 const TIMER_IRQ_ENABLE: u32 = 1 << 3;
 /// Its interrupt line.
 pub const TIMER0_IRQ: u16 = 8;
-/// The model's timer counts at 25 MHz.
-const TIMER_CLOCKS_PER_TICK: u32 = 25;
+/// The model's timer counts at 25 MHz: 25 clocks a microsecond, 6.25 a step tick (periods
+/// here are whole microseconds).
+const TIMER_CLOCKS_PER_US: u32 = 25;
 /// Where the board writes its two compare registers and a SIGN output (one store each).
 static mut COMPARE: [u32; 2] = [0; 2];
 static mut SIGN_OUT: u32 = 0;
 /// Where the board reads its input port (one load, then as many shifts and masks): every input
 /// idle, the switches open (high), the drivers' alarms and the e-stop low.
 static mut INPUT_PORT: u32 = !(1 << 8 | 1 << 14 | 1 << 15);
+/// Where the board reads its update counter (one load): the model has none, so the interrupt
+/// counts here before the engine runs.
+static mut UPDATES: u16 = 0;
 
 /// The model's timer standing in for TIM1.
 pub struct ModelStepTimer {
@@ -43,6 +45,7 @@ pub struct ModelStepTimer {
 
 impl StepTimer for ModelStepTimer {
     const MAX_PERIOD_TICKS: u32 = 65_535;
+    const SIGN_LATENCY_TICKS: u32 = 2 * TICKS_PER_US;
 
     fn set_sign(&mut self, axis: Axis, high: bool) {
         // One store, as the board's BSRR write.
@@ -55,7 +58,7 @@ impl StepTimer for ModelStepTimer {
         let edge = ticks.saturating_sub(self.width_ticks);
         // SAFETY: the model's timer registers; COMPARE is only written here, from the interrupt.
         unsafe {
-            write_volatile(TIMER0_RELOAD, ticks * TIMER_CLOCKS_PER_TICK);
+            write_volatile(TIMER0_RELOAD, ticks * TIMER_CLOCKS_PER_US / TICKS_PER_US);
             write_volatile(addr_of_mut!(COMPARE[0]), if axes & 1 != 0 { edge } else { u32::MAX });
             write_volatile(addr_of_mut!(COMPARE[1]), if axes & 2 != 0 { edge } else { u32::MAX });
         }
@@ -83,6 +86,11 @@ impl StepTimer for ModelStepTimer {
         let port = unsafe { read_volatile(addr_of!(INPUT_PORT)) };
         (((port >> 4) & 0x1F) | ((port >> 9) & 0x60)) as InputLevels
     }
+
+    fn update_count(&mut self) -> u16 {
+        // SAFETY: UPDATES is written only by the interrupt, which runs this.
+        unsafe { read_volatile(addr_of!(UPDATES)) }
+    }
 }
 
 /// The model's interrupt number for the NVIC.
@@ -101,21 +109,26 @@ struct Pulses {
     machine: &'static Machine,
 }
 
-static PULSES: Mutex<RefCell<Option<Pulses>>> = Mutex::new(RefCell::new(None));
+/// The engine of the run under way, for the interrupt: as the board's, a pointer the interrupt
+/// alone uses once it is set (each run sets it while the interrupt is masked).
+static PULSES: AtomicPtr<Pulses> = AtomicPtr::new(null_mut());
+static mut PULSES_STORE: Option<Pulses> = None;
 
 /// Whether the engine runs the timer, as the interrupt leaves it: what the sleep loop reads.
 static RUNNING: AtomicBool = AtomicBool::new(false);
 
 /// The timer's interrupt: as the board's, a status read and clear, then the engine.
 pub extern "C" fn timer0_interrupt() {
-    // SAFETY: the model's timer register; writing 1 clears the interrupt.
-    unsafe { write_volatile(TIMER0_INTCLEAR, 1) };
-    critical_section::with(|cs| {
-        if let Some(p) = PULSES.borrow(cs).borrow_mut().as_mut() {
-            p.engine.on_period(p.machine);
-            RUNNING.store(p.engine.is_running(), Ordering::Relaxed);
-        }
-    });
+    // SAFETY: the model's timer register; writing 1 clears the interrupt. UPDATES is only
+    // written here.
+    unsafe {
+        write_volatile(TIMER0_INTCLEAR, 1);
+        write_volatile(addr_of_mut!(UPDATES), read_volatile(addr_of!(UPDATES)).wrapping_add(1));
+    }
+    // SAFETY: set by `measure` while this interrupt was masked; only this interrupt uses it.
+    let Some(p) = (unsafe { PULSES.load(Ordering::Acquire).as_mut() }) else { return };
+    p.engine.on_period(p.machine);
+    RUNNING.store(p.engine.is_running(), Ordering::Relaxed);
 }
 
 static MACHINE: static_machine::Slot = static_machine::Slot::new();
@@ -160,16 +173,15 @@ pub fn measure(steps: &[StepCmd], label: &str, machine: &'static Machine) {
     producer.publish(steps.len());
     producer.rest();
     let engine = PulseEngine::new(ModelStepTimer { width_ticks: 0 }, consumer);
-    critical_section::with(|cs| *PULSES.borrow(cs).borrow_mut() = Some(Pulses { engine, machine }));
+    // SAFETY: the interrupt is masked (as after the last run), so nothing else uses the store.
+    let p = unsafe { (*addr_of_mut!(PULSES_STORE)).insert(Pulses { engine, machine }) };
+    PULSES.store(p, Ordering::Release);
+    cost_mark();
+    // Kicked as the board's motion task does, from outside the interrupt: before unmasking it.
+    p.engine.kick(p.machine);
+    RUNNING.store(p.engine.is_running(), Ordering::Relaxed);
     // SAFETY: the handler only touches PULSES, set just above.
     unsafe { cortex_m::peripheral::NVIC::unmask(Irq) };
-    cost_mark();
-    critical_section::with(|cs| {
-        if let Some(p) = PULSES.borrow(cs).borrow_mut().as_mut() {
-            p.engine.kick(p.machine);
-            RUNNING.store(p.engine.is_running(), Ordering::Relaxed);
-        }
-    });
     // Sleep until the engine has stopped the timer. Interrupts are off while deciding to sleep,
     // so the last one cannot slip in between; WFI still wakes on it.
     cortex_m::interrupt::disable();

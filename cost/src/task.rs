@@ -14,6 +14,9 @@ use core::task::{Context, Poll, RawWaker, RawWakerVTable, Waker};
 use critical_section::Mutex;
 use servoplot::interp::Curve;
 use servoplot::job::Job;
+
+/// Step ticks a microsecond of the clock.
+const TICKS_PER_US: u64 = servoplot::geom::TICKS_PER_US as u64;
 use servoplot::machine::Machine;
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::pulse::StepQueue;
@@ -82,8 +85,10 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     }
     let waker = noop_waker();
     let mut cx = Context::from_waker(&waker);
-    // When the pulse side emits its next pulse, and the step it holds.
+    // When the pulse side emits its next pulse (step ticks), and the step it holds; when it
+    // emitted the last one (the clock counts whole microseconds, the pulses step ticks).
     let mut next_pulse_at: Option<(u64, servoplot::geom::StepCmd)> = None;
+    let mut last_pulse_ticks = 0u64;
     let mut emitted = 0u64;
     let mut moved = false;
     for _ in 0..MAX_POLLS {
@@ -104,17 +109,19 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
             if next_pulse_at.is_none() {
                 match consumer.pop() {
                     Some(cmd) => {
-                        let t = clock_now();
+                        let t = last_pulse_ticks.max(clock_now() * TICKS_PER_US);
                         next_pulse_at = Some((t + u64::from(cmd.interval_ticks), cmd));
                     }
                     None => break,
                 }
             }
-            let Some((at, cmd)) = next_pulse_at else { break };
+            let Some((at_ticks, cmd)) = next_pulse_at else { break };
+            let at = at_ticks.div_ceil(TICKS_PER_US);
             if at > wake_at {
                 break;
             }
             set_clock(at);
+            last_pulse_ticks = at_ticks;
             machine.emitted(cmd);
             emitted += 1;
             next_pulse_at = None;

@@ -4,7 +4,7 @@
 extern crate std;
 
 use super::*;
-use crate::geom::{Point, Step, StepCmd, TICK_HZ};
+use crate::geom::{Point, Step, StepCmd, TICK_HZ, TICKS_PER_US};
 use crate::interp::{CurveError, Interpolator, Method};
 use crate::interp::{StraightInterp, Tangent};
 use crate::job::Feed;
@@ -177,8 +177,9 @@ impl Trace {
         self.cmds.iter().zip(lengths_mm).map(|(c, len)| len / (c.interval_ticks as f64 / TICK_HZ as f64)).collect()
     }
 
-    /// Mean speeds over windows of at least `window_ticks`: (mid time s, speed mm/s).
-    fn windowed_speeds(&self, lengths_mm: &[f64], window_ticks: u64) -> Vec<(f64, f64)> {
+    /// Mean speeds over windows of at least `window_us`: (mid time s, speed mm/s).
+    fn windowed_speeds(&self, lengths_mm: &[f64], window_us: u64) -> Vec<(f64, f64)> {
+        let window_ticks = window_us * u64::from(TICKS_PER_US);
         let mut out = Vec::new();
         let (mut t, mut w_ticks, mut w_mm) = (0u64, 0u64, 0.0f64);
         for (c, len) in self.cmds.iter().zip(lengths_mm) {
@@ -200,15 +201,15 @@ impl Trace {
         self.max_accel_over(lengths_mm, 5_000)
     }
 
-    /// Largest tangential acceleration between windows of at least `window_ticks`, mm/s².
-    fn max_accel_over(&self, lengths_mm: &[f64], window_ticks: u64) -> f64 {
-        self.max_accel_above(lengths_mm, window_ticks, 0.0)
+    /// Largest tangential acceleration between windows of at least `window_us`, mm/s².
+    fn max_accel_over(&self, lengths_mm: &[f64], window_us: u64) -> f64 {
+        self.max_accel_above(lengths_mm, window_us, 0.0)
     }
 
     /// As [`Self::max_accel_over`], between windows both faster than `floor_mm_per_s` (the start
     /// rate: below it the servos take a jump in speed, as when they start and stop).
-    fn max_accel_above(&self, lengths_mm: &[f64], window_ticks: u64, floor_mm_per_s: f64) -> f64 {
-        let w = self.windowed_speeds(lengths_mm, window_ticks);
+    fn max_accel_above(&self, lengths_mm: &[f64], window_us: u64, floor_mm_per_s: f64) -> f64 {
+        let w = self.windowed_speeds(lengths_mm, window_us);
         w.windows(2)
             .filter(|p| p[0].1.min(p[1].1) > floor_mm_per_s)
             .map(|p| ((p[1].1 - p[0].1) / (p[1].0 - p[0].0)).abs())
@@ -313,7 +314,8 @@ fn assert_axis_rates_within(trace: &Trace, limits: &Limits) {
 
 /// Largest acceleration of each axis, mm/s², from its mean velocity over windows of at least
 /// `window_ticks` (so that single steps do not show as spikes).
-fn max_axis_accel(trace: &Trace, limits: &Limits, window_ticks: u64) -> [f64; 2] {
+fn max_axis_accel(trace: &Trace, limits: &Limits, window_us: u64) -> [f64; 2] {
+    let window_ticks = window_us * u64::from(TICKS_PER_US);
     let spm = limits.steps_per_mm();
     let mut windows = Vec::new(); // (mid time s, velocity mm/s per axis)
     let (mut t, mut w_ticks, mut moved) = (0u64, 0u64, [0i64; 2]);

@@ -155,6 +155,8 @@ pub const ALARM_ESTOP: u8 = 10;
 pub const ALARM_DRIVER: u8 = 17;
 /// The alarm code for a curve that stopped part way for another reason (not a GRBL code).
 pub const ALARM_CURVE_STOPPED: u8 = 20;
+/// The alarm code for the step timer's interrupt coming a whole period late (not a GRBL code).
+pub const ALARM_MISSED_UPDATE: u8 = 21;
 
 /// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened and what
 /// clears it.
@@ -210,6 +212,9 @@ fn tripped(trip: Trip) -> AlarmText {
             (ALARM_DRIVER, ["Driver alarm ", axis.name(), "", ": servos off; clear the driver's fault, then '$X'"])
         }
         Trip::EStop => (ALARM_ESTOP, ["Emergency stop", "", "", ": release it, then '$X'"]),
+        Trip::MissedUpdate => {
+            (ALARM_MISSED_UPDATE, ["Pulse timer late: stopped without braking; '$X' to unlock", "", "", ""])
+        }
     }
 }
 
@@ -238,8 +243,9 @@ pub struct StatusFields {
 /// The status report for `?`, as GRBL 1.1 writes it:
 /// `<Idle|MPos:10.000,5.000,0.000|FS:0,0>`. `$10` chooses `MPos:` (bit 0 set) or `WPos:` and
 /// adds `|Bf:` (bit 1); `|WCO:` and `|Ov:` follow when `fields` asks for them. Once the pulses
-/// have had to wait for the motion task, `|Un:N` counts those step-queue underruns (not a GRBL
-/// field; senders skip fields they do not know).
+/// have had to wait for the motion task, `|Un:N` counts those step-queue underruns, and once the
+/// step timer's interrupt has come a period late, `|Mu:N` counts those missed updates (neither
+/// a GRBL field; senders skip fields they do not know).
 pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields: &StatusFields) -> fmt::Result {
     let state = match status.state {
         RunState::Idle => "Idle",
@@ -273,6 +279,9 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
     }
     if status.underruns > 0 {
         write!(out, "|Un:{}", Int::from(status.underruns))?;
+    }
+    if status.missed_updates > 0 {
+        write!(out, "|Mu:{}", Int::from(status.missed_updates))?;
     }
     out.write_str(">\r\n")
 }
@@ -461,6 +470,9 @@ mod tests {
         // Once the pulses have had to wait for the motion task, the count follows.
         let late = Status { underruns: 3, ..st(RunState::Run, 0, 0) };
         assert_eq!(text(|o| status(o, &late, &s, &at(6000.0))), "<Run|MPos:0.000,0.000,0.000|FS:6000,0|Un:3>\r\n");
+        // And once the step timer's interrupt has come a period late, that count.
+        let missed = Status { missed_updates: 1, ..st(RunState::Alarm, 0, 0) };
+        assert_eq!(text(|o| status(o, &missed, &s, &at(0.0))), "<Alarm|MPos:0.000,0.000,0.000|FS:0,0|Mu:1>\r\n");
     }
 
     #[test]

@@ -202,6 +202,9 @@ pub fn main() -> ExitCode {
     if with_cpu {
         eprintln!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
     }
+    if report.missed_updates > 0 {
+        eprintln!("missed step timer updates: {}", report.missed_updates);
+    }
     match write_pictures(&report, &args.out) {
         Ok(()) => {}
         Err(e) => {

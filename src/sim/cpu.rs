@@ -241,10 +241,10 @@ impl WorkTime for SimCpu<'_> {
             }
             _ => 0.0,
         };
-        let ticks = (seconds * TICK_HZ as f32).ceil() as u64;
+        let us = (seconds * 1e6).ceil() as u64;
         async move {
-            if ticks > 0 {
-                Timer::after(Duration::from_ticks(ticks)).await;
+            if us > 0 {
+                Timer::after(Duration::from_micros(us)).await;
             }
         }
     }
@@ -265,7 +265,7 @@ impl ThreadLevel {
 
     /// True while thread mode is taken.
     pub fn busy(&self) -> bool {
-        Instant::now().as_ticks() < self.busy_until_us.get()
+        Instant::now().as_micros() < self.busy_until_us.get()
     }
 
     /// Takes thread mode until `t_us`.
@@ -292,13 +292,13 @@ impl<'a> SimSlices<'a> {
 impl BetweenSlices for SimSlices<'_> {
     fn after(&mut self, slice: &Slice) -> impl Future<Output = ()> {
         let seconds = self.model.as_ref().map_or(0.0, |m| m.build_seconds(slice, self.machine.settings().method));
-        let ticks = (seconds * TICK_HZ as f32).ceil() as u64;
+        let us = (seconds * 1e6).ceil() as u64;
         // Taken from now, even should the future be dropped: the work is done.
-        let until = Instant::now().as_ticks() + ticks;
+        let until = Instant::now().as_micros() + us;
         self.thread.hold_until(until);
         async move {
-            if ticks > 0 {
-                Timer::at(Instant::from_ticks(until)).await;
+            if us > 0 {
+                Timer::at(Instant::from_micros(until)).await;
             } else {
                 embassy_futures::yield_now().await;
             }

@@ -52,6 +52,7 @@ use keys::{KeyMatrix, KeyScript};
 use lcd::{Frame, LcdPin, SIM_LCD_SPI_HZ, SimSpi};
 use pins::{LevelPin, PulseTrace, SimPen, SimWatchdog, TracePin};
 use serial::SimSerial;
+pub use step_timer::LateInterrupt;
 use step_timer::SimStepTimer;
 
 /// After the inputs are used up and the machine rests, the run goes on this long so the LCD
@@ -91,6 +92,8 @@ pub struct SimConfig {
     pub switches: Option<Switches>,
     /// Driver alarms, e-stops and stuck switches at set virtual times.
     pub events: InputScript,
+    /// A step timer interrupt that comes late (none by default).
+    pub late_interrupt: Option<LateInterrupt>,
 }
 
 /// What a simulation produced.
@@ -120,6 +123,8 @@ pub struct SimReport {
     pub timed_out: bool,
     /// Times the pulses had to wait for the motion task.
     pub underruns: u32,
+    /// Times the step timer's interrupt came a whole period late.
+    pub missed_updates: u32,
     /// Every change of the servo-on output, with its virtual time.
     pub son: Vec<(u64, bool)>,
     /// Every change of the run LED and of the buzzer, with its virtual time.
@@ -201,7 +206,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let (steps, step_consumer) = step_queue.split();
     let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
-    let mut engine = PulseEngine::new(SimStepTimer::new(pins, inputs.clone()), step_consumer);
+    let timer = SimStepTimer::new(pins, inputs.clone()).with_late_interrupt(config.late_interrupt);
+    let mut engine = PulseEngine::new(timer, step_consumer);
     let son = LevelPin::default();
     let watchdog = SimWatchdog::default();
     let pen = SimPen::default();
@@ -328,6 +334,7 @@ pub fn run(config: SimConfig) -> SimReport {
     }
     let position = machine.position();
     let underruns = machine.underruns();
+    let missed_updates = machine.missed_updates();
     let settings = machine.settings();
     let end_us = clock::now_ticks();
     let trace =
@@ -348,6 +355,7 @@ pub fn run(config: SimConfig) -> SimReport {
         end_us,
         timed_out,
         underruns,
+        missed_updates,
         son: son.changes(),
         watchdog_unfed_us: watchdog.longest_unfed_us(end_us),
         pen: pen.changes(),

@@ -1,65 +1,94 @@
 //! Simulated step/direction outputs and the pulse trace they record.
 //!
-//! Every PULS rising edge becomes a [`Pulse`] stamped with the virtual time, with the direction
-//! read from the SIGN level at that instant, exactly as a servo driver reads it. The pen path in
-//! `plot.svg` and every count the tests check are rebuilt from this trace, not from commands.
+//! Every PULS rising edge becomes a [`Pulse`] stamped with its exact time in step ticks, with the
+//! direction read from the SIGN level at that instant, exactly as a servo driver reads it; every
+//! SIGN change is kept too. The pen path in `plot.svg` and every count the tests check are rebuilt
+//! from this trace, not from commands, and so are the timings a driver needs (the shortest PULS
+//! high and low times, SIGN's set-up before and hold after a pulse).
 
 use std::cell::RefCell;
 use std::rc::Rc;
 use std::vec::Vec;
 
-use crate::geom::{Axis, Point, Step};
+use crate::geom::{Axis, Point, Step, TICKS_PER_US};
 use crate::sim::clock;
 
 /// One pulse as a servo driver sees it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Pulse {
+    /// Its rising edge, step ticks.
+    pub t_ticks: u64,
+    /// The same in whole microseconds (rounded down).
     pub t_us: u64,
     pub axis: Axis,
     /// SIGN level at the rising edge.
     pub sign_high: bool,
 }
 
+/// One change of a SIGN output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SignChange {
+    pub t_ticks: u64,
+    pub axis: Axis,
+    pub high: bool,
+}
+
 /// Everything the step/direction pins did.
 #[derive(Debug, Default)]
 pub struct PulseTrace {
     pub pulses: Vec<Pulse>,
-    /// Shortest time from a SIGN change to the next PULS edge on that axis.
-    pub min_dir_setup_us: Option<u64>,
-    /// Shortest PULS high time.
-    pub min_pulse_width_us: Option<u64>,
+    pub sign_changes: Vec<SignChange>,
+    /// Shortest time from a SIGN change to the next PULS rising edge on that axis, ticks.
+    pub min_dir_setup_ticks: Option<u64>,
+    /// Shortest time from a PULS falling edge to the next SIGN change on that axis, ticks.
+    pub min_dir_hold_ticks: Option<u64>,
+    /// Shortest PULS high time, and shortest low time between two pulses of one axis, ticks.
+    pub min_pulse_width_ticks: Option<u64>,
+    pub min_pulse_low_ticks: Option<u64>,
     sign_high: [bool; 2],
     /// Per axis, pulses with SIGN high less those with SIGN low.
     driven: [i64; 2],
     sign_changed_at: [Option<u64>; 2],
     puls_high_since: [Option<u64>; 2],
+    puls_low_since: [Option<u64>; 2],
+}
+
+/// `at` becomes the smaller of itself and `v`.
+fn keep_min(at: &mut Option<u64>, v: u64) {
+    *at = Some(at.map_or(v, |m| m.min(v)));
 }
 
 impl PulseTrace {
-    fn edge(&mut self, axis: Axis, role: Role, high: bool) {
-        let t = clock::now_ticks();
+    fn edge(&mut self, axis: Axis, role: Role, high: bool, t: u64) {
         let i = axis.index();
         match role {
             Role::Sign => {
                 if self.sign_high[i] != high {
                     self.sign_high[i] = high;
                     self.sign_changed_at[i] = Some(t);
+                    self.sign_changes.push(SignChange { t_ticks: t, axis, high });
+                    if let Some(fell) = self.puls_low_since[i] {
+                        keep_min(&mut self.min_dir_hold_ticks, t - fell);
+                    }
                 }
             }
             Role::Puls => match (self.puls_high_since[i], high) {
                 (None, true) => {
                     self.puls_high_since[i] = Some(t);
-                    self.pulses.push(Pulse { t_us: t, axis, sign_high: self.sign_high[i] });
+                    let t_us = t / u64::from(TICKS_PER_US);
+                    self.pulses.push(Pulse { t_ticks: t, t_us, axis, sign_high: self.sign_high[i] });
                     self.driven[i] += if self.sign_high[i] { 1 } else { -1 };
                     if let Some(changed) = self.sign_changed_at[i].take() {
-                        let setup = t - changed;
-                        self.min_dir_setup_us = Some(self.min_dir_setup_us.map_or(setup, |m| m.min(setup)));
+                        keep_min(&mut self.min_dir_setup_ticks, t - changed);
+                    }
+                    if let Some(fell) = self.puls_low_since[i] {
+                        keep_min(&mut self.min_pulse_low_ticks, t - fell);
                     }
                 }
                 (Some(since), false) => {
                     self.puls_high_since[i] = None;
-                    let width = t - since;
-                    self.min_pulse_width_us = Some(self.min_pulse_width_us.map_or(width, |m| m.min(width)));
+                    self.puls_low_since[i] = Some(t);
+                    keep_min(&mut self.min_pulse_width_ticks, t - since);
                 }
                 _ => {}
             },
@@ -82,22 +111,28 @@ impl PulseTrace {
         c
     }
 
-    /// The steps the drivers took, in order, with their times; pulses on both axes at the same
-    /// instant form one diagonal step. `invert_mask` is the `$3` setting in force.
+    /// The steps the drivers took, in order, with their times in µs (rounded down); pulses on
+    /// both axes at the same instant form one diagonal step. `invert_mask` is the `$3` setting
+    /// in force.
     pub fn steps(&self, invert_mask: u8) -> Vec<(u64, Step)> {
+        self.steps_ticks(invert_mask).into_iter().map(|(t, s)| (t / u64::from(TICKS_PER_US), s)).collect()
+    }
+
+    /// [`steps`](Self::steps), with their exact times in step ticks.
+    pub fn steps_ticks(&self, invert_mask: u8) -> Vec<(u64, Step)> {
         let mut out: Vec<(u64, Step)> = Vec::new();
         for p in &self.pulses {
             let inverted = invert_mask & (1 << p.axis.index()) != 0;
             let d = if p.sign_high != inverted { 1 } else { -1 };
             let mut step = match out.last() {
-                Some((t, s)) if *t == p.t_us && s.on(p.axis) == 0 => out.pop().map(|(_, s)| s).unwrap_or_default(),
+                Some((t, s)) if *t == p.t_ticks && s.on(p.axis) == 0 => out.pop().map(|(_, s)| s).unwrap_or_default(),
                 _ => Step::NONE,
             };
             match p.axis {
                 Axis::X => step.x = d,
                 Axis::Y => step.y = d,
             }
-            out.push((p.t_us, step));
+            out.push((p.t_ticks, step));
         }
         out
     }
@@ -137,19 +172,10 @@ impl TracePin {
     }
 }
 
-impl embedded_hal::digital::ErrorType for TracePin {
-    type Error = core::convert::Infallible;
-}
-
-impl embedded_hal::digital::OutputPin for TracePin {
-    fn set_low(&mut self) -> Result<(), Self::Error> {
-        self.trace.borrow_mut().edge(self.axis, self.role, false);
-        Ok(())
-    }
-
-    fn set_high(&mut self) -> Result<(), Self::Error> {
-        self.trace.borrow_mut().edge(self.axis, self.role, true);
-        Ok(())
+impl TracePin {
+    /// Drives the pin to `high` at `t_ticks` (step ticks, not before the last edge recorded).
+    pub fn set_at(&mut self, high: bool, t_ticks: u64) {
+        self.trace.borrow_mut().edge(self.axis, self.role, high, t_ticks);
     }
 }
 

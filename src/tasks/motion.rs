@@ -20,7 +20,7 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 
 use crate::drawing::Drawing;
-use crate::geom::Point;
+use crate::geom::{Point, TICKS_PER_US};
 use crate::inputs::Trip;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
@@ -187,8 +187,8 @@ pub async fn run(
         match filled {
             FillEnd::QueueFull => {
                 // Enough motion queued: wait until half of it is emitted, or for a control.
-                let wait_us = u64::from(machine.queued_ticks() / 2).max(MOTION_RETRY_US);
-                select(Timer::after(Duration::from_ticks(wait_us)), machine.control_requested()).await;
+                let wait_us = u64::from(machine.queued_ticks() / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
+                select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
             }
             FillEnd::PlanEmpty | FillEnd::CurveFailed(_) => {
                 machine.set_plan_empty(planner.is_idle() && held.is_none());

@@ -22,6 +22,7 @@ use embassy_time::{Duration, Instant, Timer};
 use embedded_hal::digital::{OutputPin, PinState};
 use embedded_hal::pwm::SetDutyCycle;
 
+use crate::geom::TICKS_PER_US;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
 use crate::pen::{PEN_SERVO_PERIOD_US, PenServo};
@@ -57,8 +58,8 @@ pub async fn run<P: OutputPin>(
         let settings = machine.settings();
         let setup = InputSetup::from_settings(&settings);
         let active = setup.stops_active(now);
-        // The debounce clock in ticks, wrapping as it allows.
-        let ticks = Instant::now().as_ticks() as u32;
+        // The debounce clock in step ticks, wrapping as it allows.
+        let ticks = (Instant::now().as_micros() as u32).wrapping_mul(TICKS_PER_US);
         if let Some(trip) = debounce.sample(active, ticks, setup.debounce_ticks) {
             machine.trip(trip);
             debounce.clear();

@@ -341,6 +341,7 @@ impl fmt::Display for FaultText {
                 return write!(f, "{} {}", Text(axis.name()), say(Msg::FaultDriver));
             }
             MotionFault::Tripped(Trip::EStop) => Msg::FaultEstop,
+            MotionFault::Tripped(Trip::MissedUpdate) => Msg::FaultMissedUpdate,
             MotionFault::Homing(HomingFail::Aborted) => return write!(f, "{}", say(Msg::FaultHomingAborted)),
             MotionFault::Homing(HomingFail::PullOff(axis) | HomingFail::Approach(axis)) => {
                 return write!(f, "{} {} {}", say(Msg::FaultHoming), Text(axis.name()), say(Msg::FaultFailed));

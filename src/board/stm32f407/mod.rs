@@ -217,6 +217,7 @@ pub fn init(spawner: Spawner) -> Board {
     // PULS on TIM1's PWM outputs (low until a period ends with a pulse), SIGN on GPIO.
     let step_timer = Tim1StepTimer::new(
         p.TIM1,
+        p.TIM4,
         PwmPin::new(p.PE9, OutputType::PushPull),
         PwmPin::new(p.PE11, OutputType::PushPull),
         [Pin::new(p.PE10, Level::Low, Speed::VeryHigh), Pin::new(p.PE12, Level::Low, Speed::VeryHigh)],

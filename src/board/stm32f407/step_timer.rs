@@ -2,25 +2,26 @@
 //! CH2 (PE11, Y PULS) so that each period ends with a pulse the hardware times to the tick,
 //! ARR and CCR preloaded so the next period follows by itself. Its update interrupt runs the
 //! pulse engine at the highest priority; the motion task pends that interrupt to start it.
+//! TIM4 counts TIM1's update events in hardware, so the engine learns how many periods really
+//! ended when its interrupt comes late.
 
-use core::cell::RefCell;
-use core::mem::MaybeUninit;
+use core::ptr::null_mut;
+use core::sync::atomic::{AtomicPtr, Ordering};
 
 use embassy_stm32::Peri;
 use embassy_stm32::gpio::{Level, Output};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::InterruptExt;
 use embassy_stm32::pac::timer::regs::SrAdv;
-use embassy_stm32::peripherals::TIM1;
+use embassy_stm32::peripherals::{TIM1, TIM4};
 use embassy_stm32::time::Hertz;
-use embassy_stm32::timer::low_level::{OutputCompareMode, OutputPolarity, Timer};
+use embassy_stm32::timer::low_level::{MasterMode, OutputCompareMode, OutputPolarity, SlaveMode, Timer, TriggerSource};
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Channel};
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use static_cell::StaticCell;
 
 use super::inputs::InputPins;
-use servoplot::geom::{Axis, TICK_HZ};
+use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
 use servoplot::inputs::InputLevels;
 use servoplot::machine::Machine;
 use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
@@ -31,9 +32,19 @@ const PULS_CHANNELS: [Channel; 2] = [Channel::Ch1, Channel::Ch2];
 /// A compare value the 16-bit counter never reaches (its periods end at 65_534): no pulse.
 const NO_PULSE: u16 = u16::MAX;
 
-/// TIM1 driving PULS, the SIGN outputs, and the input pins the engine watches.
+/// The longest the update interrupt's SIGN write comes after the update event. Cortex-M4
+/// exception entry is 12 cycles (ARM's Cortex-M4 TRM, 3.9), a few more for the vector fetch
+/// through flash wait states; the handler then does some 30 instructions before the GPIO write
+/// (under 100 cycles with the ART accelerator on); and nothing in the firmware masks interrupts
+/// for longer than a short critical section (no value over 64 bytes is copied inside one). Under
+/// 400 cycles in all at 168 MHz: 2 µs keeps a margin.
+const SIGN_LATENCY_US: u32 = 2;
+
+/// TIM1 driving PULS, the SIGN outputs, and the input pins the engine watches; TIM4 counting
+/// TIM1's update events.
 pub struct Tim1StepTimer {
     timer: Timer<'static, TIM1>,
+    updates: Timer<'static, TIM4>,
     sign: [Output<'static>; 2],
     inputs: InputPins,
     width_ticks: u32,
@@ -41,15 +52,17 @@ pub struct Tim1StepTimer {
 }
 
 impl Tim1StepTimer {
-    /// TIM1 set up and stopped, PULS low, SIGN low.
+    /// TIM1 set up and stopped, PULS low, SIGN low; TIM4 counting its update events.
     pub fn new(
         tim: Peri<'static, TIM1>,
+        update_counter: Peri<'static, TIM4>,
         puls_x: PwmPin<'static, TIM1, Ch1>,
         puls_y: PwmPin<'static, TIM1, Ch2>,
         sign: [Output<'static>; 2],
         inputs: InputPins,
     ) -> Self {
         let mut timer = Timer::new(tim);
+        // 168 MHz / 4 MHz: a prescaler of 42 (PSC = 41), whole.
         timer.set_tick_freq(Hertz(TICK_HZ));
         timer.set_autoreload_preload(true);
         for channel in PULS_CHANNELS {
@@ -60,15 +73,27 @@ impl Tim1StepTimer {
             timer.enable_channel(channel, true);
         }
         timer.set_moe(true);
+        // TRGO pulses at every update event (RM0090, TIMx_CR2: MMS = 010, "the update event is
+        // selected as trigger output").
+        timer.set_master_mode(MasterMode::UPDATE);
+        // TIM4 counts TRGO's pulses: its internal trigger 0 is TIM1's TRGO (RM0090, TIMx_SMCR:
+        // the table of internal trigger connections), and external clock mode 1 (SMS = 111)
+        // clocks the counter with every rising edge of the chosen trigger. Prescaler 0 and the
+        // reset ARR of 0xFFFF: CNT counts update events, wrapping at 2¹⁶.
+        let updates = Timer::new(update_counter);
+        updates.set_trigger_source(TriggerSource::ITR0);
+        updates.set_slave_mode(SlaveMode::EXT_CLOCK_MODE);
+        updates.start();
         // Setting the tick rate made an update event: its flag is no period of ours.
         timer.regs_core().sr().write_value(embassy_stm32::pac::timer::regs::SrCore(!1));
         timer.enable_update_interrupt(true);
-        Tim1StepTimer { timer, sign, inputs, width_ticks: 0, _puls: (puls_x, puls_y) }
+        Tim1StepTimer { timer, updates, sign, inputs, width_ticks: 0, _puls: (puls_x, puls_y) }
     }
 }
 
 impl StepTimer for Tim1StepTimer {
     const MAX_PERIOD_TICKS: u32 = NO_PULSE as u32;
+    const SIGN_LATENCY_TICKS: u32 = SIGN_LATENCY_US * TICKS_PER_US;
 
     fn set_sign(&mut self, axis: Axis, high: bool) {
         self.sign[axis.index()].set_level(if high { Level::High } else { Level::Low });
@@ -110,33 +135,26 @@ impl StepTimer for Tim1StepTimer {
     fn input_levels(&mut self) -> InputLevels {
         self.inputs.levels()
     }
+
+    #[inline(always)]
+    fn update_count(&mut self) -> u16 {
+        self.updates.regs_core().cnt().read().cnt()
+    }
 }
 
-/// The engine and the machine it counts for, owned by the interrupt.
+/// The engine and the machine it counts for.
 struct Pulses {
     engine: PulseEngine<'static, Tim1StepTimer>,
     machine: &'static Machine,
 }
 
-/// Where the interrupt finds the engine once [`start`] has put it there. Not an
-/// `Option<Pulses>`: its `None` is not all zero bytes, so the static would be copied from flash
-/// at boot (120 B of it); this one is zero, in `.bss`, and the interrupt tests one byte all the
-/// same.
-struct Slot {
-    /// `pulses` holds the engine.
-    filled: bool,
-    pulses: MaybeUninit<Pulses>,
-}
+/// Where [`start`] builds the engine, once.
+static PULSES_CELL: StaticCell<Pulses> = StaticCell::new();
 
-impl Slot {
-    fn get(&mut self) -> Option<&mut Pulses> {
-        // SAFETY: `filled` is set only once `pulses` is written, and never cleared.
-        self.filled.then(|| unsafe { self.pulses.assume_init_mut() })
-    }
-}
-
-static PULSES: Mutex<CriticalSectionRawMutex, RefCell<Slot>> =
-    Mutex::new(RefCell::new(Slot { filled: false, pulses: MaybeUninit::uninit() }));
+/// The engine, for the interrupt: null until [`start`] has built it. From then on only the
+/// interrupt uses it, one run at a time (nothing else can reach it, and the interrupt does not
+/// nest in itself), so it takes no lock and masks nothing.
+static PULSES: AtomicPtr<Pulses> = AtomicPtr::new(null_mut());
 
 /// Hands the engine to the interrupt and enables it at `priority`; once, at power-on.
 pub fn start(
@@ -145,12 +163,8 @@ pub fn start(
     machine: &'static Machine,
     priority: interrupt::Priority,
 ) {
-    let pulses = Pulses { engine: PulseEngine::new(timer, steps), machine };
-    PULSES.lock(|p| {
-        let mut slot = p.borrow_mut();
-        slot.pulses.write(pulses);
-        slot.filled = true;
-    });
+    let pulses = PULSES_CELL.init(Pulses { engine: PulseEngine::new(timer, steps), machine });
+    PULSES.store(pulses, Ordering::Release);
     interrupt::TIM1_UP_TIM10.set_priority(priority);
     interrupt::TIM1_UP_TIM10.unpend();
     // SAFETY: the handler below only touches PULSES, set just above.
@@ -170,15 +184,16 @@ fn TIM1_UP_TIM10() {
         // rc_w0: a 0 clears UIF, the 1s leave the other flags alone.
         regs.sr().write_value(SrAdv(!1));
     }
-    PULSES.lock(|p| {
-        if let Some(p) = p.borrow_mut().get() {
-            if update {
-                p.engine.on_period(p.machine);
-            }
-            if !p.engine.is_running() {
-                // Pended by the motion task: start if steps are queued.
-                p.engine.kick(p.machine);
-            }
-        }
-    });
+    let pulses = PULSES.load(Ordering::Acquire);
+    // SAFETY: non-null, it is the `&'static mut` that `start` took from PULSES_CELL (which
+    // hands out one, once) and gave up to this interrupt; this is its only user, and a run of
+    // it never overlaps another.
+    let Some(p) = (unsafe { pulses.as_mut() }) else { return };
+    if update {
+        p.engine.on_period(p.machine);
+    }
+    if !p.engine.is_running() {
+        // Pended by the motion task: start if steps are queued.
+        p.engine.kick(p.machine);
+    }
 }

@@ -65,7 +65,7 @@ fn abort_stops_on_the_path_and_drops_the_rest() {
     // A new job starts from rest at the start rate.
     p.push(Chords::line(100, 0, method), DEFAULT_FEED, method).unwrap();
     let first = p.next_cmd().unwrap().unwrap();
-    assert_eq!(first.interval_ticks, 2_000);
+    assert_eq!(first.interval_ticks, 2_000 * TICKS_PER_US);
 }
 
 #[test]
@@ -137,7 +137,7 @@ fn limits_come_only_from_settings_in_range() {
     assert_eq!(Limits::from_settings(&Settings::default()), Limits::default());
     // 30 kHz is not a whole number of ticks: the period is rounded up, never down.
     let l = limits_with(|s| s.max_pulse_rate_hz = 30_000.0);
-    assert_eq!(l.min_interval_ticks(), 34);
+    assert_eq!(l.min_interval_ticks(), 134);
     assert!(l.max_pulse_rate_hz() <= 30_000.0);
 }
 
@@ -146,12 +146,12 @@ fn odd_feeds_fall_back_to_the_default_or_the_minimum() {
     let limits = Limits::default(); // default feed 3000 mm/min = 50 mm/s
     let method = Method::Diagonal;
     for (feed, expected_ticks) in [
-        (Feed::MmPerMin(0.0), 200),
-        (Feed::MmPerMin(-5.0), 200),
-        (Feed::MmPerMin(f32::NAN), 200),
-        (Feed::MmPerMin(f32::INFINITY), 200),
+        (Feed::MmPerMin(0.0), 200 * TICKS_PER_US),
+        (Feed::MmPerMin(-5.0), 200 * TICKS_PER_US),
+        (Feed::MmPerMin(f32::NAN), 200 * TICKS_PER_US),
+        (Feed::MmPerMin(f32::INFINITY), 200 * TICKS_PER_US),
         // Below the 1 mm/min floor: one 0.01 mm step per 0.6 s.
-        (Feed::MmPerMin(1e-6), 600_000),
+        (Feed::MmPerMin(1e-6), 600_000 * TICKS_PER_US),
     ] {
         let mut p = TestPlanner::new(limits);
         p.push(Chords::line(3_000, 0, method), feed, method).unwrap();
@@ -170,16 +170,16 @@ fn new_limits_wait_until_the_planner_is_idle() {
     let mut p = TestPlanner::new(Limits::default());
     p.push(Chords::line(2_000, 0, method), DEFAULT_FEED, method).unwrap();
     let first = p.next_cmd().unwrap().unwrap();
-    assert_eq!(first.interval_ticks, 2_000, "5 mm/s start rate");
+    assert_eq!(first.interval_ticks, 2_000 * TICKS_PER_US, "5 mm/s start rate");
     // Double the start rate while moving: the running job keeps its own.
     p.set_limits(limits_with(|s| s.start_rate_mm_per_min = 600.0));
     let mut last = first;
     while let Some(c) = p.next_cmd() {
         last = c.unwrap();
     }
-    assert!(last.interval_ticks >= 1_998, "ended at {} ticks", last.interval_ticks);
+    assert!(last.interval_ticks >= 1_998 * TICKS_PER_US, "ended at {} ticks", last.interval_ticks);
     p.push(Chords::line(2_000, 0, method), DEFAULT_FEED, method).unwrap();
-    assert_eq!(p.next_cmd().unwrap().unwrap().interval_ticks, 1_000, "10 mm/s start rate");
+    assert_eq!(p.next_cmd().unwrap().unwrap().interval_ticks, 1_000 * TICKS_PER_US, "10 mm/s start rate");
 }
 
 #[test]
