@@ -144,35 +144,57 @@ impl Timing {
     }
 }
 
-/// SIGN levels of both axes as bits (bit 0 X, bit 1 Y), and which of them are known.
+/// SIGN of both axes as bits (bit 0 X, bit 1 Y): set where high (or, as the engine plans ahead,
+/// where forward), and which of them are known.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct Signs {
-    high: u8,
+    set: u8,
     known: u8,
 }
 
 impl Signs {
-    /// Of the axes in `moving`, those whose level is not `high` (or not known yet).
+    /// Of the axes in `moving`, those whose bit is not as in `set` (or not known yet).
     #[inline(always)]
-    fn changes(self, moving: u8, high: u8) -> u8 {
-        moving & (!self.known | (self.high ^ high))
+    fn changes(self, moving: u8, set: u8) -> u8 {
+        moving & (!self.known | (self.set ^ set))
     }
 
-    /// The levels once the axes in `axes` are set to `high` (within `axes`).
+    /// The bits once those of `axes` are as in `set` (within `axes`).
     #[inline(always)]
-    fn set(&mut self, axes: u8, high: u8) {
-        self.high = (self.high & !axes) | high;
+    fn put(&mut self, axes: u8, set: u8) {
+        self.set = (self.set & !axes) | set;
         self.known |= axes;
+    }
+
+    /// The same signs with `mask`'s bits flipped: levels from directions, or back, with the
+    /// direction invert mask.
+    fn flipped(self, mask: u8) -> Signs {
+        Signs { set: self.set ^ mask, known: self.known }
     }
 }
 
-/// The axes `cmd` steps and those it steps forward (bits, bit 0 X, bit 1 Y).
-#[inline(always)]
-fn step_bits(cmd: StepCmd) -> (u8, u8) {
-    let s = cmd.step;
-    let moving = u8::from(s.x != 0) | (u8::from(s.y != 0) << 1);
-    let forward = u8::from(s.x > 0) | (u8::from(s.y > 0) << 1);
-    (moving, forward)
+/// What a step needs of the outputs and the inputs, as bits (bit 0 X, bit 1 Y).
+#[derive(Clone, Copy, Debug)]
+struct StepBits {
+    /// The axes it steps.
+    moving: u8,
+    /// Those it steps forward.
+    forward: u8,
+    /// The limit switches it runs towards.
+    toward: u8,
+}
+
+impl StepBits {
+    #[inline(always)]
+    fn of(cmd: StepCmd) -> StepBits {
+        // A step of an axis is -1, 0 or +1: as a byte 0xFF, 0x00 or 0x01. Bit 0 says it moves,
+        // bit 1 that it moves backward: a few shifts and masks, no comparisons.
+        let (x, y) = (cmd.step.x as u8, cmd.step.y as u8);
+        let moving = (x & 1) | ((y & 1) << 1);
+        let backward = ((x >> 1) & 1) | (y & 2);
+        let forward = moving & !backward;
+        StepBits { moving, forward, toward: limits_toward(moving, forward) }
+    }
 }
 
 /// What a period is for.
@@ -186,34 +208,39 @@ enum Kind {
     Tail,
 }
 
-/// One period of the timer, as the engine preloads it.
+/// One period of the timer, as the engine keeps it while the timer has it: what its start and
+/// its end need (the timer has its length). Three words, copied as such at every update.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 struct Period {
-    ticks: u32,
-    kind: Kind,
-    /// The step whose pulse ends the period ([`Kind::Step`]).
+    /// The step whose pulse ends the period ([`Kind::Step`]), as queued: what the machine counts.
     cmd: StepCmd,
-    /// The axes pulsed at its end (bit 0 X, bit 1 Y).
-    axes: u8,
-    /// SIGN levels driven as the period starts, on the axes of `sign_changes` (bits).
-    sign_high: u8,
+    kind: Kind,
+    /// The axes whose SIGN changes as the period starts (bits, bit 0 X, bit 1 Y), to the levels
+    /// `cmd` needs.
     sign_changes: u8,
     /// The limit switches its motion runs towards.
     toward: u8,
 }
 
 impl Period {
-    const TAIL: Period = Period::pulseless(TAIL_TICKS, Kind::Tail, 0);
+    const TAIL: Period = Period::pulseless(Kind::Tail, 0);
 
-    const fn pulseless(ticks: u32, kind: Kind, toward: u8) -> Period {
+    const fn pulseless(kind: Kind, toward: u8) -> Period {
         let cmd = StepCmd { step: crate::geom::Step::NONE, interval_ticks: 0 };
-        Period { ticks, kind, cmd, axes: 0, sign_high: 0, sign_changes: 0, toward }
+        Period { kind, cmd, sign_changes: 0, toward }
     }
 
-    /// A pulse-less period of `ticks` in a motion towards the switches of `toward`: they stay
-    /// watched while it waits.
-    const fn wait(ticks: u32, toward: u8) -> Period {
-        Period::pulseless(ticks, Kind::Wait, toward)
+    /// A pulse-less period in a motion towards the switches of `toward`: they stay watched
+    /// while it waits.
+    const fn wait(toward: u8) -> Period {
+        Period::pulseless(Kind::Wait, toward)
+    }
+
+    /// The period ending with `cmd`'s pulse, changing SIGN on the axes of `changes`.
+    #[inline(always)]
+    fn step(cmd: StepCmd, bits: StepBits, changes: u8) -> Period {
+        Period { kind: Kind::Step, cmd, sign_changes: changes, toward: bits.toward }
     }
 }
 
@@ -226,9 +253,9 @@ pub struct PulseEngine<'q, T: StepTimer> {
     /// The period counting now and the one preloaded after it.
     active: Period,
     preloaded: Period,
-    /// SIGN levels driven, and those in force once the preloaded period starts.
+    /// SIGN levels driven, and the directions they stand for once the preloaded period starts.
     sign: Signs,
-    sign_preloaded: Signs,
+    direction_preloaded: Signs,
     /// A step whose pulse comes after pulse-less periods (SIGN's hold, an interval longer than
     /// the timer counts), and the ticks from the end of those to its pulse.
     pending: Option<(StepCmd, u32)>,
@@ -253,7 +280,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             active: Period::TAIL,
             preloaded: Period::TAIL,
             sign: Signs::default(),
-            sign_preloaded: Signs::default(),
+            direction_preloaded: Signs::default(),
             pending: None,
             starving: false,
             inputs: InputSetup::from_settings(&Settings::default()),
@@ -298,10 +325,9 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             self.inputs.watched |= LIMITS;
         }
         self.debounce.clear();
-        self.sign_preloaded = self.sign;
+        self.direction_preloaded = self.sign.flipped(self.timing.invert_mask);
         self.active = Period::TAIL;
-        let first = self.next_period(machine);
-        self.preload(first);
+        self.preload_queued::<true>(machine);
         self.updates = self.timer.update_count();
         self.running = true;
         machine.set_pulsing(true);
@@ -323,27 +349,43 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
             return;
         }
         // SIGN first: the sooner after the update event, the less of the set-up it takes.
-        let starting = self.preloaded;
-        if starting.sign_changes != 0 {
-            self.drive_signs(starting.sign_changes, starting.sign_high);
+        let changes = self.preloaded.sign_changes;
+        if changes != 0 {
+            self.drive_signs(changes, StepBits::of(self.preloaded.cmd).forward ^ self.timing.invert_mask);
         }
         if self.active.kind == Kind::Step {
             machine.emitted(self.active.cmd);
         }
-        self.active = starting;
+        self.active = self.preloaded;
         if self.tripped(machine) {
             self.timer.halt();
             self.stopped(machine);
             return;
         }
-        let next = self.next_period(machine);
-        if starting.kind == Kind::Tail && next.kind == Kind::Tail {
-            // The last pulse is out, and nothing came in behind the rest.
+        if self.active.kind != Kind::Step {
+            self.after_pause(machine);
+            return;
+        }
+        // After a step the queue had one: no underrun is under way.
+        self.preload_queued::<false>(machine);
+    }
+
+    /// A pulse-less period has started: a step may be pending behind it, and after the last
+    /// pulse the timer stops, unless more came in behind the rest.
+    #[cold]
+    #[inline(never)]
+    fn after_pause(&mut self, machine: &Machine) {
+        if let Some((cmd, ticks)) = self.pending {
+            self.pending = None;
+            self.preload_pulse_after(cmd, ticks, StepBits::of(cmd));
+            return;
+        }
+        if self.active.kind == Kind::Tail && !self.queue.ready() && self.queue.at_rest() {
             self.timer.stop();
             self.stopped(machine);
             return;
         }
-        self.preload(next);
+        self.preload_queued::<true>(machine);
     }
 
     /// The interrupt came `extra` whole periods late: see the module documentation.
@@ -358,9 +400,10 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         let mut repeated = self.preloaded;
         repeated.sign_changes = 0;
         if repeated.kind == Kind::Step {
-            let forward = self.sign.high ^ self.timing.invert_mask;
+            let axes = StepBits::of(repeated.cmd).moving;
+            let forward = self.sign.set ^ self.timing.invert_mask;
             let along = |axis: u8| -> i8 {
-                match (repeated.axes & axis != 0, forward & axis != 0) {
+                match (axes & axis != 0, forward & axis != 0) {
                     (false, _) => 0,
                     (true, true) => 1,
                     (true, false) => -1,
@@ -371,12 +414,11 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
                 machine.emitted(repeated.cmd);
             }
         }
-        self.clock_ticks = self.clock_ticks.wrapping_add(repeated.ticks.wrapping_mul(u32::from(extra)));
         self.active = repeated;
         machine.count_missed_update();
         machine.trip(Trip::MissedUpdate);
         // Nothing more: the timer stops once the repeat under way is out.
-        self.preload(Period::TAIL);
+        self.preload(TAIL_TICKS, 0, Period::TAIL);
     }
 
     /// Samples the inputs the active period watches; true once the machine has tripped, by them
@@ -384,7 +426,8 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     #[inline(always)]
     fn tripped(&mut self, machine: &Machine) -> bool {
         let levels = self.timer.input_levels();
-        let active = self.inputs.active(levels) & (self.active.toward | ALWAYS_WATCHED);
+        let toward = self.active.toward;
+        let active = self.inputs.active(levels) & (toward | ALWAYS_WATCHED);
         if (active != 0 || self.debounce.holding())
             && let Some(trip) = self.debounce.sample(active, self.clock_ticks, self.inputs.debounce_ticks)
         {
@@ -404,12 +447,13 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         machine.pulses_stopped();
     }
 
+    /// Preloads `period`, `ticks` long, pulsing the axes of `axes` at its end.
     #[inline(always)]
-    fn preload(&mut self, period: Period) {
+    fn preload(&mut self, ticks: u32, axes: u8, period: Period) {
         self.preloaded = period;
         // The debounce's clock runs one period ahead: only its differences count.
-        self.clock_ticks = self.clock_ticks.wrapping_add(period.ticks);
-        self.timer.preload(period.ticks, period.axes);
+        self.clock_ticks = self.clock_ticks.wrapping_add(ticks);
+        self.timer.preload(ticks, axes);
     }
 
     /// Drives SIGN high or low as `high` says on the axes of `changes`.
@@ -421,63 +465,67 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
                 self.timer.set_sign(axis, high & bit != 0);
             }
         }
-        self.sign.set(changes, high & changes);
+        self.sign.put(changes, high & changes);
     }
 
-    /// What follows the preloaded period.
+    /// Preloads what follows the preloaded period from the next queued command, none pending.
+    /// Each way preloads its own period, so the common one (the next step, in the same
+    /// directions) builds it in place. `MAY_STARVE`: an underrun may be under way (not after a
+    /// step, which the queue had).
     #[inline(always)]
-    fn next_period(&mut self, machine: &Machine) -> Period {
-        let (cmd, ticks) = match self.pending.take() {
-            Some(pending) => pending,
-            None => match self.queue.pop() {
-                Some(cmd) => {
-                    self.starving = false;
-                    let ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
-                    let (moving, forward) = step_bits(cmd);
-                    let high = (forward ^ self.timing.invert_mask) & moving;
-                    if self.sign_preloaded.changes(moving, high) != 0 {
-                        // SIGN holds after the last pulse, then changes as the pulse's own
-                        // period starts.
-                        let hold = self.timing.hold_ticks;
-                        self.pending = Some((cmd, ticks.saturating_sub(hold).max(self.timing.sign_period_ticks)));
-                        return Period::wait(hold, limits_toward(moving, forward));
-                    }
-                    (cmd, ticks)
-                }
-                None if self.queue.at_rest() => return Period::TAIL,
-                None => {
-                    if !self.starving {
-                        self.starving = true;
-                        machine.count_underrun();
-                    }
-                    return Period::wait(UNDERRUN_WAIT_TICKS, self.preloaded.toward);
-                }
-            },
+    fn preload_queued<const MAY_STARVE: bool>(&mut self, machine: &Machine) {
+        let Some(cmd) = self.queue.pop() else {
+            self.preload_dry(machine);
+            return;
         };
+        if MAY_STARVE {
+            self.starving = false;
+        }
+        let ticks = cmd.interval_ticks.max(self.timing.min_period_ticks);
+        let bits = StepBits::of(cmd);
+        if self.direction_preloaded.changes(bits.moving, bits.forward) != 0 {
+            // SIGN holds after the last pulse, then changes as the pulse's own period starts.
+            let hold = self.timing.hold_ticks;
+            self.pending = Some((cmd, ticks.saturating_sub(hold).max(self.timing.sign_period_ticks)));
+            self.preload(hold, 0, Period::wait(bits.toward));
+            return;
+        }
+        if ticks > T::MAX_PERIOD_TICKS {
+            self.preload_pulse_after(cmd, ticks, bits);
+            return;
+        }
+        self.preload(ticks, bits.moving, Period::step(cmd, bits, 0));
+    }
+
+    /// The queue has nothing: the rest, or an underrun.
+    #[cold]
+    #[inline(never)]
+    fn preload_dry(&mut self, machine: &Machine) {
+        if self.queue.at_rest() {
+            self.preload(TAIL_TICKS, 0, Period::TAIL);
+            return;
+        }
+        if !self.starving {
+            self.starving = true;
+            machine.count_underrun();
+        }
+        let toward = self.preloaded.toward;
+        self.preload(UNDERRUN_WAIT_TICKS, 0, Period::wait(toward));
+    }
+
+    /// Preloads the period of `ticks` that ends with `cmd`'s pulse, driving the SIGN levels it
+    /// needs; or where the timer cannot count so far, a pulse-less period before it.
+    #[cold]
+    #[inline(never)]
+    fn preload_pulse_after(&mut self, cmd: StepCmd, ticks: u32, bits: StepBits) {
         if ticks > T::MAX_PERIOD_TICKS {
             let wait = T::MAX_PERIOD_TICKS / 2;
             self.pending = Some((cmd, ticks - wait));
-            let (moving, forward) = step_bits(cmd);
-            return Period::wait(wait, limits_toward(moving, forward));
+            self.preload(wait, 0, Period::wait(bits.toward));
+            return;
         }
-        self.step_period(cmd, ticks)
-    }
-
-    /// The period of `ticks` that ends with `cmd`'s pulse, driving the SIGN levels it needs.
-    #[inline(always)]
-    fn step_period(&mut self, cmd: StepCmd, ticks: u32) -> Period {
-        let (moving, forward) = step_bits(cmd);
-        let high = (forward ^ self.timing.invert_mask) & moving;
-        let sign_changes = self.sign_preloaded.changes(moving, high);
-        self.sign_preloaded.set(moving, high);
-        Period {
-            ticks,
-            kind: Kind::Step,
-            cmd,
-            axes: moving,
-            sign_high: high,
-            sign_changes,
-            toward: limits_toward(moving, forward),
-        }
+        let changes = self.direction_preloaded.changes(bits.moving, bits.forward);
+        self.direction_preloaded.put(bits.moving, bits.forward);
+        self.preload(ticks, bits.moving, Period::step(cmd, bits, changes));
     }
 }

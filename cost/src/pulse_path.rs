@@ -55,12 +55,14 @@ impl StepTimer for ModelStepTimer {
     }
 
     fn preload(&mut self, ticks: u32, axes: u8) {
-        let edge = ticks.saturating_sub(self.width_ticks);
+        // As the board's: the edge, or on an axis without a pulse a compare never reached.
+        let edge = ticks.wrapping_sub(self.width_ticks);
+        let on = |axis: u8| edge | u32::from(axes & axis == 0).wrapping_neg();
         // SAFETY: the model's timer registers; COMPARE is only written here, from the interrupt.
         unsafe {
             write_volatile(TIMER0_RELOAD, ticks * TIMER_CLOCKS_PER_US / TICKS_PER_US);
-            write_volatile(addr_of_mut!(COMPARE[0]), if axes & 1 != 0 { edge } else { u32::MAX });
-            write_volatile(addr_of_mut!(COMPARE[1]), if axes & 2 != 0 { edge } else { u32::MAX });
+            write_volatile(addr_of_mut!(COMPARE[0]), on(1));
+            write_volatile(addr_of_mut!(COMPARE[1]), on(2));
         }
     }
 

@@ -56,8 +56,9 @@ impl StepQueue {
 
     /// The producer and the consumer end; the queue stays borrowed while they live.
     pub fn split(&mut self) -> (StepProducer<'_>, StepConsumer<'_>) {
+        let (taken, published) = (*self.taken.get_mut(), *self.published.get_mut());
         let queue = &*self;
-        (StepProducer { queue }, StepConsumer { queue })
+        (StepProducer { queue }, StepConsumer { queue, taken, published })
     }
 
     fn base(&self) -> *mut StepCmd {
@@ -110,7 +111,8 @@ impl StepProducer<'_> {
     }
 
     /// Takes back every command published and not yet taken, and rests there. Only while the
-    /// consumer takes nothing: the pulse engine halted by a trip (see [`crate::machine::Machine::trip`]).
+    /// consumer takes nothing: the pulse engine halted by a trip (see [`crate::machine::Machine::trip`]);
+    /// it sees the change at its next [`ready`](StepConsumer::ready).
     pub fn retract(&mut self) {
         let taken = self.queue.taken.load(Ordering::Acquire);
         self.queue.published.store(taken, Ordering::Release);
@@ -118,36 +120,48 @@ impl StepProducer<'_> {
     }
 }
 
-/// The pulse engine's end of the [`StepQueue`].
+/// The pulse engine's end of the [`StepQueue`]. It keeps its own copy of the commands taken
+/// (it alone changes them) and of the count published when it last looked, which it reads
+/// again only once it has taken that many: most commands cost no load of the producer's
+/// counter.
 pub struct StepConsumer<'q> {
     queue: &'q StepQueue,
+    taken: u32,
+    published: u32,
 }
 
 impl StepConsumer<'_> {
     /// The next command, if one is published.
     #[inline(always)]
     pub fn pop(&mut self) -> Option<StepCmd> {
-        let taken = self.queue.taken.load(Ordering::Relaxed);
-        if taken == self.queue.published.load(Ordering::Acquire) {
-            return None;
+        let taken = self.taken;
+        if taken == self.published {
+            self.published = self.queue.published.load(Ordering::Acquire);
+            if taken == self.published {
+                return None;
+            }
         }
-        // SAFETY: the slot of command `taken` lies within the ring and is published (the Acquire
-        // load above): the producer wrote it and writes it again only after `taken` moves past
-        // it (the Release store below). `&mut self` is the only consumer.
+        // SAFETY: the slot of command `taken` lies within the ring and is published (an Acquire
+        // load of `published`, now or before): the producer wrote it and writes it again only
+        // after `taken` moves past it (the Release store below). `&mut self` is the only
+        // consumer.
         let cmd = unsafe { self.queue.base().add((taken & MASK) as usize).read() };
-        self.queue.taken.store(taken.wrapping_add(1), Ordering::Release);
+        self.taken = taken.wrapping_add(1);
+        self.queue.taken.store(self.taken, Ordering::Release);
         Some(cmd)
     }
 
-    /// True when a command is published and not yet taken.
-    pub fn ready(&self) -> bool {
-        self.queue.taken.load(Ordering::Relaxed) != self.queue.published.load(Ordering::Acquire)
+    /// True when a command is published and not yet taken. Reads what the producer published
+    /// (and took back) anew.
+    pub fn ready(&mut self) -> bool {
+        self.published = self.queue.published.load(Ordering::Acquire);
+        self.taken != self.published
     }
 
     /// True when the commands taken end exactly at the producer's last rest: if the queue is
     /// empty now, the motion has ended (and not merely run ahead of the producer).
     pub fn at_rest(&self) -> bool {
-        self.queue.taken.load(Ordering::Relaxed) == self.queue.rest_at.load(Ordering::Acquire)
+        self.taken == self.queue.rest_at.load(Ordering::Acquire)
     }
 }
 

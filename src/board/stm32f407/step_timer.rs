@@ -99,13 +99,16 @@ impl StepTimer for Tim1StepTimer {
         self.sign[axis.index()].set_level(if high { Level::High } else { Level::Low });
     }
 
+    #[inline(always)]
     fn preload(&mut self, ticks: u32, axes: u8) {
         let regs = self.timer.regs_gp16();
         // The engine keeps 2·width ≤ ticks ≤ MAX_PERIOD_TICKS for periods that pulse.
         regs.arr().write(|w| w.set_arr((ticks - 1) as u16));
-        let edge = ticks.saturating_sub(self.width_ticks) as u16;
-        regs.ccr(0).write(|w| w.set_ccr(if axes & 1 != 0 { edge } else { NO_PULSE }));
-        regs.ccr(1).write(|w| w.set_ccr(if axes & 2 != 0 { edge } else { NO_PULSE }));
+        // The pulse's leading edge, or on an axis without a pulse NO_PULSE (all ones).
+        let edge = ticks.wrapping_sub(self.width_ticks) as u16;
+        let on = |axis: u8| edge | u16::from(axes & axis == 0).wrapping_neg();
+        regs.ccr(0).write(|w| w.set_ccr(on(1)));
+        regs.ccr(1).write(|w| w.set_ccr(on(2)));
     }
 
     fn start(&mut self, width_ticks: u32) {
