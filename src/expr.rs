@@ -179,6 +179,15 @@ enum BinOp {
     Max,
 }
 
+/// The operators of `expr` and `term`, as the parser fuses them with a constant operand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Arith {
+    Add,
+    Sub,
+    Mul,
+    Div,
+}
+
 /// One operation of the reverse-Polish program.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
@@ -187,6 +196,21 @@ enum Op {
     Num(u8),
     /// Push the argument `x`.
     X,
+    /// The program's first operand, the number at this index or `x`: nothing is under it to
+    /// push.
+    FirstNum(u8),
+    FirstX,
+    /// The top with the number at this index as the right operand: `top + c`, `top - c`,
+    /// `top * c`, `top / c`; where the source had a number there, one operation instead of two
+    /// and nothing pushed.
+    AddConst(u8),
+    SubConst(u8),
+    MulConst(u8),
+    DivConst(u8),
+    /// The number at this index with the top as the right operand: `c - top`, `c / top` (for
+    /// `+` and `*` the order makes no difference: [`Op::AddConst`], [`Op::MulConst`]).
+    ConstSub(u8),
+    ConstDiv(u8),
     /// Negate the top.
     Neg,
     /// Apply a one-argument function to the top.
@@ -203,8 +227,16 @@ impl Op {
     /// How the operation changes the stack's depth.
     const fn stack_effect(self) -> isize {
         match self {
-            Op::Num(_) | Op::X => 1,
-            Op::Neg | Op::Call(_) | Op::PowInt(_) => 0,
+            Op::Num(_) | Op::X | Op::FirstNum(_) | Op::FirstX => 1,
+            Op::Neg
+            | Op::Call(_)
+            | Op::PowInt(_)
+            | Op::AddConst(_)
+            | Op::SubConst(_)
+            | Op::MulConst(_)
+            | Op::DivConst(_)
+            | Op::ConstSub(_)
+            | Op::ConstDiv(_) => 0,
             Op::Bin(_) => -1,
         }
     }
@@ -245,28 +277,48 @@ impl Expr {
     /// f(x). Fails on a domain error, a division by zero or a value out of range.
     pub fn eval(&self, x: f32) -> Result<f32, EvalError> {
         // The top of the stack is `top`, the values under it are in `below`: most operations
-        // only change the top. The first push puts the initial `top` (no value) at the bottom.
+        // only change the top, and a program's first operand pushes nothing.
         let mut below = Stack(heapless::Vec::new());
         let mut top = 0.0;
         for op in self.ops.iter() {
             top = match *op {
+                Op::FirstNum(i) => self.constant(i)?,
+                Op::FirstX => checked(x)?,
                 Op::Num(i) => {
                     below.push(top)?;
-                    // Every index was made by the parser for this constant table.
-                    self.consts.get(usize::from(i)).copied().ok_or(EvalError::Overflow)?
+                    self.constant(i)?
                 }
                 Op::X => {
                     below.push(top)?;
                     checked(x)?
                 }
                 Op::Neg => -top,
-                Op::Call(f) => call(f, top)?,
+                Op::Call(f) => {
+                    let v = call(f, top);
+                    if !(v.abs() <= EXPR_MAX_MAGNITUDE) {
+                        return Err(call_error(f, top));
+                    }
+                    v
+                }
                 Op::Bin(op) => binary(op, below.pop()?, top)?,
                 Op::PowInt(n) => checked(power_int(top, i32::from(n))?)?,
+                Op::AddConst(i) => checked(top + self.constant(i)?)?,
+                Op::SubConst(i) => checked(top - self.constant(i)?)?,
+                Op::MulConst(i) => checked(top * self.constant(i)?)?,
+                Op::DivConst(i) => divided(top, self.constant(i)?)?,
+                Op::ConstSub(i) => checked(self.constant(i)? - top)?,
+                Op::ConstDiv(i) => divided(self.constant(i)?, top)?,
             };
         }
-        // A program leaves one value: its result on top of the initial one.
-        if below.0.len() == 1 { Ok(top) } else { Err(EvalError::Overflow) }
+        // A program leaves one value: its result, nothing under it.
+        if below.0.is_empty() { Ok(top) } else { Err(EvalError::Overflow) }
+    }
+
+    /// The number at index `i` of the constants.
+    #[inline(always)]
+    fn constant(&self, i: u8) -> Result<f32, EvalError> {
+        // Every index was made by the parser for this constant table.
+        self.consts.get(usize::from(i)).copied().ok_or(EvalError::Overflow)
     }
 
     /// Number of operations in the program (at most [`EXPR_MAX_OPS`]).
@@ -281,32 +333,45 @@ fn checked(v: f32) -> Result<f32, EvalError> {
     if v.abs() <= EXPR_MAX_MAGNITUDE { Ok(v) } else { Err(EvalError::Overflow) }
 }
 
-fn call(f: Func1, a: f32) -> Result<f32, EvalError> {
-    let v = match f {
+/// A function of `a`, or a NaN where `a` is outside its domain (see [`call_error`]). Out of
+/// line: inlined, its many constants would be loaded at the start of every evaluation,
+/// whatever the program calls; and it returns a plain `f32`, in a register.
+#[inline(never)]
+fn call(f: Func1, a: f32) -> f32 {
+    match f {
         Func1::Sin => math::sin(a),
         Func1::Cos => math::cos(a),
         Func1::Tan => {
             let (sin, cos) = math::sin_cos(a);
-            if cos.abs() < TAN_POLE_MIN_COS {
-                return Err(EvalError::TanPole);
-            }
-            sin / cos
+            if cos.abs() < TAN_POLE_MIN_COS { f32::NAN } else { sin / cos }
         }
-        Func1::Asin | Func1::Acos if !(-1.0..=1.0).contains(&a) => return Err(EvalError::ArcOutOfRange),
+        Func1::Asin | Func1::Acos if !(-1.0..=1.0).contains(&a) => f32::NAN,
         Func1::Asin => math::asin(a),
         Func1::Acos => math::acos(a),
         Func1::Atan => math::atan(a),
-        Func1::Sqrt if a < 0.0 => return Err(EvalError::SqrtOfNegative),
+        Func1::Sqrt if a < 0.0 => f32::NAN,
         Func1::Sqrt => math::sqrt(a),
         Func1::Abs => a.abs(),
         Func1::Exp => math::exp(a),
-        Func1::Ln | Func1::Log10 if a <= 0.0 => return Err(EvalError::LogOfNonPositive),
+        Func1::Ln | Func1::Log10 if a <= 0.0 => f32::NAN,
         Func1::Ln => math::ln(a),
         Func1::Log10 => math::log10(a),
         Func1::Floor => math::floor(a),
         Func1::Ceil => math::ceil(a),
-    };
-    checked(v)
+    }
+}
+
+/// Why `call(f, a)` is out of range: `a` outside the function's domain, or a value too large.
+#[cold]
+#[inline(never)]
+fn call_error(f: Func1, a: f32) -> EvalError {
+    match f {
+        Func1::Tan if math::sin_cos(a).1.abs() < TAN_POLE_MIN_COS => EvalError::TanPole,
+        Func1::Asin | Func1::Acos if !(-1.0..=1.0).contains(&a) => EvalError::ArcOutOfRange,
+        Func1::Sqrt if a < 0.0 => EvalError::SqrtOfNegative,
+        Func1::Ln | Func1::Log10 if a <= 0.0 => EvalError::LogOfNonPositive,
+        _ => EvalError::Overflow,
+    }
 }
 
 fn binary(op: BinOp, a: f32, b: f32) -> Result<f32, EvalError> {
@@ -314,13 +379,21 @@ fn binary(op: BinOp, a: f32, b: f32) -> Result<f32, EvalError> {
         BinOp::Add => a + b,
         BinOp::Sub => a - b,
         BinOp::Mul => a * b,
-        BinOp::Div if b == 0.0 => return Err(EvalError::DivisionByZero),
-        BinOp::Div => a / b,
+        BinOp::Div => return divided(a, b),
         BinOp::Pow => power(a, b)?,
         BinOp::Min => math::min(a, b),
         BinOp::Max => math::max(a, b),
     };
     checked(v)
+}
+
+/// `a / b`.
+#[inline(always)]
+fn divided(a: f32, b: f32) -> Result<f32, EvalError> {
+    if b == 0.0 {
+        return Err(EvalError::DivisionByZero);
+    }
+    checked(a / b)
 }
 
 /// `a^b`, by multiplication for a small integer `b` (see
@@ -344,6 +417,17 @@ fn power(a: f32, b: f32) -> Result<f32, EvalError> {
 /// power beyond).
 #[inline]
 fn power_int(a: f32, n: i32) -> Result<f32, EvalError> {
+    match n {
+        1 => Ok(a),
+        2 => Ok(a * a),
+        3 => Ok(a * a * a),
+        _ => power_int_other(a, n),
+    }
+}
+
+/// [`power_int`] for the exponents other than 1, 2 and 3.
+#[inline(never)]
+fn power_int_other(a: f32, n: i32) -> Result<f32, EvalError> {
     if a == 0.0 && n < 0 {
         return Err(EvalError::DivisionByZero);
     }
@@ -480,8 +564,14 @@ impl Parser<'_> {
         }
     }
 
-    /// Appends `op` to the program; `pos` is the token it comes from, for errors.
+    /// Appends `op` to the program; `pos` is the token it comes from, for errors. A number or
+    /// `x` with nothing on the stack is the program's first operand.
     fn emit(&mut self, op: Op, pos: usize) -> Result<(), ParseError> {
+        let op = match op {
+            Op::Num(i) if self.depth == 0 => Op::FirstNum(i),
+            Op::X if self.depth == 0 => Op::FirstX,
+            op => op,
+        };
         if self.ops.push(op).is_err() {
             return Self::error(ParseErrorKind::TooComplex, pos);
         }
@@ -523,32 +613,76 @@ impl Parser<'_> {
 
     /// `expr := term (('+' | '-') term)*`
     fn expr(&mut self) -> Result<(), ParseError> {
+        let mut left_at = Some(self.ops.len());
         self.term()?;
         loop {
-            let op = match self.peek()? {
-                (Tok::Plus, at) => (Op::Bin(BinOp::Add), at),
-                (Tok::Minus, at) => (Op::Bin(BinOp::Sub), at),
+            let (op, at) = match self.peek()? {
+                (Tok::Plus, at) => (Arith::Add, at),
+                (Tok::Minus, at) => (Arith::Sub, at),
                 _ => return Ok(()),
             };
             self.bump()?;
+            let left = self.lone_number(left_at.take());
             self.term()?;
-            self.emit(op.0, op.1)?;
+            self.emit_binary(op, left, at)?;
         }
     }
 
     /// `term := unary (('*' | '/') unary)*`
     fn term(&mut self) -> Result<(), ParseError> {
+        let mut left_at = Some(self.ops.len());
         self.unary()?;
         loop {
-            let op = match self.peek()? {
-                (Tok::Star, at) => (Op::Bin(BinOp::Mul), at),
-                (Tok::Slash, at) => (Op::Bin(BinOp::Div), at),
+            let (op, at) = match self.peek()? {
+                (Tok::Star, at) => (Arith::Mul, at),
+                (Tok::Slash, at) => (Arith::Div, at),
                 _ => return Ok(()),
             };
             self.bump()?;
+            let left = self.lone_number(left_at.take());
             self.unary()?;
-            self.emit(op.0, op.1)?;
+            self.emit_binary(op, left, at)?;
         }
+    }
+
+    /// If the operand compiled from `start` on (`None`: not a first operand) is a lone number,
+    /// takes it back and returns its index: the operation will take it as its constant.
+    fn lone_number(&mut self, start: Option<usize>) -> Option<u8> {
+        let i = match self.ops.get(start?..)? {
+            &[Op::Num(i) | Op::FirstNum(i)] => i,
+            _ => return None,
+        };
+        self.ops.pop();
+        self.depth = self.depth.saturating_sub(1);
+        Some(i)
+    }
+
+    /// Emits `+ - * /` once its right operand is compiled: with the constant `left` as its left
+    /// operand, or with a right operand that is a lone number as its constant, one operation.
+    /// The operands and their errors come in the order of the text either way (a number has
+    /// none), and `a + b`, `a * b` are exactly `b + a`, `b * a`.
+    fn emit_binary(&mut self, op: Arith, left: Option<u8>, at: usize) -> Result<(), ParseError> {
+        let fused = match (left, op, self.ops.last()) {
+            (Some(i), Arith::Add, _) => Op::AddConst(i),
+            (Some(i), Arith::Mul, _) => Op::MulConst(i),
+            (Some(i), Arith::Sub, _) => Op::ConstSub(i),
+            (Some(i), Arith::Div, _) => Op::ConstDiv(i),
+            (None, _, Some(&Op::Num(i))) => {
+                self.ops.pop();
+                self.depth = self.depth.saturating_sub(1);
+                match op {
+                    Arith::Add => Op::AddConst(i),
+                    Arith::Sub => Op::SubConst(i),
+                    Arith::Mul => Op::MulConst(i),
+                    Arith::Div => Op::DivConst(i),
+                }
+            }
+            (None, Arith::Add, _) => Op::Bin(BinOp::Add),
+            (None, Arith::Sub, _) => Op::Bin(BinOp::Sub),
+            (None, Arith::Mul, _) => Op::Bin(BinOp::Mul),
+            (None, Arith::Div, _) => Op::Bin(BinOp::Div),
+        };
+        self.emit(fused, at)
     }
 
     /// `unary := ('-' | '+') unary | power`

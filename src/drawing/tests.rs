@@ -235,11 +235,11 @@ fn slices_build_what_one_go_builds() {
 #[test]
 fn a_slice_does_about_as_much_work_whatever_it_walks() {
     // A step is worth one; an X step of a function one more per operation of its expression
-    // (8 here), of a sine four more: a slice of 2,048 steps' worth walks many steps of a steep
-    // curve and few of a flat one.
+    // (as compiled: 6 and 4 here), of a sine four more: a slice of 2,048 steps' worth walks many
+    // steps of a steep curve and few of a flat one.
     let cases = [
-        (function("20*exp(-x^2/200)", -30.0, 30.0), 8),
-        (function("sin(x/2)*100", -30.0, 30.0), 6),
+        (function("20*exp(-x^2/200)", -30.0, 30.0), 6),
+        (function("sin(x/2)*100", -30.0, 30.0), 4),
         (sine(10.0, 0.3, 60.0), 4),
         (ellipse(30.0, 15.0, 0.0, 360.0), 0),
     ];
@@ -247,6 +247,9 @@ fn a_slice_does_about_as_much_work_whatever_it_walks() {
         let mut slices = 0;
         sliced(&request, Point::ORIGIN, BUILD_SLICE_STEPS, |s, _| {
             slices += 1;
+            if s.kind == ShapeKind::Function {
+                assert_eq!(u32::from(s.expr_ops), evaluation, "{request:?}");
+            }
             let work = s.steps + s.x_steps * evaluation;
             // The last batch of a slice may reach one step's worth past it.
             assert!(work <= BUILD_SLICE_STEPS + 1 + evaluation, "{request:?}: {s:?}");

@@ -212,9 +212,9 @@ pub struct ExplicitCurve<G> {
     walk: Walk,
 }
 
-/// Where the walk along an explicit curve stands. Its code takes g as a `&dyn CurveFn`: one
-/// copy serves every kind of curve (a sine, a function), at the cost of one indirect call per
-/// column.
+/// Where the walk along an explicit curve stands. Its stepping is compiled for each kind of
+/// curve (a sine, a function), so that g is called directly at each column, not through a
+/// pointer; what runs once per curve takes g as a `&dyn CurveFn`.
 #[derive(Clone, Debug)]
 struct Walk {
     method: Method,
@@ -322,13 +322,13 @@ impl Walk {
         (0..c.done).fold(start, |p, j| p.stepped(c.step(j)))
     }
 
-    fn nominal_end(&self, g: &dyn CurveFn) -> Result<Point, CurveError> {
+    fn nominal_end<G: CurveFn + ?Sized>(&self, g: &G) -> Result<Point, CurveError> {
         Ok(Point::new(i32::from(self.dir) * self.columns, nearest_step(self.offset(g, self.columns)?)))
     }
 
     /// The ideal curve at `column`, relative to the start, in steps.
     #[inline]
-    fn offset(&self, g: &dyn CurveFn, column: i32) -> Result<f32, CurveError> {
+    fn offset<G: CurveFn + ?Sized>(&self, g: &G, column: i32) -> Result<f32, CurveError> {
         let h = (g.y(column)? - self.origin) * self.steps_per_unit;
         // False for NaN as well.
         if h.abs() <= MAX_CURVE_OFFSET_STEPS_F32 { Ok(h) } else { Err(CurveError::Overflow) }
@@ -337,7 +337,7 @@ impl Walk {
     /// The value and row of `column`, checked against the limits for a chord that starts at
     /// row `r0`, or why that chord cannot be drawn.
     #[inline(always)]
-    fn column(&self, g: &dyn CurveFn, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
+    fn column<G: CurveFn + ?Sized>(&self, g: &G, column: i32, r0: i32) -> Result<(f32, i32), CurveError> {
         let h = self.offset(g, column)?;
         let r = nearest_step(h);
         if (r - r0).abs() > self.max_jump_steps { Err(CurveError::Jump) } else { Ok((h, r)) }
@@ -410,7 +410,7 @@ impl<G: CurveFn> Interpolator for ExplicitCurve<G> {
 }
 
 impl Walk {
-    fn fill(&mut self, g: &dyn CurveFn, out: &mut [Step]) -> Filled {
+    fn fill<G: CurveFn>(&mut self, g: &G, out: &mut [Step]) -> Filled {
         let mut i = 0;
         loop {
             // An error is handed out only where there is room for a step: where `next_step`
