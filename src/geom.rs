@@ -78,6 +78,23 @@ impl Step {
         Step { x, y }
     }
 
+    /// The axes the step moves and which way, as bits: bit 0 X backward, bit 1 Y backward, bit 2
+    /// X forward, bit 3 Y forward (the order of the limit switches it runs towards, see
+    /// `crate::inputs`). A table lookup: a move of -1, 0 or +1 has the low bits 11, 00 or 01.
+    pub const fn directions(self) -> u8 {
+        const BITS: [u8; 16] = {
+            let mut bits = [0; 16];
+            let mut i = 0;
+            while i < 16 {
+                let (x, y) = (i & 3, i >> 2);
+                bits[i] = (x == 3) as u8 | ((y == 3) as u8) << 1 | ((x == 1) as u8) << 2 | ((y == 1) as u8) << 3;
+                i += 1;
+            }
+            bits
+        };
+        BITS[((self.x as u8 & 3) | ((self.y as u8 & 3) << 2)) as usize]
+    }
+
     /// The direction of `v` on one axis: -1, 0 or +1.
     pub const fn sign(v: i32) -> i8 {
         if v > 0 {
@@ -144,4 +161,22 @@ pub struct StepCmd {
     pub step: Step,
     /// Time from the previous pulse to this one, in [`TICK_HZ`] ticks.
     pub interval_ticks: u32,
+    /// `step.directions()`, worked out once where the command is made: the pulse engine's
+    /// interrupt only loads it (it fits the bytes the step leaves free).
+    directions: u8,
+}
+
+impl StepCmd {
+    /// No step, no interval: a placeholder.
+    pub const NONE: StepCmd = StepCmd::new(Step::NONE, 0);
+
+    pub const fn new(step: Step, interval_ticks: u32) -> StepCmd {
+        StepCmd { step, interval_ticks, directions: step.directions() }
+    }
+
+    /// [`Step::directions`] of the step.
+    #[inline(always)]
+    pub const fn directions(&self) -> u8 {
+        self.directions
+    }
 }

@@ -16,7 +16,7 @@
 //! An input trips once it has been active at every sample for the debounce time (`$206`): a
 //! glitch shorter than that never trips, a switch that bounces trips once it stays closed.
 
-use crate::geom::{Axis, TICK_HZ};
+use crate::geom::{Axis, Step, TICK_HZ};
 use crate::settings::Settings;
 
 /// Input bits, as [`InputLevels`] and [`InputSetup::active`] hold them.
@@ -67,12 +67,12 @@ impl Trip {
     }
 }
 
-/// The limit switches a step runs towards: the one at the end each of its axes moves to, from the
-/// axes it moves and those it moves forward (bits, bit 0 X, bit 1 Y; `forward` within `moving`).
+/// The limit switches a step runs towards: the one at the end each of its axes moves to. Its
+/// direction bits ([`Step::directions`]) are in the switches' order.
 #[inline(always)]
-pub fn limits_toward(moving: u8, forward: u8) -> u8 {
+pub const fn limits_toward(step: Step) -> u8 {
     const _: () = assert!(LIMIT_X_MIN == 1 && LIMIT_Y_MIN == 2 && LIMIT_X_MAX == 1 << 2 && LIMIT_Y_MAX == 2 << 2);
-    (moving & !forward) | (forward << 2)
+    step.directions()
 }
 
 /// Which inputs are wired and watched and which of their levels is active, from the settings.
@@ -237,9 +237,11 @@ mod tests {
 
     #[test]
     fn a_step_runs_toward_the_switches_at_the_ends_it_moves_to() {
-        // X forward, Y back; Y forward alone; nothing.
-        assert_eq!(limits_toward(0b11, 0b01), LIMIT_X_MAX | LIMIT_Y_MIN);
-        assert_eq!(limits_toward(0b10, 0b10), LIMIT_Y_MAX);
-        assert_eq!(limits_toward(0, 0), 0);
+        // X forward, Y back; Y forward alone; X back alone; both back; nothing.
+        assert_eq!(limits_toward(Step::new(1, -1)), LIMIT_X_MAX | LIMIT_Y_MIN);
+        assert_eq!(limits_toward(Step::new(0, 1)), LIMIT_Y_MAX);
+        assert_eq!(limits_toward(Step::new(-1, 0)), LIMIT_X_MIN);
+        assert_eq!(limits_toward(Step::new(-1, -1)), LIMIT_X_MIN | LIMIT_Y_MIN);
+        assert_eq!(limits_toward(Step::NONE), 0);
     }
 }

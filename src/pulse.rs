@@ -48,7 +48,7 @@
 //! calls it at the virtual times the hardware would.
 
 use crate::geom::{Axis, StepCmd, TICK_HZ, TICKS_PER_US, us_to_ticks};
-use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, Trip, limits_toward};
+use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, Trip};
 use crate::machine::Machine;
 use crate::math;
 use crate::settings::Settings;
@@ -185,15 +185,14 @@ struct StepBits {
 }
 
 impl StepBits {
+    /// From the command's direction bits: the motion task worked them out, the interrupt only
+    /// shifts and masks them.
     #[inline(always)]
     fn of(cmd: StepCmd) -> StepBits {
-        // A step of an axis is -1, 0 or +1: as a byte 0xFF, 0x00 or 0x01. Bit 0 says it moves,
-        // bit 1 that it moves backward: a few shifts and masks, no comparisons.
-        let (x, y) = (cmd.step.x as u8, cmd.step.y as u8);
-        let moving = (x & 1) | ((y & 1) << 1);
-        let backward = ((x >> 1) & 1) | (y & 2);
-        let forward = moving & !backward;
-        StepBits { moving, forward, toward: limits_toward(moving, forward) }
+        // Backward bits 0-1, forward bits 2-3: the limit switches ahead (`limits_toward`).
+        let toward = cmd.directions();
+        let forward = toward >> 2;
+        StepBits { moving: (toward | forward) & 3, forward, toward }
     }
 }
 
@@ -227,7 +226,7 @@ impl Period {
     const TAIL: Period = Period::pulseless(Kind::Tail, 0);
 
     const fn pulseless(kind: Kind, toward: u8) -> Period {
-        let cmd = StepCmd { step: crate::geom::Step::NONE, interval_ticks: 0 };
+        let cmd = StepCmd::NONE;
         Period { kind, cmd, sign_changes: 0, toward }
     }
 
@@ -409,7 +408,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
                     (true, false) => -1,
                 }
             };
-            repeated.cmd.step = crate::geom::Step::new(along(1), along(2));
+            repeated.cmd = StepCmd::new(crate::geom::Step::new(along(1), along(2)), repeated.cmd.interval_ticks);
             for _ in 0..extra {
                 machine.emitted(repeated.cmd);
             }

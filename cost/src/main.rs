@@ -129,7 +129,7 @@ fn with_planner(c: Curve, method: Method, limits: Limits) -> u64 {
     }
     // In batches, as the motion task fills the step queue.
     let mut buf =
-        [servoplot::geom::StepCmd { step: servoplot::geom::Step::NONE, interval_ticks: 0 }; PLANNER_BATCH_STEPS];
+        [servoplot::geom::StepCmd::NONE; PLANNER_BATCH_STEPS];
     let mut n = 0;
     loop {
         let emitted = p.fill(&mut buf, u32::MAX);
@@ -230,7 +230,7 @@ fn pulse_path_runs() {
     if filled.steps < PULSE_RUN_STEPS[1] {
         panic!("circle too short");
     }
-    let cmds = buf.map(|step| servoplot::geom::StepCmd { step, interval_ticks: PULSE_INTERVAL_TICKS });
+    let cmds = buf.map(|step| servoplot::geom::StepCmd::new(step, PULSE_INTERVAL_TICKS));
     let machine = pulse_path::machine(settings);
     for n in PULSE_RUN_STEPS {
         pulse_path::measure(&cmds[..n], if n == PULSE_RUN_STEPS[0] { "short" } else { "long" }, machine);

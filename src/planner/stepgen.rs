@@ -65,7 +65,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// by a hold), `Some(Err(e))` where a curve fails (the machine is then at rest; the next call
     /// goes on with the next segment).
     pub fn next_cmd(&mut self) -> Option<Result<StepCmd, CurveError>> {
-        let mut cmd = [StepCmd { step: crate::geom::Step::NONE, interval_ticks: 0 }];
+        let mut cmd = [StepCmd::NONE];
         let emitted = self.fill(&mut cmd, u32::MAX);
         match emitted.end {
             _ if emitted.steps == 1 => Some(Ok(cmd[0])),
@@ -102,7 +102,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         let (c, over) = carry.overflowing_add(*frac);
                         carry = c;
                         let interval_ticks = *whole + u32::from(over);
-                        *slot = StepCmd { step, interval_ticks };
+                        *slot = StepCmd::new(step, interval_ticks);
                         ticks = ticks.wrapping_add(interval_ticks);
                         dx += i32::from(step.x);
                         dy += i32::from(step.y);
@@ -131,7 +131,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         let (c, over) = carry.overflowing_add(frac);
                         carry = c;
                         let interval_ticks = whole + u32::from(over);
-                        *slot = StepCmd { step, interval_ticks };
+                        *slot = StepCmd::new(step, interval_ticks);
                         ticks = ticks.wrapping_add(interval_ticks);
                         dx += i32::from(step.x);
                         dy += i32::from(step.y);

@@ -7,7 +7,7 @@
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use crate::geom::{Step, StepCmd};
+use crate::geom::StepCmd;
 
 /// Commands the queue holds (a power of two). At 100 kHz, 256 steps are 2.5 ms of motion, many
 /// times the motion task's latency on its own interrupt executor, which refills the queue when
@@ -45,9 +45,8 @@ impl Default for StepQueue {
 impl StepQueue {
     /// An empty queue, at rest.
     pub const fn new() -> Self {
-        const NONE: StepCmd = StepCmd { step: Step::NONE, interval_ticks: 0 };
         StepQueue {
-            slots: UnsafeCell::new([NONE; STEP_QUEUE_LEN]),
+            slots: UnsafeCell::new([StepCmd::NONE; STEP_QUEUE_LEN]),
             taken: AtomicU32::new(0),
             published: AtomicU32::new(0),
             rest_at: AtomicU32::new(0),
@@ -169,10 +168,11 @@ impl StepConsumer<'_> {
 mod tests {
     extern crate std;
     use super::*;
+    use crate::geom::Step;
     use std::vec::Vec;
 
     fn cmd(i: u32) -> StepCmd {
-        StepCmd { step: Step::new(1, 0), interval_ticks: i }
+        StepCmd::new(Step::new(1, 0), i)
     }
 
     /// Publishes `cmds` in as few batches as the ring allows; how many it took.

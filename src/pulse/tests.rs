@@ -85,7 +85,7 @@ fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, m
 }
 
 fn step(x: i8, y: i8, interval_ticks: u32) -> StepCmd {
-    StepCmd { step: Step::new(x, y), interval_ticks }
+    StepCmd::new(Step::new(x, y), interval_ticks)
 }
 
 /// `n` microseconds in ticks.
