@@ -1,19 +1,22 @@
 #!/usr/bin/env python3
-"""Counts the instructions servoplot's motion path costs on a Cortex-M4F and prints the table.
+"""Counts what servoplot's motion path costs on a Cortex-M4F and prints the table.
 
-Builds the instruction-counting QEMU plugin (plugin/insn_count.c) and the harness (src/main.rs,
-the firmware's release profile), runs the harness on QEMU's mps2-an386 (a Cortex-M4 with FPU),
-and turns the instruction counts between the harness's marks into per-step figures.
+Builds the counting QEMU plugin (plugin/insn_count.c) and the harness (src/main.rs, the
+firmware's release profile), runs the harness on QEMU's mps2-an386 (a Cortex-M4 with FPU), and
+turns what the plugin counts between the harness's marks into per-step figures: instructions,
+exactly, and cycles on the STM32F407 from the Cortex-M4's instruction timings (see CYCLES).
 
     python3 count.py                    # every case: the table the README keeps
     python3 count.py --only circle      # cases whose name contains "circle"
     python3 count.py --only circle --profile   # and which functions the instructions went to
+    python3 count.py --kinds            # and the kinds of instructions each case runs
     python3 count.py --check-model f407.txt    # fails if the simulator's model is out of date
     python3 count.py --write-model f407.txt    # writes it anew from what is counted
     python3 count.py --masked           # longest stretch with interrupts masked (shared state)
     python3 count.py --masked --image ELF --qemu-arg=-serial --qemu-arg=null   # any image
 """
 import argparse
+import bisect
 import os
 import subprocess
 import sys
@@ -30,10 +33,51 @@ MASKED_SRC = os.path.join(HERE, "plugin", "masked.c")
 MASKED_PLUGIN = os.path.join(HERE, "..", "target", "cost", "masked.so")
 QEMU = "qemu-system-arm"
 
-# The processor the counts are turned into time for: the STM32F407 at 168 MHz, and an estimate
-# of its cycles per instruction running from flash through the ART accelerator.
+# The processor the counts are turned into time for: the STM32F407 at 168 MHz.
 CLOCK_HZ = 168_000_000
-CYCLES_PER_INSTRUCTION = 1.3
+
+# Cycles of each kind of instruction the plugin tells apart, on the Cortex-M4 with zero wait
+# states: its Technical Reference Manual (r0p1), Table 3-1 and 3.3.2 (load and store timings),
+# and Table 7-1 for the FPU.
+CYCLES = {
+    "alu": 1,          # data processing, moves, compares, shifts, bit fields, extends
+    "mul": 1,          # MUL, MLA, MLS, SMULL, UMULL, SMLAL, UMLAL
+    "div": 12,         # SDIV, UDIV: 2 to 12 by early termination; the most
+    "load": 2,         # LDR, LDRB, LDRH, LDRSB, LDRSH
+    "load_pipe": 1,    # the same right after a load: its address phase overlaps that load's data
+    "load_pc": 2,      # LDR PC: 2, and the refill below
+    "store": 1,        # STR with an immediate offset: its data phase overlaps what follows
+    "store_reg": 2,    # STR with a register offset
+    "pair": 3,         # LDRD, STRD: 1 + N
+    "multi": 1,        # LDM, STM, PUSH, POP: 1 + N, the N words charged apart (WORD_CYCLES)
+    "branch": 1,       # B, BL, BX, BLX, CBZ, CBNZ: 1, and a refill where taken
+    "table": 2,        # TBB, TBH: 2, and a refill
+    "it": 1,           # IT
+    "it_folded": 0,    # IT right after a 16-bit instruction: folded into it
+    "barrier": 1,      # DMB, DSB, ISB: 1 + B, B at its least (0; ISB's refill is counted)
+    "system": 2,       # MRS, MSR, CPSIE, CPSID: 1 or 2, the most; WFI without its wait
+    "fp": 1,           # VADD, VSUB, VMUL, VABS, VNEG, VCMP, VCVT, VMOV, VMRS
+    "fp_mac": 3,       # VMLA, VMLS, VNMLA, VNMLS, VFMA, VFMS
+    "fp_divsqrt": 14,  # VDIV, VSQRT
+    "fp_load": 2,      # VLDR
+    "fp_store": 2,     # VSTR
+    "fp_multi": 1,     # VLDM, VSTM, VPUSH, VPOP: 1 + N words
+    "other": 1,        # anything else (the run says which, if any)
+}
+# Each word an LDM, STM, PUSH, POP or their FPU forms move.
+WORD_CYCLES = 1
+# The pipeline's refill after a taken branch: 1 to 3 by the target's alignment and width, and
+# whether the core speculated its address early (TRM, Table 3-1, P): the most.
+REFILL_CYCLES = 3
+# The STM32F407 runs from flash at 5 wait states at 168 MHz and 2.7-3.6 V (RM0090, Table 10),
+# through the ART accelerator with prefetch and both caches on. Sequential code streams through
+# the prefetch buffer; a taken branch whose target line is not in the 64-line instruction cache,
+# and a load of a constant from flash not in the 8-line data cache, waits them out. The plugin
+# models both caches (least recently used line out).
+FLASH_WAIT_CYCLES = 5
+# The step timer's interrupt runs once a pulse: entry 12 cycles (TRM 5.5.1, interrupt latency),
+# return 10, which no instruction of the handler shows.
+INTERRUPT_CYCLES = 12 + 10
 
 # The simulator's model (f407.txt): each kind of curve costs what its costliest case costs.
 MODEL_KINDS = {
@@ -45,11 +89,13 @@ MODEL_KINDS = {
 }
 MODEL_HEADER = """\
 # The motion path's cost on the board, for the simulator's CPU model (`cargo sim --cpu f407`).
-# Written by `python3 cost/count.py --write-model cost/f407.txt` from the instructions counted on
-# QEMU's Cortex-M4F (mps2-an386); `.ci/run` checks that it still matches what is counted.
-# Per step: the motion task all-in (interpolator, planner, task), the most costly case of each kind.
-# Per pulse: the step timer's interrupt. Cycles per instruction: an estimate for the STM32F407 at
-# 168 MHz running from flash through its ART accelerator (five wait states).
+# Written by `python3 cost/count.py --write-model cost/f407.txt` from what is counted on QEMU's
+# Cortex-M4F (mps2-an386); `.ci/run` checks that it still matches.
+# Per step: the motion task all-in (interpolator, planner, task), the most costly case of each
+# kind (in cycles). Per pulse: the step timer's interrupt. The figures are instructions; each
+# `cycles_per_instruction` turns its kind's into cycles on the STM32F407 at 168 MHz (the
+# Cortex-M4's instruction timings, flash at five wait states through the ART accelerator, and
+# for the pulse the interrupt's entry and return: see count.py).
 # A function: per step, plus per X step (where it evaluates the curve) `per_x_step` and
 # `per_x_step_op` per operation of its expression. `build`: the drawing builder's walk per step,
 # plus per X step of a sine or a function `per_x_step`, and for a function `per_x_step_op`.
@@ -58,10 +104,9 @@ MODEL_HEADER = """\
 MODEL_TOLERANCE = 0.05
 
 # The budgets (--check-budgets): instructions per step of the motion task all-in, by kind of
-# curve, and per pulse. Together they let both axes run at 100 kHz on any curve with at most
-# half of the processor.
-STEP_BUDGETS = {"line": 250, "arc": 250, "ellipse": 250, "sine": 600, "function": 600}
-PULSE_BUDGET = 300
+# curve, and per pulse.
+STEP_BUDGETS = {"line": 200, "arc": 200, "ellipse": 200, "sine": 400, "function": 400}
+PULSE_BUDGET = 150
 
 # The longest stretch with interrupts masked (--masked), instructions: outside the pulse
 # interrupt, the pulses wait at most this long for their interrupt (500 instructions are about
@@ -106,6 +151,44 @@ def demangle(name):
     return text
 
 
+class Counts:
+    """What the plugin counted over a stretch of the run: instructions, each kind, the words of
+    multiple transfers, taken branches and misses of the flash caches."""
+
+    def __init__(self, kinds, values):
+        self.kinds = kinds
+        self.values = values
+
+    def __sub__(self, other):
+        return Counts(self.kinds, [a - b for a, b in zip(self.values, other.values)])
+
+    def __add__(self, other):
+        return Counts(self.kinds, [a + b for a, b in zip(self.values, other.values)])
+
+    @property
+    def instructions(self):
+        return self.values[0]
+
+    def kind(self, name):
+        return self.values[1 + self.kinds.index(name)]
+
+    @property
+    def words(self):
+        return self.values[-4]
+
+    @property
+    def taken(self):
+        return self.values[-3]
+
+    @property
+    def misses(self):
+        return self.values[-2] + self.values[-1]
+
+    def cycles(self):
+        base = sum(CYCLES[k] * self.kind(k) for k in self.kinds)
+        return base + WORD_CYCLES * self.words + REFILL_CYCLES * self.taken + FLASH_WAIT_CYCLES * self.misses
+
+
 def run(only, profile):
     syms = functions(ELF)
     mark = next(addr for addr, _, name in syms if name == "cost_mark")
@@ -119,7 +202,14 @@ def run(only, profile):
         sys.exit(f"the harness failed ({done.returncode}):\n{done.stdout}{done.stderr}")
     with open(log) as f:
         lines = f.read().splitlines()
-    marks = [int(l.split()[1]) for l in lines if l.startswith("mark ")]
+    kinds = next(l.split()[1:] for l in lines if l.startswith("kinds "))
+    unknown = [kind for kind in kinds if kind not in CYCLES]
+    if unknown:
+        sys.exit(f"no cycles for the plugin's kinds {unknown}")
+    for l in lines:
+        if l.startswith("unknown "):
+            print(f"note: `{l.split()[1]}` is not a kind the plugin knows: charged {CYCLES['other']} cycle")
+    marks = [Counts(kinds, [int(v) for v in l.split()[1:]]) for l in lines if l.startswith("mark ")]
     results = [l.split() for l in done.stdout.splitlines() if l.startswith("result ")]
     if len(marks) != 2 * len(results) + 2:
         sys.exit(f"{len(marks)} marks for {len(results)} results:\n{done.stdout}")
@@ -130,11 +220,11 @@ def run(only, profile):
     # The builder's slices also count one by one: the longest of each case.
     longest = {}
     for k, (_, what, case, method, count) in enumerate(results):
-        instructions = marks[2 * k + 3] - marks[2 * k + 2] - overhead
-        total, steps = measured.get((case, method, what), (0, 0))
-        measured[(case, method, what)] = (total + instructions, steps + int(count))
-        if what == "slice":
-            longest[(case, method)] = max(longest.get((case, method), 0), instructions)
+        counts = marks[2 * k + 3] - marks[2 * k + 2] - overhead
+        total, steps = measured.get((case, method, what), (Counts(kinds, [0] * len(counts.values)), 0))
+        measured[(case, method, what)] = (total + counts, steps + int(count))
+        if what == "slice" and ((case, method) not in longest or counts.cycles() > longest[(case, method)].cycles()):
+            longest[(case, method)] = counts
     blocks = [l.split() for l in lines if l.startswith("block ")]
     return measured, blocks, syms, (done.stdout, longest)
 
@@ -142,7 +232,6 @@ def run(only, profile):
 def print_profile(blocks, syms):
     syms = sorted(syms)
     starts = [a for a, _, _ in syms]
-    import bisect
     per_function = {}
     for _, addr, n, execs in blocks:
         a = int(addr, 16)
@@ -155,12 +244,30 @@ def print_profile(blocks, syms):
         print(f"{count:>12} {100 * count / total:5.1f}%  {name[:110]}")
 
 
-def model_from(measured, per_pulse):
+class Pulse:
+    """The pulse path, per pulse: the difference of two runs of different lengths."""
+
+    def __init__(self, measured):
+        short, long_ = measured.get(("short", "both", "pulse")), measured.get(("long", "both", "pulse"))
+        self.counts = None
+        if short and long_:
+            self.n = long_[1] - short[1]
+            self.counts = long_[0] - short[0]
+
+    def instructions(self):
+        return self.counts.instructions / self.n
+
+    def cycles(self):
+        return self.counts.cycles() / self.n + INTERRUPT_CYCLES
+
+
+def model_from(measured, pulse):
     """The simulator's model file from the counts, or None if a case is missing."""
-    lines = [MODEL_HEADER + f"clock_hz {CLOCK_HZ}", f"cycles_per_instruction {CYCLES_PER_INSTRUCTION}"]
-    if per_pulse is None:
+    if pulse.counts is None:
         return None
-    lines.append(f"pulse {round(per_pulse)}")
+    lines = [MODEL_HEADER + f"clock_hz {CLOCK_HZ}"]
+    lines.append(f"pulse {round(pulse.instructions())}")
+    lines.append(f"pulse cycles_per_instruction {pulse.cycles() / pulse.instructions():.2f}")
     for kind, cases in MODEL_KINDS.items():
         if kind == "function":
             # Fitted by the size of the expression: see build_model.
@@ -169,7 +276,9 @@ def model_from(measured, per_pulse):
             costs = [measured[(c, method, "task")] for c in cases if (c, method, "task") in measured]
             if len(costs) != len(cases):
                 return None
-            lines.append(f"{kind} {method} {round(max(n / s for n, s in costs))}")
+            counts, steps = max(costs, key=lambda cs: cs[0].cycles() / cs[1])
+            lines.append(f"{kind} {method} {round(counts.instructions / steps)}")
+            lines.append(f"{kind} {method} cycles_per_instruction {counts.cycles() / counts.instructions:.2f}")
     return "\n".join(lines) + "\n"
 
 
@@ -180,7 +289,8 @@ def model_from(measured, per_pulse):
 # costs in the usual mix (arithmetic, sin, cos, exp, sqrt, small powers): a function whose
 # operations are mostly sines costs up to a fifth more than the model says, one of mostly
 # arithmetic a fifth less. b-fn-heavy, all general powers, costs three times as much per
-# operation: it is counted for the longest slice, not fitted.
+# operation: it is counted for the longest slice, not fitted. Each fit's cycles per instruction
+# are those of its cases together.
 MOTION_FUNCTION_CASES = ["gauss", "cubic", "sinx", "m-fn3", "m-fn10", "m-fn18", "m-fn30"]
 BUILD_KINDS = {
     "arc": ["b-circle", "b-arc"],
@@ -223,45 +333,62 @@ def walked(output):
     return facts
 
 
+def cycles_per_instruction(counts):
+    """Cycles per instruction over `counts`, a list of Counts."""
+    return sum(c.cycles() for c in counts) / sum(c.instructions for c in counts)
+
+
 def build_model(measured, facts):
     """The builder's figures and the motion task's function figures, by method: name -> value;
     None if a case is missing."""
     out = {}
     for method in ("classic", "diagonal"):
-        rows, values = [], []
+        rows, values, counted = [], [], []
         for case in MOTION_FUNCTION_CASES:
             if (case, method, "task") not in measured or (case, method) not in facts:
                 return None
-            n, steps = measured[(case, method, "task")]
+            counts, steps = measured[(case, method, "task")]
             _, x_steps, ops = facts[(case, method)]
             rows.append([steps, x_steps, x_steps * ops])
-            values.append(n)
+            values.append(counts.instructions)
+            counted.append(counts)
         x = least_squares(rows, values)
         out[f"function {method}"], out[f"function {method} per_x_step"] = x[0], x[1]
         out[f"function {method} per_x_step_op"] = x[2]
+        out[f"function {method} cycles_per_instruction"] = cycles_per_instruction(counted)
         for kind, cases in BUILD_KINDS.items():
-            rows, values = [], []
+            rows, values, counted = [], [], []
             for case in cases:
                 if (case, method, "slice") not in measured or (case, method) not in facts:
                     return None
-                n, steps = measured[(case, method, "slice")]
+                counts, steps = measured[(case, method, "slice")]
                 _, x_steps, ops = facts[(case, method)]
                 rows.append({"sine": [steps, x_steps], "function": [steps, x_steps, x_steps * ops]}.get(kind, [steps]))
-                values.append(n)
+                values.append(counts.instructions)
+                counted.append(counts)
+            cpi = cycles_per_instruction(counted)
             if kind in ("arc", "ellipse"):
                 out[f"build {kind} {method}"] = max(v / r[0] for r, v in zip(rows, values))
+                out[f"build {kind} {method} cycles_per_instruction"] = cpi
                 continue
             x = least_squares(rows, values)
             out[f"build {kind} {method}"], out[f"build {kind} {method} per_x_step"] = x[0], x[1]
             if kind == "function":
                 out[f"build function {method} per_x_step_op"] = x[2]
+            out[f"build {kind} {method} cycles_per_instruction"] = cpi
     return out
 
 
 def build_model_lines(figures):
     """The model's lines for `figures`: the motion task's function figures, then the builder's."""
     order = [n for n in figures if n.startswith("function ")] + [n for n in figures if n.startswith("build ")]
-    return [f"{n} {figures[n]:.1f}" if figures[n] < 10 else f"{n} {round(figures[n])}" for n in order]
+    def value(name):
+        v = figures[name]
+        if name.endswith(" cycles_per_instruction"):
+            return f"{v:.2f}"
+        return f"{v:.1f}" if v < 10 else f"{round(v)}"
+
+    return [f"{n} {value(n)}" for n in order]
 
 
 def print_functions(measured, facts, figures):
@@ -273,7 +400,8 @@ def print_functions(measured, facts, figures):
     print("| case | method | steps | X steps | ops | instr/step | model (instr/step) |")
     print("|---|---|---:|---:|---:|---:|---:|")
     for case, method in rows:
-        n, steps = measured[(case, method, "task")]
+        counts, steps = measured[(case, method, "task")]
+        n = counts.instructions
         _, x_steps, ops = facts.get((case, method), ("?", 0, 0))
         c = figures[f"function {method} per_x_step"] + figures[f"function {method} per_x_step_op"] * ops
         model = (figures[f"function {method}"] * steps + c * x_steps) / steps
@@ -292,7 +420,8 @@ def print_builds(measured, facts, figures, longest):
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     worst = 0.0
     for case, method in rows:
-        n, steps = measured[(case, method, "slice")]
+        counts, steps = measured[(case, method, "slice")]
+        n = counts.instructions
         kind, x_steps, ops = facts.get((case, method), ("?", 0, 0))
         model = ""
         if figures:
@@ -301,8 +430,9 @@ def print_builds(measured, facts, figures, longest):
                  + figures.get(f"build {kind} {method} per_x_step_op", 0.0) * ops)
             model = f"{(s * steps + c * x_steps) / steps:.1f}"
         per_x = f"{n / x_steps:.0f}" if x_steps else ""
-        slice_n = longest.get((case, method), 0)
-        slice_ms = slice_n * CYCLES_PER_INSTRUCTION / CLOCK_HZ * 1000
+        slice_counts = longest.get((case, method))
+        slice_n = slice_counts.instructions if slice_counts else 0
+        slice_ms = slice_counts.cycles() / CLOCK_HZ * 1000 if slice_counts else 0.0
         worst = max(worst, slice_ms)
         print(f"| {case} | {method} | {steps} | {x_steps} | {ops} | {n / steps:.1f} | {per_x} | {model} "
               f"| {slice_n} | {slice_ms:.2f} |")
@@ -333,18 +463,19 @@ def check_model(path, model):
     print(f"\n{path} matches the counts (within {MODEL_TOLERANCE:.0%})")
 
 
-def check_budgets(measured, per_pulse):
+def check_budgets(measured, pulse):
     over = []
     for kind, cases in MODEL_KINDS.items():
         for case in cases:
             for method in ("classic", "diagonal"):
                 if (case, method, "task") not in measured:
                     continue
-                n, steps = measured[(case, method, "task")]
-                if n / steps > STEP_BUDGETS[kind]:
-                    over.append(f"{case} {method}: {n / steps:.1f} instructions per step, budget {STEP_BUDGETS[kind]}")
-    if per_pulse is not None and per_pulse > PULSE_BUDGET:
-        over.append(f"pulse path: {per_pulse:.1f} instructions per pulse, budget {PULSE_BUDGET}")
+                counts, steps = measured[(case, method, "task")]
+                if counts.instructions / steps > STEP_BUDGETS[kind]:
+                    over.append(f"{case} {method}: {counts.instructions / steps:.1f} instructions per step, "
+                                f"budget {STEP_BUDGETS[kind]}")
+    if pulse.counts is not None and pulse.instructions() > PULSE_BUDGET:
+        over.append(f"pulse path: {pulse.instructions():.1f} instructions per pulse, budget {PULSE_BUDGET}")
     if over:
         sys.exit("over budget:\n  " + "\n  ".join(over))
     print(f"\nevery case within its budget (per step: {STEP_BUDGETS}; per pulse: {PULSE_BUDGET})")
@@ -352,7 +483,6 @@ def check_budgets(measured, per_pulse):
 
 def name_of(addr, syms):
     """`function+offset` for a code address, from the image's function symbols."""
-    import bisect
     if addr >= 0xFFFF_FFFF:
         return "?"
     starts = [a for a, _, _ in syms]
@@ -420,10 +550,38 @@ def print_masked(stretches, notes, syms, budget, check):
         sys.exit(f"over budget: a masked stretch of {longest} instructions, budget {budget}")
 
 
+# The kinds the --kinds table shows, as shares of the instructions; the rest are "other".
+KIND_GROUPS = [
+    ("ALU", ["alu", "it", "it_folded"]),
+    ("loads", ["load", "load_pipe", "load_pc", "pair"]),
+    ("stores", ["store", "store_reg"]),
+    ("multiple", ["multi"]),
+    ("branches", ["branch", "table"]),
+    ("MUL", ["mul"]),
+    ("DIV", ["div"]),
+    ("FPU", ["fp", "fp_mac", "fp_load", "fp_store", "fp_multi"]),
+    ("VDIV/VSQRT", ["fp_divsqrt"]),
+]
+
+
+def print_kinds(rows):
+    """Per case: the share of each group of kinds, the branches taken and the cache misses."""
+    names = [name for name, _ in KIND_GROUPS]
+    print("\n| case | " + " | ".join(names) + " | taken branches | flash cache misses | cycles per instruction |")
+    print("|---|" + "---:|" * (len(names) + 3))
+    for label, counts in rows:
+        n = counts.instructions
+        shares = [sum(counts.kind(k) for k in kinds) / n for _, kinds in KIND_GROUPS]
+        cells = " | ".join(f"{100 * s:.1f} %" for s in shares)
+        print(f"| {label} | {cells} | {100 * counts.taken / n:.1f} % | {100 * counts.misses / n:.2f} % "
+              f"| {counts.cycles() / n:.2f} |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", help="run only the cases whose name contains this text")
     parser.add_argument("--profile", action="store_true", help="also print instructions per function")
+    parser.add_argument("--kinds", action="store_true", help="also print the kinds of instructions per case")
     parser.add_argument("--no-build", action="store_true", help="use the harness and plugin as built")
     parser.add_argument("--write-model", metavar="FILE", help="write the simulator's CPU model from the counts")
     parser.add_argument("--check-model", metavar="FILE", help="fail if the simulator's CPU model is out of date")
@@ -455,37 +613,50 @@ def main():
     def per_step(case, method, what):
         if (case, method, what) not in measured:
             return None
-        n, steps = measured[(case, method, what)]
-        return n / max(steps, 1)
+        counts, steps = measured[(case, method, what)]
+        return counts.instructions / max(steps, 1)
 
-    short, long_ = measured.get(("short", "both", "pulse")), measured.get(("long", "both", "pulse"))
-    per_pulse = (long_[0] - short[0]) / (long_[1] - short[1]) if short and long_ else None
+    pulse = Pulse(measured)
 
-    def khz(instructions):
-        return f"{CLOCK_HZ / (CYCLES_PER_INSTRUCTION * instructions) / 1000:.0f}"
+    def khz(cycles):
+        return f"{CLOCK_HZ / cycles / 1000:.0f}"
 
-    print("Instructions on a Cortex-M4F; step rates at 168 MHz and 1.3 cycles per instruction.\n")
+    print("Instructions on a Cortex-M4F, counted; cycles on the STM32F407 from the Cortex-M4's "
+          "instruction timings, step rates at 168 MHz.\n")
     print("| curve | method | setup (instructions) | steps | interpolator (instr/step) | + planner (instr/step) "
-          "| + motion task (instr/step) | motion task alone tops out at (kHz) | with the pulses too (kHz) |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+          "| + motion task (instr/step) | cycles/step (per instruction) | motion task alone tops out at (kHz) "
+          "| with the pulses too (kHz) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    kind_rows = []
     for case, method in cases:
         fmt = lambda v: "" if v is None else f"{v:.1f}"
-        task = per_step(case, method, "task")
-        setup = measured.get((case, method, "setup"), (0, 0))[0]
-        steps = measured.get((case, method, "interp"), (0, 0))[1]
-        alone = khz(task) if task else ""
-        both = khz(task + per_pulse) if task and per_pulse else ""
-        print(f"| {case} | {method} | {setup} | {steps} | {fmt(per_step(case, method, 'interp'))} "
-              f"| {fmt(per_step(case, method, 'planner'))} | {fmt(task)} | {alone} | {both} |")
-    if per_pulse is not None:
-        print(f"\nPulse path: {per_pulse:.1f} instructions per pulse (the step timer's interrupt, entry to "
-              f"return, with the sleep around it); alone it tops out at {khz(per_pulse)} kHz.")
+        task = measured.get((case, method, "task"))
+        setup = measured.get((case, method, "setup"), (None, 0))[0]
+        steps = measured.get((case, method, "interp"), (None, 0))[1]
+        cycles = task[0].cycles() / task[1] if task else None
+        alone = khz(cycles) if cycles else ""
+        both = khz(cycles + pulse.cycles()) if cycles and pulse.counts else ""
+        cpi = f"{cycles:.0f} ({task[0].cycles() / task[0].instructions:.2f})" if task else ""
+        print(f"| {case} | {method} | {setup.instructions if setup else ''} | {steps} "
+              f"| {fmt(per_step(case, method, 'interp'))} | {fmt(per_step(case, method, 'planner'))} "
+              f"| {fmt(per_step(case, method, 'task'))} | {cpi} | {alone} | {both} |")
+        if task:
+            kind_rows.append((f"{case} {method}", task[0]))
+    if pulse.counts is not None:
+        print(f"\nPulse path: {pulse.instructions():.1f} instructions per pulse (the step timer's interrupt, entry to "
+              f"return, with the sleep around it), {pulse.cycles():.0f} cycles with the interrupt's entry and "
+              f"return ({pulse.cycles() / pulse.instructions():.2f} per instruction, "
+              f"{1e6 * pulse.cycles() / CLOCK_HZ:.2f} µs); alone it tops out at {khz(pulse.cycles())} kHz.")
+        kind_rows.append(("pulse path", pulse.counts))
+    if args.kinds:
+        print_kinds(kind_rows)
+    model = model_from(measured, pulse)
     output, longest = output
     facts = walked(output)
     figures = build_model(measured, facts)
     print_functions(measured, facts, figures)
     slice_ms = print_builds(measured, facts, figures, longest)
-    model = model_from(measured, per_pulse)
+    model = model_from(measured, pulse)
     if model is not None and figures is not None:
         model += "\n".join(build_model_lines(figures)) + "\n"
     else:
@@ -497,7 +668,7 @@ def main():
     if args.check_model:
         check_model(args.check_model, model)
     if args.check_budgets:
-        check_budgets(measured, per_pulse)
+        check_budgets(measured, pulse)
         if slice_ms is not None and slice_ms > BUILD_SLICE_BUDGET_MS:
             sys.exit(f"a slice of the builder takes {slice_ms:.2f} ms, budget {BUILD_SLICE_BUDGET_MS} ms")
         print(f"every slice of the builder within its budget ({BUILD_SLICE_BUDGET_MS} ms)")

@@ -92,10 +92,11 @@ pub fn table() {
     println!(
         "Each drawing at F60000 with 200 steps/mm, 1,000 mm/s and 10,000 mm/s² on both axes, so that \
          the pulse rate binds; the simulator charges the firmware's work the time it takes on the F407 \
-         (`--cpu f407`, {} instructions per pulse for the step timer's interrupt). Rates tried: 10 to \
-         200 kHz; \"≥ 200\" means every rate kept up. \"Fastest reached\": the most steps in any 2 ms, \
-         at that `$205`.\n",
-        cpu.pulse_instructions
+         (`--cpu f407`, {:.0} instructions and {:.0} cycles per pulse for the step timer's interrupt). \
+         Rates tried: 10 to 200 kHz; \"≥ 200\" means every rate kept up. \"Fastest reached\": the most \
+         steps in any 2 ms, at that `$205`.\n",
+        cpu.pulse_instructions,
+        cpu.pulse_instructions * cpu.pulse_cycles_per_instruction
     );
     println!(
         "| drawing | classic: highest `$205` (kHz) | fastest reached (kHz) | diagonal: highest `$205` (kHz) | fastest reached (kHz) |"

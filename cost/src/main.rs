@@ -128,8 +128,7 @@ fn with_planner(c: Curve, method: Method, limits: Limits) -> u64 {
         panic!("push");
     }
     // In batches, as the motion task fills the step queue.
-    let mut buf =
-        [servoplot::geom::StepCmd::NONE; PLANNER_BATCH_STEPS];
+    let mut buf = [servoplot::geom::StepCmd::NONE; PLANNER_BATCH_STEPS];
     let mut n = 0;
     loop {
         let emitted = p.fill(&mut buf, u32::MAX);

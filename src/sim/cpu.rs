@@ -1,7 +1,7 @@
 //! The board's processor, modelled for the simulator: how long the motion task's work and the
 //! builds of drawings take on the STM32F407, and how much of the processor the step timer's
 //! interrupt takes meanwhile. The figures are the instructions the cost harness counts on a
-//! Cortex-M4F (`cost/f407.txt`).
+//! Cortex-M4F and the cycles they take on average (`cost/f407.txt`).
 //!
 //! With the model in place the motion task publishes a batch of steps only once the chip would
 //! have computed it, so the pulses wait for it, and an underrun is counted, exactly where the
@@ -44,9 +44,10 @@ const METHODS: [(&str, Method); 2] = [("classic", Method::Classic), ("diagonal",
 #[derive(Clone, Debug, PartialEq)]
 pub struct CpuModel {
     pub clock_hz: f32,
-    pub cycles_per_instruction: f32,
     /// Instructions of the step timer's interrupt per pulse.
     pub pulse_instructions: f32,
+    /// The cycles each of them takes on average, the interrupt's entry and return included.
+    pub pulse_cycles_per_instruction: f32,
     /// Instructions of the motion task per step; for a function, besides its X steps'.
     pub step_instructions: [[f32; 2]; 5],
     /// Instructions of the motion task per X step of a function (where the planner evaluates
@@ -54,6 +55,8 @@ pub struct CpuModel {
     pub function_x_step_instructions: [f32; 2],
     /// The same per operation of the function's expression.
     pub function_x_step_op_instructions: [f32; 2],
+    /// The cycles each of the motion task's instructions takes on average.
+    pub step_cycles_per_instruction: [[f32; 2]; 5],
     /// Instructions of the builder per step walked (a line is not walked: 0).
     pub build_step_instructions: [[f32; 2]; 5],
     /// Instructions of the builder per X step of a sine or a function, besides the step: the
@@ -61,6 +64,8 @@ pub struct CpuModel {
     pub build_x_step_instructions: [[f32; 2]; 5],
     /// Instructions of the builder per X step of a function, per operation of its expression.
     pub build_function_op_instructions: [f32; 2],
+    /// The cycles each of the builder's instructions takes on average (a line: 0).
+    pub build_cycles_per_instruction: [[f32; 2]; 5],
 }
 
 impl CpuModel {
@@ -69,12 +74,13 @@ impl CpuModel {
         CpuModel::parse(F407_TABLE)
     }
 
-    /// A model from its table: `clock_hz`, `cycles_per_instruction`, `pulse N`, and for every
-    /// kind and method `<kind> <method> N` (the motion task per step), `function <method>
-    /// per_x_step N` and `function <method> per_x_step_op N`, and `build <kind> <method> N`
-    /// (the builder per step walked) for every kind but the line, `build <kind> <method>
-    /// per_x_step N` for the sine and the function, and `build function <method>
-    /// per_x_step_op N`; `#` starts a comment.
+    /// A model from its table: `clock_hz`, `pulse N`, and for every kind and method `<kind>
+    /// <method> N` (the motion task per step), `function <method> per_x_step N` and `function
+    /// <method> per_x_step_op N`, and `build <kind> <method> N` (the builder per step walked)
+    /// for every kind but the line, `build <kind> <method> per_x_step N` for the sine and the
+    /// function, and `build function <method> per_x_step_op N`. Each of `pulse`, `<kind>
+    /// <method>` and `build <kind> <method>` has its `... cycles_per_instruction N` too, for all
+    /// of its figures; `#` starts a comment.
     pub fn parse(text: &str) -> Result<CpuModel, String> {
         let mut figures = BTreeMap::new();
         for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
@@ -82,11 +88,11 @@ impl CpuModel {
             let Some((value, name)) = words.split_last() else { continue };
             let value = value.parse::<f32>().map_err(|_| std::format!("not a number: {line}"))?;
             let known = match name {
-                ["clock_hz"] | ["cycles_per_instruction"] | ["pulse"] => true,
+                ["clock_hz"] | ["pulse"] | ["pulse", "cycles_per_instruction"] => true,
                 [kind, method]
                 | ["build", kind, method]
-                | [kind, method, "per_x_step" | "per_x_step_op"]
-                | ["build", kind, method, "per_x_step" | "per_x_step_op"] => {
+                | [kind, method, "per_x_step" | "per_x_step_op" | "cycles_per_instruction"]
+                | ["build", kind, method, "per_x_step" | "per_x_step_op" | "cycles_per_instruction"] => {
                     kind_of(kind).is_some() && method_of(method).is_some()
                 }
                 _ => false,
@@ -99,21 +105,26 @@ impl CpuModel {
         let get = |name: &str| figures.get(name).copied().ok_or_else(|| std::format!("no {name}"));
         let mut model = CpuModel {
             clock_hz: get("clock_hz")?,
-            cycles_per_instruction: get("cycles_per_instruction")?,
             pulse_instructions: get("pulse")?,
+            pulse_cycles_per_instruction: get("pulse cycles_per_instruction")?,
             step_instructions: [[0.0; 2]; 5],
             function_x_step_instructions: [0.0; 2],
             function_x_step_op_instructions: [0.0; 2],
+            step_cycles_per_instruction: [[0.0; 2]; 5],
             build_step_instructions: [[0.0; 2]; 5],
             build_x_step_instructions: [[0.0; 2]; 5],
             build_function_op_instructions: [0.0; 2],
+            build_cycles_per_instruction: [[0.0; 2]; 5],
         };
         for (m, (method, _)) in METHODS.iter().enumerate() {
             for (k, kind) in ShapeKind::ALL.iter().enumerate() {
                 let name = kind_name(*kind);
                 model.step_instructions[k][m] = get(&std::format!("{name} {method}"))?;
+                model.step_cycles_per_instruction[k][m] = get(&std::format!("{name} {method} cycles_per_instruction"))?;
                 if *kind != ShapeKind::Straight {
                     model.build_step_instructions[k][m] = get(&std::format!("build {name} {method}"))?;
+                    model.build_cycles_per_instruction[k][m] =
+                        get(&std::format!("build {name} {method} cycles_per_instruction"))?;
                 }
                 if matches!(kind, ShapeKind::Sine | ShapeKind::Function) {
                     model.build_x_step_instructions[k][m] = get(&std::format!("build {name} {method} per_x_step"))?;
@@ -126,8 +137,8 @@ impl CpuModel {
         Ok(model)
     }
 
-    fn seconds(&self, instructions: f32) -> f32 {
-        instructions * self.cycles_per_instruction / self.clock_hz
+    fn seconds(&self, instructions: f32, cycles_per_instruction: f32) -> f32 {
+        instructions * cycles_per_instruction / self.clock_hz
     }
 
     /// Seconds the motion task takes for `steps` steps of `kind` with `method`, `x_steps` of
@@ -141,12 +152,13 @@ impl CpuModel {
             }
             _ => 0.0,
         };
-        self.seconds(self.step_instructions[k][m] * steps as f32 + per_x_step * x_steps as f32)
+        let instructions = self.step_instructions[k][m] * steps as f32 + per_x_step * x_steps as f32;
+        self.seconds(instructions, self.step_cycles_per_instruction[k][m])
     }
 
     /// Seconds the step timer's interrupt takes per pulse.
     pub fn pulse_seconds(&self) -> f32 {
-        self.seconds(self.pulse_instructions)
+        self.seconds(self.pulse_instructions, self.pulse_cycles_per_instruction)
     }
 
     /// Seconds the builder takes for `slice`, walked with `method`.
@@ -154,7 +166,8 @@ impl CpuModel {
         let (k, m) = (kind_index(slice.kind), method_index(method));
         let ops = if slice.kind == ShapeKind::Function { f32::from(slice.expr_ops) } else { 0.0 };
         let per_x_step = self.build_x_step_instructions[k][m] + self.build_function_op_instructions[m] * ops;
-        self.seconds(self.build_step_instructions[k][m] * slice.steps as f32 + per_x_step * slice.x_steps as f32)
+        let instructions = self.build_step_instructions[k][m] * slice.steps as f32 + per_x_step * slice.x_steps as f32;
+        self.seconds(instructions, self.build_cycles_per_instruction[k][m])
     }
 }
 
@@ -319,9 +332,15 @@ mod tests {
         assert!(model.function_x_step_op_instructions.iter().all(|&v| v > 0.0));
         // Every kind but the line is walked by the builder.
         assert!(model.build_step_instructions[1..].iter().flatten().all(|&v| v > 0.0));
-        // 168 MHz at 1.3 cycles per instruction: a 100-instruction step takes 0.77 µs.
+        // The Cortex-M4 takes at least a cycle an instruction, and from flash at most a few.
+        let cpis = core::iter::once(model.pulse_cycles_per_instruction)
+            .chain(model.step_cycles_per_instruction.iter().flatten().copied())
+            .chain(model.build_cycles_per_instruction[1..].iter().flatten().copied());
+        assert!(cpis.into_iter().all(|c| (1.0..3.0).contains(&c)));
+        // A step's time is its instructions at their cycles each, at 168 MHz.
         let line = model.steps_seconds(ShapeKind::Straight, Method::Diagonal, 0, 1, 1);
-        assert!((line - model.step_instructions[0][1] * 1.3 / 168e6).abs() < 1e-12);
+        let cpi = model.step_cycles_per_instruction[0][1];
+        assert!((line - model.step_instructions[0][1] * cpi / 168e6).abs() < 1e-12);
     }
 
     #[test]
@@ -329,16 +348,18 @@ mod tests {
         let model = CpuModel::f407().unwrap();
         let slice = |kind, expr_ops, steps, x_steps| Slice { kind, expr_ops, steps, x_steps, done: false };
         let d = Method::Diagonal;
-        let seconds = |instructions: f32| instructions * 1.3 / 168e6;
+        let seconds = |kind: ShapeKind, instructions: f32| {
+            instructions * model.build_cycles_per_instruction[kind_index(kind)][1] / 168e6
+        };
         let arc = model.build_seconds(&slice(ShapeKind::Arc, 0, 1000, 700), d);
         assert!(
-            (arc - seconds(1000.0 * model.build_step_instructions[1][1])).abs() < 1e-9,
+            (arc - seconds(ShapeKind::Arc, 1000.0 * model.build_step_instructions[1][1])).abs() < 1e-9,
             "X steps cost an arc nothing"
         );
         // A function's X step evaluates its expression: each operation adds to it.
         let short = model.build_seconds(&slice(ShapeKind::Function, 3, 100, 100), d);
         let long = model.build_seconds(&slice(ShapeKind::Function, 30, 100, 100), d);
-        let per_op = seconds(100.0 * 27.0 * model.build_function_op_instructions[1]);
+        let per_op = seconds(ShapeKind::Function, 100.0 * 27.0 * model.build_function_op_instructions[1]);
         assert!((long - short - per_op).abs() < 1e-9);
         // Steep: most steps walk without an evaluation.
         let steep = model.build_seconds(&slice(ShapeKind::Function, 3, 2000, 10), d);
@@ -350,9 +371,14 @@ mod tests {
 
     #[test]
     fn a_bad_table_is_refused_with_the_line() {
-        assert!(CpuModel::parse("clock_hz 1\n").unwrap_err().contains("cycles_per_instruction"));
+        assert!(CpuModel::parse("clock_hz 1\n").unwrap_err().contains("no pulse"));
         assert!(CpuModel::parse("build line sideways 3\n").unwrap_err().contains("build line sideways 3"));
         assert!(CpuModel::parse("line sideways 3\n").unwrap_err().contains("line sideways 3"));
         assert!(CpuModel::parse("pulse fast\n").unwrap_err().contains("pulse fast"));
+        assert!(CpuModel::parse("pulse 140 1.7\n").unwrap_err().contains("pulse 140 1.7"));
+        // Every figure's cycles per instruction is there.
+        let without = |name: &str| F407_TABLE.lines().filter(|l| !l.starts_with(name)).collect::<std::vec::Vec<_>>();
+        let table = without("arc diagonal cycles_per_instruction").join("\n");
+        assert!(CpuModel::parse(&table).unwrap_err().contains("no arc diagonal cycles_per_instruction"));
     }
 }
