@@ -293,13 +293,10 @@ impl Expr {
                     checked(x)?
                 }
                 Op::Neg => -top,
-                Op::Call(f) => {
-                    let v = call(f, top);
-                    if !(v.abs() <= EXPR_MAX_MAGNITUDE) {
-                        return Err(call_error(f, top));
-                    }
-                    v
-                }
+                Op::Call(f) => match checked(call(f, top)) {
+                    Ok(v) => v,
+                    Err(_) => return Err(call_error(f, top)),
+                },
                 Op::Bin(op) => binary(op, below.pop()?, top)?,
                 Op::PowInt(n) => checked(power_int(top, i32::from(n))?)?,
                 Op::AddConst(i) => checked(top + self.constant(i)?)?,
