@@ -113,21 +113,25 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                     }
                 }
                 Pace::Ramp(ramp) => {
+                    // The run's figures in locals, so that they stay in registers through the
+                    // loop; the distance left is written back after it.
+                    let r = *ramp;
+                    let mut left_nm = r.left_nm;
                     let mut v2 = self.speed.map_or(-1.0, |w| w * w);
                     for (slot, &step) in out[written..].iter_mut().zip(steps) {
                         // The rule step by step: from rest the start rate; then what the
                         // acceleration adds, within the cap and the braking distance left, and
                         // for a hold or an abort what braking allows.
-                        let mut w2 = if v2 < 0.0 { ramp.start2 } else { v2 + ramp.gain };
-                        w2 = math::min(w2, ramp.cap2);
-                        ramp.left_nm = ramp.left_nm.saturating_sub(ramp.step_nm);
-                        w2 = math::min(w2, ramp.exit2 + ramp.two_a * (ramp.left_nm as f32 / NM_PER_MM));
-                        if ramp.braking && v2 >= 0.0 {
-                            w2 = math::min(w2, math::max(v2 - ramp.gain, ramp.start2));
+                        let mut w2 = if v2 < 0.0 { r.start2 } else { v2 + r.gain };
+                        w2 = math::min(w2, r.cap2);
+                        left_nm = left_nm.saturating_sub(r.step_nm);
+                        w2 = math::min(w2, r.exit2 + r.two_a * (left_nm as f32 / NM_PER_MM));
+                        if r.braking && v2 >= 0.0 {
+                            w2 = math::min(w2, math::max(v2 - r.gain, r.start2));
                         }
                         // `max` also replaces a NaN, which valid limits never produce.
                         w2 = math::max(w2, MIN_SPEED_MM_PER_S * MIN_SPEED_MM_PER_S);
-                        let (whole, frac) = split_ticks(ramp.ticks_mm / math::sqrt(w2), ramp.min_ticks);
+                        let (whole, frac) = split_ticks(r.ticks_mm / math::sqrt(w2), r.min_ticks);
                         let (c, over) = carry.overflowing_add(frac);
                         carry = c;
                         let interval_ticks = whole + u32::from(over);
@@ -136,10 +140,10 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                         dx += i32::from(step.x);
                         dy += i32::from(step.y);
                         taken += 1;
-                        let reached_cap = w2 >= ramp.cap2;
-                        let stopped = ramp.braking && w2 <= ramp.start2;
+                        let reached_cap = w2 >= r.cap2;
+                        let stopped = r.braking && w2 <= r.start2;
                         v2 = w2;
-                        if stopped || (reached_cap && !ramp.braking) {
+                        if stopped || (reached_cap && !r.braking) {
                             ends_early = true;
                             break;
                         }
@@ -147,6 +151,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                             break;
                         }
                     }
+                    ramp.left_nm = left_nm;
                     if v2 >= 0.0 {
                         self.speed = Some(math::sqrt(v2));
                     }
