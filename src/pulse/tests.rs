@@ -399,6 +399,13 @@ fn an_interrupt_a_period_late_counts_the_repeated_pulse_and_stops_in_an_alarm() 
     // Every pulse whole: the repeat ran to its end.
     let (last_ticks, last_axes, _) = *timer.periods.last().unwrap();
     assert_eq!((last_ticks, last_axes), (us(100), 3));
+
+    // Two periods late: two repeats and the one under way, all counted; one fault.
+    let (timer, machine) = emit(Settings::default(), &cmds, &[3, 4]);
+    let pulses = timer.periods.iter().filter(|p| p.1 != 0).count();
+    assert_eq!(pulses, 5);
+    assert_eq!(machine.position(), Point::new(5, 5));
+    assert_eq!(machine.missed_updates(), 1);
 }
 
 #[test]
