@@ -5,12 +5,17 @@
 //! direction, the pulse each period ends with, from the periods and SIGN levels the engine gave
 //! it — what a logic analyser on the F407's PULS/SIGN pins would count — so a run can be checked
 //! against the position the engine counted.
+//!
+//! Its update events, as the pulse engine learns of them (`StepTimer::update_count`), are the
+//! periods whose pulses it counts: one for each update its interrupt handles. A period QEMU lets
+//! the timer count again before the interrupt runs (with `-icount sleep=off` it skips idle time
+//! to the reloaded deadline) ends with no pulse on the model, so it is no update to count.
 
 use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::peripheral::NVIC;
-use servoplot::geom::{Axis, TICK_HZ};
+use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
 use servoplot::inputs::{InputLevels, LIMITS};
 use servoplot::machine::Machine;
 use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
@@ -41,6 +46,8 @@ pub struct ModelStepTimer {
     preloaded_axes: u8,
     /// `start` raised an update event the interrupt has yet to see.
     starting: bool,
+    /// Update events handled so far (wrapping): the periods counted.
+    updates: u16,
 }
 
 impl ModelStepTimer {
@@ -48,7 +55,7 @@ impl ModelStepTimer {
     pub fn new() -> Self {
         regs::write(TIMER1, TIMER_CTRL, 0);
         regs::write(TIMER1, TIMER_INTCLEAR, 1);
-        ModelStepTimer { sign: [false; 2], active_axes: 0, preloaded_axes: 0, starting: false }
+        ModelStepTimer { sign: [false; 2], active_axes: 0, preloaded_axes: 0, starting: false, updates: 0 }
     }
 
     /// An update event: the period that was counting has ended with its pulses, and the
@@ -61,12 +68,15 @@ impl ModelStepTimer {
             }
         }
         self.active_axes = self.preloaded_axes;
+        self.updates = self.updates.wrapping_add(1);
     }
 }
 
 impl StepTimer for ModelStepTimer {
     /// The F407's 16-bit period, so the engine splits long intervals the same way.
     const MAX_PERIOD_TICKS: u32 = u16::MAX as u32 - 1;
+    /// The F407's, so the engine times SIGN on the model as on the chip.
+    const SIGN_LATENCY_TICKS: u32 = 2 * TICKS_PER_US;
 
     fn set_sign(&mut self, axis: Axis, high: bool) {
         self.sign[axis.index()] = high;
@@ -98,6 +108,10 @@ impl StepTimer for ModelStepTimer {
 
     fn input_levels(&mut self) -> InputLevels {
         IDLE_INPUTS
+    }
+
+    fn update_count(&mut self) -> u16 {
+        self.updates
     }
 }
 
