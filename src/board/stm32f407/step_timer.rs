@@ -34,10 +34,11 @@ const NO_PULSE: u16 = u16::MAX;
 
 /// The longest the update interrupt's SIGN write comes after the update event. Cortex-M4
 /// exception entry is 12 cycles (ARM's Cortex-M4 TRM, 3.9), a few more for the vector fetch
-/// through flash wait states; the handler then does some 30 instructions before the GPIO write
-/// (under 100 cycles with the ART accelerator on); and nothing in the firmware masks interrupts
-/// for longer than a short critical section (no value over 64 bytes is copied inside one). Under
-/// 400 cycles in all at 168 MHz: 2 µs keeps a margin.
+/// through flash wait states; the handler then runs up to some 55 instructions before its last
+/// GPIO write (about 110 cycles with the ART accelerator on); and nothing else in the firmware
+/// masks interrupts for longer than 80 instructions, some 150 cycles (`cost/count.py --masked`
+/// counts the longest stretch and fails above that). Under 300 cycles in all at 168 MHz: 2 µs
+/// (336) keeps a margin.
 const SIGN_LATENCY_US: u32 = 2;
 
 /// TIM1 driving PULS, the SIGN outputs, and the input pins the engine watches; TIM4 counting
