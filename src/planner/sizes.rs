@@ -36,3 +36,11 @@ pub const STRAIGHT_CHUNK_STEPS: usize = 256;
 /// Steps scanned by [`Planner::push`](crate::planner::Planner::push) at once: a short segment is
 /// planned in full at once.
 pub const SCAN_STEPS_PER_PUSH: usize = 64;
+
+/// The step generator scans again once this many steps were emitted since the scan last ran
+/// (and at the start of every run).
+pub const SCAN_EVERY_STEPS: usize = 256;
+
+/// Most steps the step generator scans in one call: about 40,000 instructions on a straight
+/// line, a few tenths of a millisecond on the F407.
+pub const SCAN_STEPS_PER_CALL: usize = 1_024;

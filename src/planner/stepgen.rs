@@ -10,7 +10,7 @@ use crate::math;
 use crate::planner::block::{Ahead, Chunk, NM_PER_MM};
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
 use crate::planner::run::{Pace, Ramp, Run};
-use crate::planner::sizes::{CHUNK_STEPS, PLANNER_BLOCKS};
+use crate::planner::sizes::{CHUNK_STEPS, PLANNER_BLOCKS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL};
 use crate::planner::state::{Planner, Request};
 
 /// 2³², the scale of a step's fraction of a tick.
@@ -78,6 +78,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
     /// step queue this way, one run at a time in a tight loop.
     pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
+        if self.emitted_since_scan >= SCAN_EVERY_STEPS {
+            self.keep_scanning();
+        }
         let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
         let end = loop {
             if written >= out.len() || ticks >= ticks_room {
@@ -164,6 +167,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             }
             self.carry = carry;
             self.steps.drop_front(taken);
+            self.emitted_since_scan += taken;
             self.run.left -= taken as u32;
             if ends_early {
                 self.run.cut();
@@ -176,6 +180,20 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         Emitted { steps: written, ticks, moved: Point::new(dx, dy), end }
     }
 
+    /// Keeps the scan ahead: twice what was emitted since it last ran, and a chunk more, but at
+    /// most [`SCAN_STEPS_PER_CALL`] at once; what is left waits for the next call. The steps are
+    /// counted as they are emitted, not as their run ends: a cruise along a long line is one run,
+    /// and its steps scanned again all at once at its end would be milliseconds of the F407's in
+    /// one call.
+    fn keep_scanning(&mut self) {
+        if self.steps.free() < CHUNK_STEPS {
+            return;
+        }
+        let budget = (2 * self.emitted_since_scan + CHUNK_STEPS).min(SCAN_STEPS_PER_CALL);
+        self.scan(budget);
+        self.emitted_since_scan = self.emitted_since_scan.saturating_sub(budget / 2);
+    }
+
     /// Plans the next run.
     #[inline(never)]
     fn next_run(&mut self) -> RunStart {
@@ -185,11 +203,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         if self.request == Request::Hold && self.speed.is_none() {
             return RunStart::Empty;
         }
-        // Keep the scan ahead: twice what was emitted since it last ran, and a chunk more.
-        if self.steps.free() >= CHUNK_STEPS {
-            self.scan(2 * self.emitted_since_scan + CHUNK_STEPS);
-            self.emitted_since_scan = 0;
-        }
+        self.keep_scanning();
         // Every pass returns, drops a finished block, or scans where the motion has caught up
         // with the scan; the bound only guards against the unforeseen.
         for _ in 0..(N + PLANNER_BLOCKS + 8) {
@@ -302,7 +316,6 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         if emitted == 0 {
             return;
         }
-        self.emitted_since_scan += emitted as usize;
         let Some(chunk) = self.chunks.front_mut() else { return };
         let emitted_nm = chunk.nm(emitted);
         chunk.left = chunk.left.saturating_sub(emitted);
