@@ -32,6 +32,12 @@ use crate::pulse::StepProducer;
 use crate::settings::Settings;
 use crate::status::RunState;
 
+/// The step queue holds at least this many steps, however long: the pulse engine holds two (the
+/// period counting and the one preloaded after it), so a third is there for the next update
+/// event while the task, woken half way through the queue, refills it. Only the slowest feeds
+/// queue more than [`STEP_QUEUE_MAX_US`](crate::machine::STEP_QUEUE_MAX_US) so.
+pub const STEP_QUEUE_MIN_STEPS: u32 = 3;
+
 /// Should the planner ever have nothing to emit while it says it is moving, the task looks
 /// again after this long instead of spinning; also the shortest wait for the queue to drain.
 pub const MOTION_RETRY_US: u64 = 100;
@@ -64,6 +70,15 @@ struct Queued {
     end: Point,
     /// A rest ends what was published: the pulse engine stops when it is done.
     resting: bool,
+    /// The interval of the steps queued last (their mean over the last batch), ticks.
+    last_interval_ticks: u32,
+}
+
+impl Queued {
+    /// Nothing queued: the motion rests at `at`, after `steps` and `ticks` so far.
+    fn at_rest(steps: u32, ticks: u32, at: Point) -> Queued {
+        Queued { steps, ticks, end: at, resting: true, last_interval_ticks: 0 }
+    }
 }
 
 /// The time the motion task's work takes. On the board it is the time the work really takes,
@@ -98,7 +113,7 @@ pub async fn run(
     mut work: impl WorkTime,
 ) -> ! {
     planner.set_limits(Limits::from_settings(&machine.settings()));
-    let mut queued = Queued { steps: 0, ticks: 0, end: machine.position(), resting: true };
+    let mut queued = Queued::at_rest(0, 0, machine.position());
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
@@ -186,8 +201,11 @@ pub async fn run(
         }
         match filled {
             FillEnd::QueueFull => {
-                // Enough motion queued: wait until half of it is emitted, or for a control.
-                let wait_us = u64::from(machine.queued_ticks() / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
+                // Enough motion queued: wait until half of what the pulse engine has not taken
+                // yet is emitted (it holds two steps: the one it emits and the one after), or
+                // for a control.
+                let ahead = machine.queued_ticks().saturating_sub(2 * queued.last_interval_ticks);
+                let wait_us = u64::from(ahead / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
                 select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
             }
             FillEnd::PlanEmpty | FillEnd::CurveFailed(_) => {
@@ -246,7 +264,7 @@ async fn halted(
     planner.drop_all();
     steps.retract();
     let (emitted_steps, emitted_ticks) = machine.emitted_totals();
-    *queued = Queued { steps: emitted_steps, ticks: emitted_ticks, end: machine.position(), resting: true };
+    *queued = Queued::at_rest(emitted_steps, emitted_ticks, machine.position());
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
@@ -261,7 +279,8 @@ async fn halted(
 }
 
 /// Moves step commands from the planner into the step queue: as many as fit, up to
-/// [`STEP_QUEUE_MAX_TICKS`] of motion queued, published [`PUBLISH_BATCH_STEPS`] at a time.
+/// [`STEP_QUEUE_MAX_TICKS`] of motion queued but never fewer than [`STEP_QUEUE_MIN_STEPS`]
+/// steps, published [`PUBLISH_BATCH_STEPS`] at a time.
 async fn fill(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
@@ -270,17 +289,22 @@ async fn fill(
     work: &mut impl WorkTime,
 ) -> FillEnd {
     let mut ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
+    let mut steps_short = STEP_QUEUE_MIN_STEPS.saturating_sub(machine.queued_steps());
     loop {
+        // Steps short of the least: a step at a time whatever their length.
+        let room = ticks_room.max(u32::from(steps_short > 0));
         let slots = steps.free_slots();
         let batch = slots.len().min(PUBLISH_BATCH_STEPS);
-        let Some(slots) = slots.get_mut(..batch).filter(|s| !s.is_empty() && ticks_room > 0) else {
+        let Some(slots) = slots.get_mut(..batch).filter(|s| !s.is_empty() && room > 0) else {
             return FillEnd::QueueFull;
         };
-        let emitted = planner.fill(slots, ticks_room);
+        let emitted = planner.fill(slots, room);
+        steps_short = steps_short.saturating_sub(emitted.steps as u32);
         work.took(&emitted).await;
         steps.publish(emitted.steps);
         if emitted.steps > 0 {
             queued.resting = false;
+            queued.last_interval_ticks = emitted.ticks / emitted.steps as u32;
         }
         queued.steps = queued.steps.wrapping_add(emitted.steps as u32);
         queued.ticks = queued.ticks.wrapping_add(emitted.ticks);
