@@ -14,8 +14,10 @@ polls at 5 Hz and a feed hold and resume part way, and runs the same file throug
 (`cargo sim --serial FILE`). It fails unless every line is answered as the simulator answers it,
 every status report is well formed, the pulses the model's step timer emitted and the final
 position are the simulator's, no step-queue underrun and no missed timer update is reported,
-the stack's peak (`$I`) stays under half the stack, no task poll took 10 ms or more, and the
-firmware's defmt log, decoded with defmt-print, has its boot, settings and job lines.
+the stack's peak (`$I`) stays under half the stack, no task poll took 10 ms or more, no stretch
+with interrupts masked is over its budget (the cost runner's masked plugin follows the whole
+run: `cost/count.py --masked`), and the firmware's defmt log, decoded with defmt-print, has its
+boot, settings and job lines.
 """
 import argparse
 import os
@@ -30,7 +32,9 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, ".ci"))
-from elf import objects  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, "cost"))
+from elf import functions, objects  # noqa: E402
+import count  # noqa: E402  (the cost runner: its masked-stretch plugin and report)
 
 TARGET = "thumbv7em-none-eabihf"
 BIN = "servoplot-mps2-an386"
@@ -229,7 +233,9 @@ def check(args):
     sock_path, mon_path = os.path.join(work, "uart0"), os.path.join(work, "monitor")
     defmt_path = os.path.join(ROOT, "target", "model", "defmt.bin")
     os.makedirs(os.path.dirname(defmt_path), exist_ok=True)
-    cmd = qemu_command("chardev:host", args.qemu_arg) + [
+    masked_log = os.path.join(ROOT, "target", "model", "masked.txt")
+    plugin = ["-plugin", count.masked_plugin_args(ELF), "-d", "plugin", "-D", masked_log]
+    cmd = qemu_command("chardev:host", plugin + args.qemu_arg) + [
         "-chardev", f"socket,id=host,path={sock_path},server=on,wait=on",
         "-monitor", f"unix:{mon_path},server=on,wait=off"]
     print("model: " + " ".join(cmd))
@@ -313,6 +319,14 @@ def check(args):
             failures.append(f"the stack's peak is over {STACK_MAX_SHARE:.0%} of the stack")
         if poll_us >= POLL_MAX_US:
             failures.append(f"a task poll took {poll_us} us, {POLL_MAX_US} at most")
+
+    print()
+    stretches, notes = count.read_masked_log(masked_log, sorted(functions(ELF)))
+    try:
+        count.print_masked(stretches, notes, sorted(functions(ELF)), True)
+    except SystemExit as over:
+        failures.append(str(over))
+    print()
 
     text = decode_log(defmt_path)
     with open(os.path.join(ROOT, "target", "model", "defmt.txt"), "w") as f:

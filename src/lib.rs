@@ -14,6 +14,8 @@ extern crate std;
 #[macro_use]
 mod fmt;
 
+#[cfg(target_os = "none")]
+pub mod critical;
 pub mod decimal;
 pub mod drawing;
 pub mod expr;

@@ -40,6 +40,7 @@
 mod job_queue;
 mod jobs;
 mod published;
+mod pulse_news;
 mod settings;
 
 use core::cell::Cell;
@@ -62,6 +63,7 @@ pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
 use job_queue::JobQueue;
 use published::Published;
+use pulse_news::PulseNews;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -148,6 +150,8 @@ pub struct Machine {
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pulses_done: Signal<CriticalSectionRawMutex, ()>,
+    /// What the pulse interrupt has to tell, not yet delivered (see [`pulse_news`]).
+    pulse_news: PulseNews,
     /// Pulses emitted (written only by the pulse engine).
     position: [AtomicI32; 2],
     state: AtomicU8,
@@ -218,6 +222,7 @@ impl Machine {
             overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
             pulses_done: Signal::new(),
+            pulse_news: PulseNews::new(),
             aborts: AtomicU32::new(0),
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
@@ -459,20 +464,6 @@ impl Machine {
         self.plan_free.load(Ordering::Relaxed)
     }
 
-    /// The pulse engine found the queue empty while the motion was not at rest. Only the pulse
-    /// engine calls this.
-    pub fn count_underrun(&self) {
-        self.underruns.store(self.underruns.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
-        warn!("step queue underrun: the motion task fell behind the pulses");
-    }
-
-    /// The step timer's interrupt came a whole period late or later: the timer repeated a
-    /// period the engine then counted (see [`crate::pulse`]). Only the pulse engine calls this.
-    pub fn count_missed_update(&self) {
-        self.missed_updates.store(self.missed_updates.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
-        warn!("missed step timer update: the pulse interrupt came a whole period late");
-    }
-
     /// Missed step timer updates since power-on.
     pub fn missed_updates(&self) -> u32 {
         self.missed_updates.load(Ordering::Relaxed)
@@ -493,13 +484,6 @@ impl Machine {
     /// Step-queue underruns since power-on.
     pub fn underruns(&self) -> u32 {
         self.underruns.load(Ordering::Relaxed)
-    }
-
-    /// The pulse engine emitted everything queued and stopped. Only the pulse engine calls
-    /// this.
-    pub fn pulses_stopped(&self) {
-        self.pulses_done.signal(());
-        self.changed.signal(());
     }
 
     /// Waits until the pulse engine next reports that it stopped.

@@ -111,6 +111,11 @@ pub trait StepTimer {
     /// and the preloaded period (from [`preload`](Self::preload)), and here counts every period
     /// that has ended by now, the active one first, then the preloaded one as often as it fits.
     fn update_count(&mut self) -> u16;
+
+    /// Pends the interrupt that hands the engine's news on (`Machine::deliver_pulse_news`), below
+    /// this one: the engine has left news in the machine (a stop, a trip, an underrun). The
+    /// interrupt runs above every critical section, so it never delivers the news itself.
+    fn pend_news(&mut self);
 }
 
 /// Pulse timing, taken from the settings whenever the timer starts.
@@ -415,7 +420,8 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         }
         self.active = repeated;
         machine.count_missed_update();
-        machine.trip(Trip::MissedUpdate);
+        machine.pulse_trip(Trip::MissedUpdate);
+        self.timer.pend_news();
         // Nothing more: the timer stops once the repeat under way is out.
         self.preload(TAIL_TICKS, 0, Period::TAIL);
     }
@@ -430,7 +436,8 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         if (active != 0 || self.debounce.holding())
             && let Some(trip) = self.debounce.sample(active, self.clock_ticks, self.inputs.debounce_ticks)
         {
-            machine.trip(trip);
+            machine.pulse_trip(trip);
+            self.timer.pend_news();
         }
         machine.halted()
     }
@@ -444,6 +451,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         self.starving = false;
         machine.set_pulsing(false);
         machine.pulses_stopped();
+        self.timer.pend_news();
     }
 
     /// Preloads `period`, `ticks` long, pulsing the axes of `axes` at its end.
@@ -507,6 +515,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
         if !self.starving {
             self.starving = true;
             machine.count_underrun();
+            self.timer.pend_news();
         }
         let toward = self.preloaded.toward;
         self.preload(UNDERRUN_WAIT_TICKS, 0, Period::wait(toward));

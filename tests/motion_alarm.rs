@@ -68,6 +68,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
         }
         if machine.pulses_idle() {
             machine.pulses_stopped();
+            machine.deliver_pulse_news();
         }
         if machine.stopped() && machine.run_state() == RunState::Alarm {
             break;

@@ -16,6 +16,11 @@
  *   (an image that writes PRIMASK from anything else) is taken as clearing it and counted
  *   ("unmatched-msr"); a read that is never written back would shift the pairs, which the
  *   counts show as well ("saved" left on the stack at exit).
+ * - "basepri": from the instruction that raises BASEPRI while it is clear to the one that puts it
+ *   back clear: the firmware's critical sections (src/critical.rs) mask every interrupt but the
+ *   pulse interrupt so, with `mrs rX, basepri` to save it, `msr basepri_max, rN` to raise it
+ *   and `msr basepri, rX` to put it back; the same pairing as PRIMASK's models it (a raise
+ *   counts as masking, a write back takes the value its `mrs` saved).
  * - "section": from entering the outermost critical section to leaving it, given the entry
  *   addresses of the `critical-section` crate's `_critical_section_1_0_acquire` and `..._release`
  *   (arguments `acquire=` and `release=`): acquires and releases are counted in pairs, the
@@ -89,12 +94,16 @@ __attribute__((visibility("default"))) int qemu_plugin_version = 1;
 #define MRS_FIRST 0xf3efu
 #define MRS_SECOND_MASK 0xf0ffu
 #define MRS_PRIMASK_SECOND 0x8010u
+/* SYSm 17 is BASEPRI, 18 BASEPRI_MAX. */
+#define MSR_BASEPRI_SECOND 0x8011u
+#define MSR_BASEPRI_MAX_SECOND 0x8012u
+#define MRS_BASEPRI_SECOND 0x8011u
 /* PRIMASK values saved by `mrs` and not yet written back: deeper than any nesting of critical
  * sections. */
 #define SAVED_MAX 256
 
-enum kind { KIND_PRIMASK, KIND_SECTION, KINDS };
-static const char *const kind_names[KINDS] = {"primask", "section"};
+enum kind { KIND_PRIMASK, KIND_BASEPRI, KIND_SECTION, KINDS };
+static const char *const kind_names[KINDS] = {"primask", "basepri", "section"};
 
 /* Where stretches began: a small open-addressing table, keyed by kind, address and call. */
 #define SITES 4096
@@ -126,10 +135,16 @@ static uint64_t acquire_call = UINT64_MAX;
 static bool in_acquire;
 static struct open_stretch stretches[KINDS];
 static uint64_t section_depth;
-/* The modelled PRIMASK, and the values saved by `mrs` not yet written back by `msr`. */
-static bool primask;
-static bool saved[SAVED_MAX];
-static size_t saved_depth;
+/* A mask modelled from the instructions that write it (PRIMASK, BASEPRI): whether it masks, and
+ * the values saved by `mrs` not yet written back by `msr`. */
+struct mask {
+    enum kind kind;
+    bool masked;
+    bool saved[SAVED_MAX];
+    size_t saved_depth;
+};
+static struct mask primask = {KIND_PRIMASK};
+static struct mask basepri = {KIND_BASEPRI};
 static uint64_t saved_dropped;
 static uint64_t unmatched_msr;
 
@@ -165,55 +180,87 @@ static void on_call(unsigned int vcpu_index, void *userdata)
     last_call = (uint64_t)(uintptr_t)userdata;
 }
 
-/* PRIMASK set (at `at`) or cleared: a stretch begins or ends. */
-static void set_primask(bool masked, uint64_t at)
+/* A mask set (at `at`) or cleared: a stretch begins or ends. */
+static void set_mask(struct mask *m, bool masked, uint64_t at)
 {
-    struct open_stretch *s = &stretches[KIND_PRIMASK];
-    if (masked && !primask) {
+    struct open_stretch *s = &stretches[m->kind];
+    if (masked && !m->masked) {
         *s = (struct open_stretch){true, insn_count, at, in_acquire ? acquire_call : last_call};
-    } else if (!masked && primask && s->open) {
-        record(KIND_PRIMASK, s);
+    } else if (!masked && m->masked && s->open) {
+        record(m->kind, s);
         s->open = false;
     }
-    primask = masked;
+    m->masked = masked;
+}
+
+/* `mrs`: the mask's value saved. */
+static void save_mask(struct mask *m)
+{
+    if (m->saved_depth == SAVED_MAX) {
+        /* The oldest is lost: keep the newest, which the next writes pair with. */
+        memmove(m->saved, m->saved + 1, sizeof m->saved - sizeof m->saved[0]);
+        m->saved_depth--;
+        saved_dropped++;
+    }
+    m->saved[m->saved_depth++] = m->masked;
+}
+
+/* `msr` of a saved value: the mask put back. */
+static void restore_mask(struct mask *m, uint64_t at)
+{
+    bool value = false;
+    if (m->saved_depth > 0) {
+        value = m->saved[--m->saved_depth];
+    } else {
+        unmatched_msr++;
+    }
+    set_mask(m, value, at);
 }
 
 static void on_cpsid(unsigned int vcpu_index, void *userdata)
 {
     (void)vcpu_index;
-    set_primask(true, (uint64_t)(uintptr_t)userdata);
+    set_mask(&primask, true, (uint64_t)(uintptr_t)userdata);
     in_acquire = false;
 }
 
 static void on_cpsie(unsigned int vcpu_index, void *userdata)
 {
     (void)vcpu_index;
-    set_primask(false, (uint64_t)(uintptr_t)userdata);
+    set_mask(&primask, false, (uint64_t)(uintptr_t)userdata);
 }
 
 static void on_mrs_primask(unsigned int vcpu_index, void *userdata)
 {
     (void)vcpu_index;
     (void)userdata;
-    if (saved_depth == SAVED_MAX) {
-        /* The oldest is lost: keep the newest, which the next writes pair with. */
-        memmove(saved, saved + 1, sizeof saved - sizeof saved[0]);
-        saved_depth--;
-        saved_dropped++;
-    }
-    saved[saved_depth++] = primask;
+    save_mask(&primask);
 }
 
 static void on_msr_primask(unsigned int vcpu_index, void *userdata)
 {
-    bool value = false;
     (void)vcpu_index;
-    if (saved_depth > 0) {
-        value = saved[--saved_depth];
-    } else {
-        unmatched_msr++;
-    }
-    set_primask(value, (uint64_t)(uintptr_t)userdata);
+    restore_mask(&primask, (uint64_t)(uintptr_t)userdata);
+}
+
+static void on_mrs_basepri(unsigned int vcpu_index, void *userdata)
+{
+    (void)vcpu_index;
+    (void)userdata;
+    save_mask(&basepri);
+}
+
+static void on_msr_basepri(unsigned int vcpu_index, void *userdata)
+{
+    (void)vcpu_index;
+    restore_mask(&basepri, (uint64_t)(uintptr_t)userdata);
+}
+
+static void on_msr_basepri_max(unsigned int vcpu_index, void *userdata)
+{
+    (void)vcpu_index;
+    set_mask(&basepri, true, (uint64_t)(uintptr_t)userdata);
+    in_acquire = false;
 }
 
 static void on_acquire(unsigned int vcpu_index, void *userdata)
@@ -271,6 +318,13 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_msr_primask, QEMU_PLUGIN_CB_NO_REGS, at);
         } else if (size == 4 && first == MRS_FIRST && (second & MRS_SECOND_MASK) == MRS_PRIMASK_SECOND) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mrs_primask, QEMU_PLUGIN_CB_NO_REGS, NULL);
+        } else if (size == 4 && (first & MSR_FIRST_MASK) == MSR_FIRST && (second & MSR_SECOND_MASK) == MSR_BASEPRI_SECOND) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_msr_basepri, QEMU_PLUGIN_CB_NO_REGS, at);
+        } else if (size == 4 && (first & MSR_FIRST_MASK) == MSR_FIRST &&
+                   (second & MSR_SECOND_MASK) == MSR_BASEPRI_MAX_SECOND) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_msr_basepri_max, QEMU_PLUGIN_CB_NO_REGS, at);
+        } else if (size == 4 && first == MRS_FIRST && (second & MRS_SECOND_MASK) == MRS_BASEPRI_SECOND) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mrs_basepri, QEMU_PLUGIN_CB_NO_REGS, NULL);
         }
     }
 }
@@ -300,7 +354,7 @@ static void on_plugin_exit(qemu_plugin_id_t id, void *userdata)
         qemu_plugin_outs("sites-full\n");
     }
     snprintf(line, sizeof line, "unmatched-msr %" PRIu64 "\nsaved %zu %" PRIu64 "\ntotal %" PRIu64 "\n", unmatched_msr,
-             saved_depth, saved_dropped, insn_count);
+             primask.saved_depth + basepri.saved_depth, saved_dropped, insn_count);
     qemu_plugin_outs(line);
 }
 

@@ -93,6 +93,9 @@ impl StepTimer for ModelStepTimer {
         // SAFETY: UPDATES is written only by the interrupt, which runs this.
         unsafe { read_volatile(addr_of!(UPDATES)) }
     }
+
+    /// Nothing here waits for the engine's news.
+    fn pend_news(&mut self) {}
 }
 
 /// The model's interrupt number for the NVIC.

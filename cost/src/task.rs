@@ -128,6 +128,7 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
         }
         if next_pulse_at.is_none() && machine.pulses_idle() {
             machine.pulses_stopped();
+            machine.deliver_pulse_news();
         }
         if wake_at != u64::MAX {
             set_clock(clock_now().max(wake_at));

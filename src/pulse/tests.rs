@@ -25,6 +25,8 @@ struct MockTimer {
     updates: u16,
     /// Update events (counting from 0 after the start's) whose interrupt comes one period late.
     late: Vec<usize>,
+    /// Times the engine asked for its news to be handed on.
+    news: usize,
 }
 
 impl StepTimer for MockTimer {
@@ -57,6 +59,9 @@ impl StepTimer for MockTimer {
     fn update_count(&mut self) -> u16 {
         self.updates
     }
+    fn pend_news(&mut self) {
+        self.news += 1;
+    }
 }
 
 /// Runs the engine as the hardware would until it stops (or `max` periods): at each update
@@ -65,6 +70,7 @@ impl StepTimer for MockTimer {
 /// each period, as the motion task could.
 fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, mut between: impl FnMut(usize)) {
     engine.kick(machine);
+    machine.deliver_pulse_news();
     if !core::mem::take(&mut engine.timer_mut().started) {
         return;
     }
@@ -74,6 +80,8 @@ fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, m
         let (ticks, axes) = timer.preload;
         if !timer.late.contains(&k) {
             engine.on_period(machine);
+            // The news interrupt, right after.
+            machine.deliver_pulse_news();
             if !engine.timer().running {
                 return;
             }

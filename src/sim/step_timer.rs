@@ -137,6 +137,9 @@ impl StepTimer for SimStepTimer {
     fn update_count(&mut self) -> u16 {
         self.updates
     }
+
+    /// The model hands the news on after every interrupt (see [`run`]).
+    fn pend_news(&mut self) {}
 }
 
 /// Waits until the virtual time reaches `t_ticks` (the microsecond at or after it).
@@ -150,6 +153,7 @@ pub async fn run(machine: &Machine, engine: &mut PulseEngine<'_, SimStepTimer>, 
     loop {
         kicks.wait().await;
         engine.kick(machine);
+        machine.deliver_pulse_news();
         if !core::mem::take(&mut engine.timer_mut().starting) {
             continue;
         }
@@ -169,6 +173,8 @@ pub async fn run(machine: &Machine, engine: &mut PulseEngine<'_, SimStepTimer>, 
                 late -= 1;
             } else {
                 engine.on_period(machine);
+                // The news interrupt, below the pulse interrupt, right after it.
+                machine.deliver_pulse_news();
                 if !engine.timer().running {
                     break;
                 }

@@ -3,10 +3,11 @@
 //! QEMU runs the model with `-icount shift=4,sleep=off`: each instruction takes 16 ns of virtual
 //! time, and idle time is skipped. The firmware's microsecond is the time the STM32F407 takes
 //! to run the instructions the model runs in it: at 168 MHz and the cycles per instruction the
-//! cost model derives from the Cortex-M4's instruction timings (`cost/f407.txt`), the F407 runs
-//! 168 / 1.53 ≈ 110 instructions a µs, which take 110 × 16 ns = 1.76 µs of virtual time:
-//! [`CLOCKS_PER_US`] counts of the model's 25 MHz timers. So every deadline, poll time and pulse
-//! rate the firmware sees on the model is what it would be on the chip.
+//! cost model derives from the Cortex-M4's instruction timings (`cost/f407.txt`: 1.5 for lines,
+//! up to 1.85 for functions), at the costliest 1.87 the F407 runs 168 / 1.87 ≈ 90 instructions
+//! a µs, which take 90 × 16 ns = 1.44 µs of virtual time: [`CLOCKS_PER_US`] counts of the
+//! model's 25 MHz timers. So every deadline, poll time and pulse rate the firmware sees on the
+//! model is what it would be on the chip, or a little worse.
 //!
 //! Timer 0 counts down freely through 2^32 counts, its interrupt counting the wraps: the time
 //! since reset. The dual timer's first counter, one-shot, is the alarm of embassy-time's queue;
@@ -22,7 +23,7 @@ use embassy_time_queue_utils::Queue;
 use super::regs::{self, *};
 
 /// Model timer counts per µs of the F407's time (see the module documentation).
-pub const CLOCKS_PER_US: u32 = 44;
+pub const CLOCKS_PER_US: u32 = 36;
 
 /// The longest alarm the one-shot counter is set for at a time, counts; a later deadline is
 /// set again when it fires.

@@ -11,6 +11,7 @@
 //! | USART2, the host link              | UART 0 (IRQs 0, 1)                                  |
 //! | USB CDC-ACM, the second link       | UART 1 (IRQs 2, 3)                                  |
 //! | UART5 / UART4 vectors, executors   | IRQ 14 (motion) / IRQ 15 (thread-mode pender)       |
+//! | TIM7 vector, the pulse news        | IRQ 16                                              |
 //! | flash sectors 10-11, the store     | code RAM at the same offsets (`devices::ModelFlash`) |
 //! | ST7920 on SPI2                     | the same driver on a bus that takes the F407's time |
 //! | keypad, SON, LED, buzzer, pen      | pins that drive nothing; no key pressed; inputs idle |
@@ -91,6 +92,7 @@ pub fn safe_outputs() {
 
 /// Sets the model up: its clock and watchdog (running from here on), the step timer, the two
 /// UARTs, at the firmware's priorities.
+#[inline(never)]
 pub fn init(_spawner: Spawner) -> Board {
     if regs::read(SCC_ID, 0) != SCC_ID_AN386 {
         defmt::error!("not QEMU's mps2-an386 (SCC ID {=u32:#x})", regs::read(SCC_ID, 0));
@@ -123,7 +125,7 @@ pub fn init(_spawner: Spawner) -> Board {
 
 /// Hands the pulse engine to the step timer's interrupt, at the pulse priority.
 pub fn start_pulses(timer: ModelStepTimer, steps: StepConsumer<'static>, machine: &'static Machine) {
-    step_timer::start(timer, steps, machine, priority::PULSE);
+    step_timer::start(timer, steps, machine, priority::PULSE, priority::PULSE_NEWS);
 }
 
 /// Wakes the pulse engine: the motion task queued steps.
@@ -186,6 +188,10 @@ unsafe extern "C" fn dual_timer() {
     }
 }
 
+unsafe extern "C" fn pulse_news() {
+    step_timer::on_news();
+}
+
 unsafe extern "C" fn motion_executor() {
     // SAFETY: this line serves only as the motion executor's interrupt.
     unsafe { executor::MOTION_EXECUTOR.on_interrupt() }
@@ -215,6 +221,7 @@ pub static __INTERRUPTS: [unsafe extern "C" fn(); regs::IRQ_LINES] = {
     table[regs::DUALTIMER_IRQ as usize] = dual_timer;
     table[regs::MOTION_EXECUTOR_IRQ as usize] = motion_executor;
     table[regs::THREAD_PENDER_IRQ as usize] = thread_pender;
+    table[regs::PULSE_NEWS_IRQ as usize] = pulse_news;
     table
 };
 

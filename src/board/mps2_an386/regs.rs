@@ -63,9 +63,10 @@ pub const UART1_TX_IRQ: u16 = 3;
 pub const TIMER0_IRQ: u16 = 8;
 pub const TIMER1_IRQ: u16 = 9;
 pub const DUALTIMER_IRQ: u16 = 10;
-/// Lines no device of the model drives: the executors' software interrupts.
+/// Lines no device of the model drives: the executors' and the pulse news' software interrupts.
 pub const MOTION_EXECUTOR_IRQ: u16 = 14;
 pub const THREAD_PENDER_IRQ: u16 = 15;
+pub const PULSE_NEWS_IRQ: u16 = 16;
 /// External interrupt lines of the model's NVIC.
 pub const IRQ_LINES: usize = 32;
 

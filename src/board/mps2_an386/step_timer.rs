@@ -12,7 +12,7 @@
 //! to the reloaded deadline) ends with no pulse on the model, so it is no update to count.
 
 use core::cell::UnsafeCell;
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicPtr, AtomicU32, Ordering};
 
 use cortex_m::peripheral::NVIC;
 use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
@@ -113,6 +113,10 @@ impl StepTimer for ModelStepTimer {
     fn update_count(&mut self) -> u16 {
         self.updates
     }
+
+    fn pend_news(&mut self) {
+        NVIC::pend(Irq(PULSE_NEWS_IRQ));
+    }
 }
 
 /// The engine and the machine it counts for, owned by the interrupt once [`start`] has put them
@@ -133,10 +137,27 @@ unsafe impl Sync for Slot {}
 
 static SLOT: Slot = Slot { filled: AtomicBool::new(false), pulses: UnsafeCell::new(None) };
 
-/// Hands the engine to timer 1's interrupt, at `priority`; once, at power-on.
-pub fn start(timer: ModelStepTimer, steps: StepConsumer<'static>, machine: &'static Machine, priority: u8) {
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(core::ptr::null_mut());
+
+/// Hands the engine to timer 1's interrupt, at `priority`, and enables the news interrupt at
+/// `news_priority`; once, at power-on.
+pub fn start(
+    timer: ModelStepTimer,
+    steps: StepConsumer<'static>,
+    machine: &'static Machine,
+    priority: u8,
+    news_priority: u8,
+) {
     if SLOT.filled.load(Ordering::Acquire) {
         return;
+    }
+    NEWS_FOR.store(core::ptr::from_ref(machine).cast_mut(), Ordering::Release);
+    // SAFETY: the priority is set before the line is unmasked; the handler only reads NEWS_FOR.
+    unsafe {
+        let mut core = cortex_m::Peripherals::steal();
+        core.NVIC.set_priority(Irq(PULSE_NEWS_IRQ), news_priority);
+        NVIC::unmask(Irq(PULSE_NEWS_IRQ));
     }
     // SAFETY: the interrupt is masked and nothing else touches the slot (see `Slot`).
     unsafe { *SLOT.pulses.get() = Some(Pulses { engine: PulseEngine::new(timer, steps), machine }) };
@@ -175,6 +196,15 @@ pub fn on_interrupt() {
     if !p.engine.is_running() {
         // Kicked by the motion task: start if steps are queued.
         p.engine.kick(p.machine);
+    }
+}
+
+/// The news interrupt: hands on what the pulse engine left in the machine (pended by it, below
+/// it; see `servoplot::machine`'s pulse news).
+pub fn on_news() {
+    // SAFETY: non-null, it is the `&'static Machine` `start` stored; only shared use.
+    if let Some(machine) = unsafe { NEWS_FOR.load(Ordering::Acquire).as_ref() } {
+        machine.deliver_pulse_news();
     }
 }
 

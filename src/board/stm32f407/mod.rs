@@ -200,6 +200,7 @@ fn clocks() -> Config {
 
 /// Sets the board up: clocks, the watchdog (running from here on), every pin and peripheral,
 /// the host links (the USB device's task on `spawner`). Nothing moves: PULS low, SON low.
+#[inline(never)]
 pub fn init(spawner: Spawner) -> Board {
     let p = embassy_stm32::init(clocks());
     chip::flash_accelerator_on();
@@ -294,7 +295,7 @@ pub fn init(spawner: Spawner) -> Board {
 
 /// Hands the pulse engine to the step timer's interrupt, at the pulse priority.
 pub fn start_pulses(timer: Tim1StepTimer, steps: StepConsumer<'static>, machine: &'static Machine) {
-    step_timer::start(timer, steps, machine, Priority::from(priority::PULSE));
+    step_timer::start(timer, steps, machine, Priority::from(priority::PULSE), Priority::from(priority::PULSE_NEWS));
 }
 
 /// Wakes the pulse engine: the motion task queued steps.

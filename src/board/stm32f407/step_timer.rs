@@ -144,6 +144,10 @@ impl StepTimer for Tim1StepTimer {
     fn update_count(&mut self) -> u16 {
         self.updates.regs_core().cnt().read().cnt()
     }
+
+    fn pend_news(&mut self) {
+        interrupt::TIM7.pend();
+    }
 }
 
 /// The engine and the machine it counts for.
@@ -160,13 +164,23 @@ static PULSES_CELL: StaticCell<Pulses> = StaticCell::new();
 /// nest in itself), so it takes no lock and masks nothing.
 static PULSES: AtomicPtr<Pulses> = AtomicPtr::new(null_mut());
 
-/// Hands the engine to the interrupt and enables it at `priority`; once, at power-on.
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(null_mut());
+
+/// Hands the engine to the interrupt and enables it at `priority`, and the news interrupt
+/// (TIM7's vector, TIM7 unused as a timer) at `news_priority`; once, at power-on.
 pub fn start(
     timer: Tim1StepTimer,
     steps: StepConsumer<'static>,
     machine: &'static Machine,
     priority: interrupt::Priority,
+    news_priority: interrupt::Priority,
 ) {
+    NEWS_FOR.store(core::ptr::from_ref(machine).cast_mut(), Ordering::Release);
+    interrupt::TIM7.set_priority(news_priority);
+    interrupt::TIM7.unpend();
+    // SAFETY: the handler below only reads NEWS_FOR, set just above.
+    unsafe { interrupt::TIM7.enable() };
     let pulses = PULSES_CELL.init(Pulses { engine: PulseEngine::new(timer, steps), machine });
     PULSES.store(pulses, Ordering::Release);
     interrupt::TIM1_UP_TIM10.set_priority(priority);
@@ -199,5 +213,15 @@ fn TIM1_UP_TIM10() {
     if !p.engine.is_running() {
         // Pended by the motion task: start if steps are queued.
         p.engine.kick(p.machine);
+    }
+}
+
+/// The news interrupt: hands on what the pulse engine left in the machine (pended by it, below
+/// it; see `servoplot::machine`'s pulse news).
+#[interrupt]
+fn TIM7() {
+    // SAFETY: non-null, it is the `&'static Machine` `start` stored; only shared use.
+    if let Some(machine) = unsafe { NEWS_FOR.load(Ordering::Acquire).as_ref() } {
+        machine.deliver_pulse_news();
     }
 }
