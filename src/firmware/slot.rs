@@ -30,6 +30,8 @@ impl<const BYTES: usize> FutureSlot<BYTES> {
 
     /// The future `make` returns, built in the slot, pinned there for good; `make` is called
     /// once, with the slot as the destination of its result. `None` if the slot was taken.
+    // The `&'static mut` comes from a shared reference on purpose: `taken` hands it out once.
+    #[allow(clippy::mut_from_ref)]
     pub fn place<F: Future + 'static>(&'static self, make: impl FnOnce() -> F) -> Option<Pin<&'static mut F>> {
         const { assert!(size_of::<F>() <= BYTES && align_of::<F>() <= 8, "the future does not fit its slot") };
         if self.taken.swap(true, Ordering::AcqRel) {

@@ -48,7 +48,7 @@ fn code(trip: Trip) -> u8 {
 }
 
 fn decode(code: u8) -> Option<Trip> {
-    let axis = |k: u8| if k % 2 == 0 { Axis::X } else { Axis::Y };
+    let axis = |k: u8| if k.is_multiple_of(2) { Axis::X } else { Axis::Y };
     Some(match code {
         1..=4 => Trip::Limit { axis: axis(code - 1), max: code > 2 },
         5 | 6 => Trip::DriverAlarm(axis(code - 5)),
