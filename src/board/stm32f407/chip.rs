@@ -44,12 +44,14 @@ pub fn flash_accelerator_on() {
 /// RM0090 §38.16.4 (DBGMCU_APB1_FZ) and §38.16.5 (DBGMCU_APB2_FZ): with DBG_TIMx_STOP set, the
 /// timer's counter clock stops while the core is halted; without it a timer in PWM mode keeps
 /// running its last period. So TIM1 (the step timer, whose periods end in PULS pulses) emits no
-/// pulse and TIM3 (the pen servo's 50 Hz frame) holds its frame while halted. DBG_IWDG_STOP
+/// pulse and TIM3 (the pen servo's 50 Hz frame) holds its frame while halted; TIM4, which
+/// counts TIM1's update events (to tell missed updates), stops with it. DBG_IWDG_STOP
 /// stops the independent watchdog's counter: the board is not reset under a debugger.
 pub fn timers_stop_on_debug_halt() {
     pac::DBGMCU.apb2fzr().modify(|w| w.set_tim1(true));
     pac::DBGMCU.apb1fzr().modify(|w| {
         w.set_tim3(true);
+        w.set_tim4(true);
         w.set_iwdg(true);
     });
 }
