@@ -230,13 +230,13 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 }
 
 /// asin x (radians, in [-π/2, π/2]) as atan2(x, √((1-x)(1+x))), with the FPU's square root:
-/// within 2.5 ulp. NaN outside [-1, 1].
+/// within 3 ulp (2.9 at worst over every `f32` in [-1, 1]). NaN outside [-1, 1].
 pub fn asin(x: f32) -> f32 {
     atan2(x, sqrt((1.0 - x) * (1.0 + x)))
 }
 
-/// acos x (radians, in [0, π]) as atan2(√((1-x)(1+x)), x): within 2.5 ulp. NaN outside
-/// [-1, 1].
+/// acos x (radians, in [0, π]) as atan2(√((1-x)(1+x)), x): within 2.5 ulp (2.4 at worst over
+/// every `f32` in [-1, 1]). NaN outside [-1, 1].
 pub fn acos(x: f32) -> f32 {
     atan2(sqrt((1.0 - x) * (1.0 + x)), x)
 }
