@@ -564,16 +564,19 @@ def print_masked(stretches, notes, syms, check):
           f"{MASKED_BUDGET}, all but the pulse interrupt {SECTION_BUDGET}):\n")
     print("| kind | longest | stretches | began at | called from |")
     print("|---|---:|---:|---|---|")
-    over = []
+    over, summary = [], []
     for kind, budget in (("primask", MASKED_BUDGET), ("basepri", SECTION_BUDGET), ("section", None)):
         found = sorted(stretches.get(kind, []), reverse=True)
         for n, count, begin, call in found[:8]:
             print(f"| {kind} | {n} | {count} | {name_of(begin, syms)} | {name_of(call, syms)} |")
         longest = found[0][0] if found else 0
         if budget is not None:
-            print(f"\nlongest {kind} stretch: {longest} instructions (budget {budget})")
+            summary.append(f"longest {kind} stretch: {longest} instructions (budget {budget})")
             if longest > budget:
                 over.append(f"a {kind} stretch of {longest} instructions, budget {budget}")
+    print()
+    for line in summary:
+        print(line)
     for note in notes:
         print(f"\n{note}")
     if not stretches:
