@@ -37,6 +37,7 @@
 //! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
 //!   for room (taken out, and woken outside the lock).
 
+mod from_pulses;
 mod job_queue;
 mod jobs;
 mod published;

@@ -1,13 +1,9 @@
-//! What the pulse interrupt tells the tasks. The interrupt runs above every critical section
-//! (they mask every interrupt but it, see [`crate::critical`]), so it takes no lock and wakes no
-//! task itself: it leaves its news here, a bit each and the trip's code, with atomics only, and
-//! the board then pends an interrupt below it whose handler hands the news on
-//! ([`Machine::deliver_pulse_news`]): the trip to the motion task, the stop to those waiting for
-//! it, the warnings to the log.
+//! What the pulse interrupt has to tell the tasks, not yet told: a bit for each kind of news
+//! and the trip's code, in atomics only (the interrupt runs above every critical section and
+//! takes no lock; see [`crate::machine::Machine::deliver_pulse_news`]).
 
 use core::sync::atomic::{AtomicU8, Ordering};
 
-use super::Machine;
 use crate::geom::Axis;
 use crate::inputs::Trip;
 
@@ -35,6 +31,46 @@ impl PulseNews {
     fn raise(&self, bit: u8) {
         self.bits.fetch_or(bit, Ordering::Release);
     }
+
+    /// An input tripped the machine.
+    pub(super) fn tripped(&self, trip: Trip) {
+        self.trip.store(code(trip), Ordering::Relaxed);
+        self.raise(TRIPPED);
+    }
+
+    /// The pulses stopped, emitting all they had.
+    pub(super) fn stopped(&self) {
+        self.raise(STOPPED);
+    }
+
+    /// The queue ran dry while the motion was not at rest.
+    pub(super) fn underrun(&self) {
+        self.raise(UNDERRUN);
+    }
+
+    /// The interrupt came a whole period late.
+    pub(super) fn missed_update(&self) {
+        self.raise(MISSED_UPDATE);
+    }
+
+    /// The news raised since the last take, cleared.
+    pub(super) fn take(&self) -> News {
+        let bits = self.bits.swap(0, Ordering::Acquire);
+        News {
+            trip: if bits & TRIPPED != 0 { decode(self.trip.load(Ordering::Relaxed)) } else { None },
+            stopped: bits & STOPPED != 0,
+            underrun: bits & UNDERRUN != 0,
+            missed_update: bits & MISSED_UPDATE != 0,
+        }
+    }
+}
+
+/// The news taken at once.
+pub(super) struct News {
+    pub trip: Option<Trip>,
+    pub stopped: bool,
+    pub underrun: bool,
+    pub missed_update: bool,
 }
 
 /// A trip as one byte, for an atomic.
@@ -56,63 +92,6 @@ fn decode(code: u8) -> Option<Trip> {
         8 => Trip::MissedUpdate,
         _ => return None,
     })
-}
-
-impl Machine {
-    /// The pulse interrupt saw `trip`: as [`trip`](Self::trip), the pulse engine halted at once,
-    /// the rest in the news. Only the pulse engine calls this.
-    pub fn pulse_trip(&self, trip: Trip) {
-        if self.halted.swap(true, Ordering::AcqRel) {
-            return;
-        }
-        if !self.is_homing_switch(trip) {
-            self.position_lost.store(true, Ordering::Relaxed);
-        }
-        self.pulse_news.trip.store(code(trip), Ordering::Relaxed);
-        self.pulse_news.raise(TRIPPED);
-    }
-
-    /// The pulse engine emitted everything queued and stopped. Only the pulse engine calls this.
-    pub fn pulses_stopped(&self) {
-        self.pulse_news.raise(STOPPED);
-    }
-
-    /// The pulse engine found the queue empty while the motion was not at rest. Only the pulse
-    /// engine calls this.
-    pub fn count_underrun(&self) {
-        self.underruns.store(self.underruns.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
-        self.pulse_news.raise(UNDERRUN);
-    }
-
-    /// The step timer's interrupt came a whole period late or later: the timer repeated a
-    /// period the engine then counted (see [`crate::pulse`]). Only the pulse engine calls this.
-    pub fn count_missed_update(&self) {
-        self.missed_updates.store(self.missed_updates.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
-        self.pulse_news.raise(MISSED_UPDATE);
-    }
-
-    /// Hands the pulse interrupt's news on: below it (the board's interrupt for it, or the
-    /// simulator's step timer after each period), never in it.
-    pub fn deliver_pulse_news(&self) {
-        let bits = self.pulse_news.bits.swap(0, Ordering::Acquire);
-        if bits & TRIPPED != 0
-            && let Some(trip) = decode(self.pulse_news.trip.load(Ordering::Relaxed))
-        {
-            self.trip.lock(|t| t.set(Some(trip)));
-            self.control_requested.signal(());
-            self.changed.signal(());
-        }
-        if bits & STOPPED != 0 {
-            self.pulses_done.signal(());
-            self.changed.signal(());
-        }
-        if bits & UNDERRUN != 0 {
-            warn!("step queue underrun: the motion task fell behind the pulses");
-        }
-        if bits & MISSED_UPDATE != 0 {
-            warn!("missed step timer update: the pulse interrupt came a whole period late");
-        }
-    }
 }
 
 #[cfg(test)]
