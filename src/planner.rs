@@ -35,7 +35,11 @@
 //! change) or allow much more. Whatever is not scanned yet is treated as a stop at the scan's
 //! front, but for the rest of a straight line: its length is known
 //! ([`Interpolator::straight_steps_left`]), so its block brakes for the line's end and a long
-//! line reaches its speed whatever the horizon. The scan also finds a segment's exit direction
+//! line reaches its speed whatever the horizon. The step generator keeps the scan ahead as it
+//! emits, a few hundred steps at a time ([`SCAN_STEPS_PER_CALL`]): twice as fast as it emits
+//! while the scan's front is nearer than braking from the highest cap scanned needs
+//! ([`LEAD_SHARE`]), as fast once it is not, so a curve's evaluations double only while the
+//! look-ahead grows. The scan also finds a segment's exit direction
 //! and a curve error: the plan stops at the error point, and `next_cmd` returns `Some(Err(e))`
 //! exactly when the motion reaches it; the next segment starts from rest.
 //!
@@ -119,7 +123,7 @@ mod tests;
 pub use limits::{CENTRIPETAL_SHARE, Limits, LimitsError, MIN_FEED_MM_PER_MIN, plot_time_lower_bound};
 pub use scan::BLOCK_MARGIN;
 pub use sizes::{
-    CHUNK_RING_LEN, CHUNK_STEPS, PLANNER_BLOCKS, PLANNER_SEGMENTS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL,
+    CHUNK_RING_LEN, CHUNK_STEPS, LEAD_SHARE, PLANNER_BLOCKS, PLANNER_SEGMENTS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL,
     SCAN_STEPS_PER_PUSH, STEP_RING_LEN, STRAIGHT_CHUNK_STEPS,
 };
 pub use state::Planner;
@@ -131,7 +135,7 @@ use ring::{CopyRing, Ring, StepRing};
 use run::Run;
 use scaling::{Factors, Scale};
 use segment::{ScanPoint, Segment};
-use state::Request;
+use state::{Request, ScanPace};
 
 /// The planner holds as many segments as it can ([`Planner::is_full`]); try again after the next
 /// [`Planner::next_cmd`].
@@ -179,7 +183,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             addr_of_mut!((*p).speed).write(None);
             addr_of_mut!((*p).run).write(Run::EMPTY);
             addr_of_mut!((*p).carry).write(0);
-            addr_of_mut!((*p).emitted_since_scan).write(0);
+            addr_of_mut!((*p).pace).write(ScanPace::START);
             slot.assume_init_mut()
         }
     }
@@ -202,7 +206,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             speed: _,
             run: _,
             carry: _,
-            emitted_since_scan: _,
+            pace: _,
         } = self;
     }
 
@@ -222,7 +226,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             speed: None,
             run: Run::EMPTY,
             carry: 0,
-            emitted_since_scan: 0,
+            pace: ScanPace::START,
         }
     }
 

@@ -161,6 +161,11 @@ impl<T: Copy + Default, const N: usize> CopyRing<T, N> {
     }
 
     /// The `i`-th element from the front.
+    pub fn get(&self, i: usize) -> Option<&T> {
+        if i < self.len() { self.slots.get((self.head.wrapping_add(i as u32) & Self::MASK) as usize) } else { None }
+    }
+
+    /// The `i`-th element from the front.
     pub fn get_mut(&mut self, i: usize) -> Option<&mut T> {
         if i < self.len() { self.slots.get_mut((self.head.wrapping_add(i as u32) & Self::MASK) as usize) } else { None }
     }

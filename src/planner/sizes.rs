@@ -38,9 +38,16 @@ pub const STRAIGHT_CHUNK_STEPS: usize = 256;
 pub const SCAN_STEPS_PER_PUSH: usize = 64;
 
 /// The step generator scans again once this many steps were emitted since the scan last ran
-/// (and at the start of every run).
-pub const SCAN_EVERY_STEPS: usize = 256;
+/// (and at the start of every run): often, so that the scan's work comes in small pieces
+/// between the steps, never in one long stretch the step queue must cover.
+pub const SCAN_EVERY_STEPS: usize = 128;
 
-/// Most steps the step generator scans in one call: about 40,000 instructions on a straight
-/// line, a few tenths of a millisecond on the F407.
-pub const SCAN_STEPS_PER_CALL: usize = 1_024;
+/// Most steps the step generator scans in one call: about 10,000 instructions on a straight
+/// line, 80,000 on a function of a dozen operations, under a millisecond of the F407: well
+/// within what the step queue holds at the highest pulse rate (see
+/// [`STEP_QUEUE_LEN`](crate::pulse::STEP_QUEUE_LEN)).
+pub const SCAN_STEPS_PER_CALL: usize = 256;
+
+/// How far ahead the scan keeps, at least, as a share of the distance to brake from the highest
+/// cap scanned: beyond it the scan only keeps pace with the motion (see `keep_scanning`).
+pub const LEAD_SHARE: f32 = 1.25;

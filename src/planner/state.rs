@@ -48,6 +48,22 @@ pub struct Planner<C: Interpolator, const N: usize> {
     pub(super) run: Run,
     /// Fraction of a tick carried to the next step, in units of 2⁻³² tick.
     pub(super) carry: u32,
-    /// Steps emitted since the scan last ran: it scans that many again, and more.
-    pub(super) emitted_since_scan: usize,
+    /// How far the scan has to catch up with the motion, and how fast it does.
+    pub(super) pace: ScanPace,
+}
+
+/// How fast the scan keeps ahead of the motion (see `Planner::keep_scanning`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ScanPace {
+    /// Steps emitted since the scan last ran: it scans `rate` times that many, and a chunk more.
+    pub emitted: usize,
+    /// 2 while the scan's front may cap the motion, 1 once it cannot.
+    pub rate: usize,
+    /// Steps emitted since `rate` was last worked out.
+    pub since_check: usize,
+}
+
+impl ScanPace {
+    /// At rest: the look-ahead grows from nothing.
+    pub const START: ScanPace = ScanPace { emitted: 0, rate: 2, since_check: 0 };
 }

@@ -10,8 +10,8 @@ use crate::math;
 use crate::planner::block::{Ahead, Chunk, NM_PER_MM};
 use crate::planner::limits::MIN_SPEED_MM_PER_S;
 use crate::planner::run::{Pace, Ramp, Run};
-use crate::planner::sizes::{CHUNK_STEPS, PLANNER_BLOCKS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL};
-use crate::planner::state::{Planner, Request};
+use crate::planner::sizes::{CHUNK_STEPS, LEAD_SHARE, PLANNER_BLOCKS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL};
+use crate::planner::state::{Planner, Request, ScanPace};
 
 /// 2³², the scale of a step's fraction of a tick.
 const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
@@ -78,7 +78,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
     /// step queue this way, one run at a time in a tight loop.
     pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
-        if self.emitted_since_scan >= SCAN_EVERY_STEPS {
+        if self.pace.emitted >= SCAN_EVERY_STEPS {
             self.keep_scanning();
         }
         let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
@@ -167,7 +167,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             }
             self.carry = carry;
             self.steps.drop_front(taken);
-            self.emitted_since_scan += taken;
+            self.pace.emitted += taken;
             self.run.left -= taken as u32;
             if ends_early {
                 self.run.cut();
@@ -180,18 +180,46 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         Emitted { steps: written, ticks, moved: Point::new(dx, dy), end }
     }
 
-    /// Keeps the scan ahead: twice what was emitted since it last ran, and a chunk more, but at
-    /// most [`SCAN_STEPS_PER_CALL`] at once; what is left waits for the next call. The steps are
-    /// counted as they are emitted, not as their run ends: a cruise along a long line is one run,
-    /// and its steps scanned again all at once at its end would be milliseconds of the F407's in
-    /// one call.
+    /// Keeps the scan ahead: twice what was emitted since it last ran, and a chunk more, while
+    /// the scan's front may still cap the motion ([`Self::lead_short`]); once it cannot, as much
+    /// as was emitted, and a chunk more. At most [`SCAN_STEPS_PER_CALL`] at once; what is left
+    /// waits for the next call. The steps are counted as they are emitted, not as their run ends:
+    /// a cruise along a long line is one run, and its steps scanned again all at once at its end
+    /// would be milliseconds of the F407's in one call.
+    ///
+    /// Scanning twice the steps emitted doubles a curve's evaluations while the look-ahead
+    /// grows: at a function's top rate the processor has no room for that, so the look-ahead
+    /// grows only as far as braking from the caps scanned needs.
     fn keep_scanning(&mut self) {
         if self.steps.free() < CHUNK_STEPS {
             return;
         }
-        let budget = (2 * self.emitted_since_scan + CHUNK_STEPS).min(SCAN_STEPS_PER_CALL);
+        self.pace.since_check += self.pace.emitted;
+        if self.pace.since_check >= SCAN_EVERY_STEPS || self.speed.is_none() {
+            // Worked out now and then: it reads every block.
+            self.pace.since_check = 0;
+            self.pace.rate = if self.lead_short() { 2 } else { 1 };
+        }
+        let ScanPace { emitted, rate, .. } = self.pace;
+        let budget = (rate * emitted + CHUNK_STEPS).min(SCAN_STEPS_PER_CALL);
         self.scan(budget);
-        self.emitted_since_scan = self.emitted_since_scan.saturating_sub(budget / 2);
+        self.pace.emitted = emitted.saturating_sub(budget / rate);
+    }
+
+    /// True while the scan's front may cap the motion: what is scanned ahead of it (with a
+    /// straight line's known rest) is shorter than [`LEAD_SHARE`] times the distance to brake
+    /// from the highest cap scanned at the lowest acceleration scanned.
+    fn lead_short(&self) -> bool {
+        let (mut lead_nm, mut top_mm_per_s, mut accel_mm_per_s2) = (0u64, 0.0f32, f32::INFINITY);
+        for i in 0..self.blocks.len() {
+            if let Some(block) = self.blocks.get(i) {
+                lead_nm += u64::from(block.end_nm().saturating_sub(block.done_nm));
+                top_mm_per_s = math::max(top_mm_per_s, block.caps.speed_mm_per_s);
+                accel_mm_per_s2 = math::min(accel_mm_per_s2, block.caps.accel_mm_per_s2);
+            }
+        }
+        let brake_nm = top_mm_per_s * top_mm_per_s / (2.0 * accel_mm_per_s2) * NM_PER_MM;
+        (lead_nm as f32) < LEAD_SHARE * brake_nm
     }
 
     /// Plans the next run.

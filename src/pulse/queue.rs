@@ -9,10 +9,12 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::geom::StepCmd;
 
-/// Commands the queue holds (a power of two). At 100 kHz, 256 steps are 2.5 ms of motion, many
-/// times the motion task's latency on its own interrupt executor, which refills the queue when
-/// half of it is emitted.
-pub const STEP_QUEUE_LEN: usize = 256;
+/// Commands the queue holds (a power of two). At 200 kHz, 1,024 steps are 5.1 ms of motion; the
+/// motion task refills the queue when half of it is emitted, so the 2.6 ms left cover its
+/// longest piece of work between two batches of steps (a scan of
+/// [`SCAN_STEPS_PER_CALL`](crate::planner::SCAN_STEPS_PER_CALL) steps of a function, under a
+/// millisecond) with room for the interrupts above it. 8 KiB.
+pub const STEP_QUEUE_LEN: usize = 1024;
 
 const MASK: u32 = {
     assert!(STEP_QUEUE_LEN.is_power_of_two() && STEP_QUEUE_LEN <= 1 << 16);
@@ -195,7 +197,8 @@ mod tests {
     fn commands_come_out_in_order_across_the_wrap_and_never_more_than_fit() {
         let mut q = StepQueue::new();
         let (mut p, mut c) = q.split();
-        let all: Vec<StepCmd> = (0..1_000).map(cmd).collect();
+        // Three times round the queue: it fills (more pushed than popped) and wraps.
+        let all: Vec<StepCmd> = (0..3 * STEP_QUEUE_LEN as u32).map(cmd).collect();
         let mut out = Vec::new();
         let mut at = 0;
         while out.len() < all.len() {

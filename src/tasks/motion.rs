@@ -17,6 +17,7 @@
 use core::sync::atomic::{Ordering, fence};
 
 use embassy_futures::select::{Either, select};
+use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 
 use crate::drawing::Drawing;
@@ -28,7 +29,7 @@ use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
 use crate::overrides::Overrides;
 use crate::pen::Pen;
 use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner, PlannerState};
-use crate::pulse::StepProducer;
+use crate::pulse::{STEP_QUEUE_LEN, StepProducer};
 use crate::settings::Settings;
 use crate::status::RunState;
 
@@ -51,10 +52,18 @@ pub const SERVO_READY_POLL_MS: u64 = 1;
 /// about 1.3 ms on the F407).
 pub const PUBLISH_BATCH_STEPS: usize = 32;
 
+/// Steps queued in one poll at most: half the queue, what the task refills when woken. From
+/// an empty queue at the start of a curve, while the planner's look-ahead grows, a whole queue
+/// of a function's steps is some 8 ms of the F407; half keeps the poll short.
+pub const FILL_MAX_STEPS: u32 = (STEP_QUEUE_LEN / 2) as u32;
+
 /// Why a fill of the step queue stopped.
 enum FillEnd {
     /// The queue holds as much as it may.
     QueueFull,
+    /// This poll queued [`FILL_MAX_STEPS`] and the queue has room still: the task yields and
+    /// goes on.
+    PollDone,
     /// The planner has nothing more now.
     PlanEmpty,
     /// The curve failed part way.
@@ -189,7 +198,7 @@ pub async fn run(
             abort(machine, planner);
         }
         let stands = matches!(planner.state(), PlannerState::Idle | PlannerState::Held);
-        if !matches!(filled, FillEnd::QueueFull) && stands && !queued.resting {
+        if !matches!(filled, FillEnd::QueueFull | FillEnd::PollDone) && stands && !queued.resting {
             // The motion comes to rest after the steps queued: at its end, or held.
             steps.rest();
             queued.resting = true;
@@ -200,6 +209,7 @@ pub async fn run(
             kick();
         }
         match filled {
+            FillEnd::PollDone => yield_now().await,
             FillEnd::QueueFull => {
                 // Enough motion queued: wait until half of what the pulse engine has not taken
                 // yet is emitted (it holds two steps: the one it emits and the one after), or
@@ -280,7 +290,7 @@ async fn halted(
 
 /// Moves step commands from the planner into the step queue: as many as fit, up to
 /// [`STEP_QUEUE_MAX_TICKS`] of motion queued but never fewer than [`STEP_QUEUE_MIN_STEPS`]
-/// steps, published [`PUBLISH_BATCH_STEPS`] at a time.
+/// steps, and at most [`FILL_MAX_STEPS`], published [`PUBLISH_BATCH_STEPS`] at a time.
 async fn fill(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
@@ -290,16 +300,21 @@ async fn fill(
 ) -> FillEnd {
     let mut ticks_room = STEP_QUEUE_MAX_TICKS.saturating_sub(machine.queued_ticks());
     let mut steps_short = STEP_QUEUE_MIN_STEPS.saturating_sub(machine.queued_steps());
+    let mut steps_left = FILL_MAX_STEPS;
     loop {
         // Steps short of the least: a step at a time whatever their length.
         let room = ticks_room.max(u32::from(steps_short > 0));
         let slots = steps.free_slots();
-        let batch = slots.len().min(PUBLISH_BATCH_STEPS);
+        if steps_left == 0 {
+            return FillEnd::PollDone;
+        }
+        let batch = slots.len().min(PUBLISH_BATCH_STEPS).min(steps_left as usize);
         let Some(slots) = slots.get_mut(..batch).filter(|s| !s.is_empty() && room > 0) else {
             return FillEnd::QueueFull;
         };
         let emitted = planner.fill(slots, room);
         steps_short = steps_short.saturating_sub(emitted.steps as u32);
+        steps_left -= emitted.steps as u32;
         work.took(&emitted).await;
         steps.publish(emitted.steps);
         if emitted.steps > 0 {
