@@ -34,6 +34,7 @@ use servoplot::tasks::panel::Panel;
 use static_cell::{ConstStaticCell, StaticCell};
 
 use crate::board::{self, Board};
+use polls::Executor;
 use slot::FutureSlot;
 
 /// How often the health task measures the stack and the polls.
@@ -85,18 +86,22 @@ fn start(spawner: Spawner) {
     let (steps, step_consumer) = STEP_QUEUE.take().split();
     board::start_pulses(board.step_timer, step_consumer, machine);
     let motion_spawner: SendSpawner = board::start_motion_executor();
-    motion_spawner.spawn(timed(motion(machine, planner, steps), "motion"));
+    motion_spawner.spawn(timed(motion(machine, planner, steps), "motion", Executor::Interrupt));
 
     let panel: &'static Panel = PANEL.init_with(Panel::new);
-    spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad"));
-    spawner.spawn(timed(servo(machine, board.son, board.pen, board.lights, board.watchdog), "servo"));
-    spawner.spawn(timed(homing(machine), "homing"));
+    spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad", Executor::ThreadMode));
+    spawner.spawn(timed(
+        servo(machine, board.son, board.pen, board.lights, board.watchdog),
+        "servo",
+        Executor::ThreadMode,
+    ));
+    spawner.spawn(timed(homing(machine), "homing", Executor::ThreadMode));
     let links = LINKS.init((board.host, board.second_link));
     let host_link = HOST_LINK.place(|| host_link(machine, store, loaded, links));
     let Some(host_link) = host_link else { defmt::panic!("the host link's future placed twice") };
-    spawner.spawn(timed(serial(host_link), "serial"));
-    spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd"));
-    spawner.spawn(timed(health(), "health"));
+    spawner.spawn(timed(serial(host_link), "serial", Executor::ThreadMode));
+    spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd", Executor::ThreadMode));
+    spawner.spawn(timed(health(), "health", Executor::ThreadMode));
 }
 
 /// The machine, built and moved into `slot` in a frame of its own (3 KB), out of the caller's.
@@ -121,10 +126,10 @@ defmt::timestamp!("{=u64:us}", embassy_time::Instant::now().as_micros());
 
 /// A task's token, its polls timed under `name`. Each task is spawned once, at start-up, so its
 /// pool always has room: a second spawn is a bug, said plainly.
-fn timed<S>(token: Result<SpawnToken<S>, SpawnError>, name: &'static str) -> SpawnToken<S> {
+fn timed<S>(token: Result<SpawnToken<S>, SpawnError>, name: &'static str, executor: Executor) -> SpawnToken<S> {
     match token {
         Ok(token) => {
-            polls::register(token.id(), name);
+            polls::register(token.id(), name, executor);
             token
         }
         Err(_) => defmt::panic!("task {=str} spawned twice", name),
@@ -192,19 +197,31 @@ async fn lcd(machine: &'static Machine, panel: &'static Panel, lcd: board::Lcd) 
 }
 
 /// Measures the stack's peak and the longest task poll every [`HEALTH_PERIOD_MS`], publishes
-/// them for `$I`, and logs them whenever either has grown.
+/// them for `$I`, and logs them whenever one has grown.
 #[embassy_executor::task]
 async fn health() -> ! {
-    let mut logged = Health { stack_peak_bytes: 0, stack_size_bytes: 0, longest_poll_us: 0 };
+    let mut logged = Health::default();
     loop {
-        let (task, longest_poll_us) = polls::longest();
-        let now =
-            Health { stack_peak_bytes: stack::peak_bytes(), stack_size_bytes: stack::size_bytes(), longest_poll_us };
+        let (own, with_preemption) = polls::longest();
+        let now = Health {
+            stack_peak_bytes: stack::peak_bytes(),
+            stack_size_bytes: stack::size_bytes(),
+            longest_poll_us: own.us,
+            longest_poll_with_preemption_us: with_preemption.us,
+        };
         health::publish(&now);
-        if now.stack_peak_bytes > logged.stack_peak_bytes || now.longest_poll_us > logged.longest_poll_us {
+        if now.stack_peak_bytes > logged.stack_peak_bytes
+            || now.longest_poll_us > logged.longest_poll_us
+            || now.longest_poll_with_preemption_us > logged.longest_poll_with_preemption_us
+        {
             info!(
-                "stack: {} of {} bytes at most; longest poll: {} us ({=str})",
-                now.stack_peak_bytes, now.stack_size_bytes, now.longest_poll_us, task
+                "stack: {} of {} bytes at most; longest poll: {} us ({=str}), {} us with preemption ({=str})",
+                now.stack_peak_bytes,
+                now.stack_size_bytes,
+                now.longest_poll_us,
+                own.task,
+                now.longest_poll_with_preemption_us,
+                with_preemption.task
             );
             logged = now;
         }

@@ -373,10 +373,12 @@ fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
 pub fn build_info(out: &mut impl Write, info: &str, planner_blocks: usize, rx_buffer_bytes: usize) -> fmt::Result {
     let (blocks, rx) = (Int::from(planner_blocks), Int::from(rx_buffer_bytes));
     write!(out, "[VER:{}.{}:{}]\r\n[OPT:,{blocks},{rx}]\r\n", Text(GRBL_VERSION), Text(BUILD_NAME), Text(info))?;
-    // On the chip: the stack's peak and size, bytes, and the longest task poll, µs.
+    // On the chip: the stack's peak and size, bytes, and the longest task poll, µs: its own
+    // work, and with the motion task's polls that preempted it.
     if let Some(h) = crate::health::read() {
         let (peak, size) = (Int::from(h.stack_peak_bytes), Int::from(h.stack_size_bytes));
-        write!(out, "[STACK:{peak},{size}]\r\n[POLL:{}]\r\n", Int::from(h.longest_poll_us))?;
+        let (own, with_preemption) = (Int::from(h.longest_poll_us), Int::from(h.longest_poll_with_preemption_us));
+        write!(out, "[STACK:{peak},{size}]\r\n[POLL:{own},{with_preemption}]\r\n")?;
     }
     Ok(())
 }

@@ -94,7 +94,7 @@ pub fn start(
     interrupt::OTG_FS.set_priority(priority);
     match usb_device(builder.build()) {
         Ok(token) => {
-            polls::register(token.id(), "usb");
+            polls::register(token.id(), "usb", polls::Executor::ThreadMode);
             spawner.spawn(token);
         }
         Err(_) => defmt::panic!("the USB device's task spawned twice"),
