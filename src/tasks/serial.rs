@@ -533,6 +533,9 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             // M2/M30 turn the spindle off: a pen lift raises the pen.
             Command::ProgramEnd if PenLift::of(settings) != PenLift::None => Some(host.pen_to(Pen::Up)),
             Command::Pause | Command::ProgramEnd => Some(host.machine_at_rest()),
+            // A setting applies to the motion after it, never under a move: the planner takes
+            // new limits at rest (see `Planner::set_limits`), so the lines before it end first.
+            Command::SetSetting { .. } | Command::RestoreSettings { .. } => Some(host.machine_at_rest()),
             Command::Home => Some(host.machine_stopped()),
             // The motion task drops what a trip cut short before the pulses may go on.
             Command::Unlock if machine.halted() => Some(host.machine_stopped()),
