@@ -95,3 +95,35 @@ fn the_rapid_override_slows_rapids_and_a_jog_takes_no_override() {
     assert!((v - 1200.0).abs() < 1200.0 * 0.002, "{v} mm/min");
     assert!(reports(&report)[0].starts_with("<Jog|") && reports(&report)[0].contains("|FS:1200,0|"));
 }
+
+#[test]
+fn overrides_sent_as_bytes_or_as_utf8_text_act_mid_file_and_every_line_runs() {
+    // A streamed file of 40 short moves. Some senders write the override bytes as text, so
+    // above 0x7F they arrive UTF-8 encoded (0x91 as 0xC2 0x91); GRBL drops the stray 0xC2.
+    let file: String = (0..40).map(|i| format!("G1 X{} Y{} F1200\n", 5 + i % 7, 3 + i % 5)).collect();
+    let lines = file.lines().count();
+    // Feed +10 % twice, rapid 50 % then 25 %, spindle +10 % twice: once raw, once as text.
+    let timed: Vec<(u64, u8)> = [
+        (300_000, &[0x91][..]),
+        (350_000, &[0xC2, 0x91]),
+        (400_000, &[0x96]),
+        (450_000, &[0xC2, 0x97]),
+        (500_000, &[0x9A]),
+        (550_000, &[0xC2, 0x9A]),
+        // The first report carries the work offset, the second the overrides.
+        (700_000, b"?"),
+        (750_000, b"?"),
+    ]
+    .iter()
+    .flat_map(|&(t, bytes)| bytes.iter().map(move |&b| (t, b)))
+    .collect();
+    let report = run(&file, &timed);
+    let answers = report.answers();
+    assert_eq!(answers.lines().filter(|l| *l == "ok").count(), lines, "{answers}");
+    assert!(!answers.contains("error"), "{answers}");
+    assert!(reports(&report)[1].ends_with("|Ov:120,25,120>"), "{:?}", reports(&report));
+    // The same steps to the same end as without the overrides.
+    let plain = run(&file, &[]);
+    assert_eq!(report.path(), plain.path());
+    assert_eq!(report.position, plain.position);
+}

@@ -12,8 +12,11 @@
 //! the end) of a G-code line or a `$J=` jog, so that a long comment or a line padded with spaces
 //! is no overflow, and any byte inside a comment (UTF-8 text included) is ignored. A `$` command
 //! is kept as sent up to a `;` comment: the plotter's curve commands need their spaces and the
-//! `$F` expression its parentheses. Leading spaces go from every line. Beyond that the assembler
-//! owns only framing (line ends, which bytes may stand in a line); the parsers read the words.
+//! `$F` expression its parentheses. Leading spaces go from every line. A byte above 0x7F that is
+//! not a realtime command is dropped wherever it comes, as GRBL drops it: senders that write
+//! realtime commands as text send 0x91 as UTF-8, 0xC2 0x91, and the 0xC2 must not spoil the line
+//! it lands in. Beyond that the assembler owns only framing (line ends, which bytes may stand in
+//! a line); the parsers read the words.
 
 use heapless::String;
 
@@ -73,8 +76,7 @@ pub enum LineEvent<'a> {
     Line(&'a str),
     /// The line was longer than [`LINE_MAX_BYTES`]; all of it was dropped (`error:11`).
     Overflow,
-    /// The line held this control or non-ASCII byte (the first one); all of it was dropped
-    /// (`error:1`).
+    /// The line held this control byte (the first one); all of it was dropped (`error:1`).
     BadByte(u8),
 }
 
@@ -92,9 +94,9 @@ impl LineEvent<'_> {
 /// Collects bytes into lines; see the module documentation.
 ///
 /// A line ends at LF or CR, each on its own, as in GRBL: CRLF ends a line and then an empty one,
-/// and GRBL answers both (senders send LF). Every other byte that is not realtime belongs to the line: outside
-/// comments, printable ASCII (and tab, in a `$` command) is kept; any other byte marks the whole
-/// line as refused. A line whose kept bytes grow past [`LINE_MAX_BYTES`] is dropped up to its end
+/// and GRBL answers both (senders send LF). A byte above 0x7F that is not realtime is dropped.
+/// Every other byte belongs to the line: outside comments, printable ASCII (and tab, in a `$`
+/// command) is kept; a control byte marks the whole line as refused. A line whose kept bytes grow past [`LINE_MAX_BYTES`] is dropped up to its end
 /// and reported once, as [`LineEvent::Overflow`], when that end arrives. A soft reset byte
 /// (0x18) drops the partial line, as GRBL's reset flushes its receive buffer.
 #[derive(Clone, Debug)]
@@ -191,6 +193,10 @@ impl LineAssembler {
 
     /// A byte of the line under way, not a line end: dropped, kept, or refusing the line.
     fn take(&mut self, byte: u8) {
+        if byte > 0x7F {
+            // Not realtime (the caller took those): dropped, in a comment or not.
+            return;
+        }
         match self.comment {
             Comment::ToEnd => return,
             Comment::Paren => {
@@ -321,14 +327,15 @@ mod tests {
     }
 
     #[test]
-    fn control_and_non_ascii_bytes_refuse_the_line_without_eating_the_next() {
+    fn bytes_above_0x7f_are_dropped_and_control_bytes_refuse_the_line_without_eating_the_next() {
         let mut a = LineAssembler::new();
-        // "°" in UTF-8 is C2 B0; neither byte is a GRBL realtime command.
-        let got = feed(&mut a, "G0 X1°\nG0 X2\n$S A5°\n".as_bytes());
-        assert_eq!(
-            got,
-            std::vec![Err(LineEvent::BadByte(0xC2)), Ok("G0X2".to_string()), Err(LineEvent::BadByte(0xC2))]
-        );
+        // "°" in UTF-8 is C2 B0; neither byte is a GRBL realtime command: both are dropped.
+        let got = feed(&mut a, "G0 X1°\nG0 X2\n$S A5°\n(é) G1 X4\n".as_bytes());
+        assert_eq!(got, ["G0X1", "G0X2", "$S A5", "G1X4"].map(|l| Ok(l.to_string())));
+        // The override 0x91 sent as UTF-8 text, 0xC2 0x91, in the middle of a line: the 0x91
+        // acts (the caller takes realtime bytes first), the 0xC2 leaves no trace.
+        let got = feed(&mut a, b"G1 X\xC2\x915\n");
+        assert_eq!(got, std::vec![Ok("G1X5".to_string())]);
         let got = feed(&mut a, b"G0\x07X1\n\tG0\tX3\n");
         assert_eq!(got, std::vec![Err(LineEvent::BadByte(0x07)), Ok("G0X3".to_string())]);
         assert_eq!(LineEvent::BadByte(7).error(), Some(GrblError::ExpectedCommandLetter));
