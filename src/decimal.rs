@@ -322,6 +322,8 @@ impl core::fmt::Display for Num {
 
 /// Writes `value` with at most `max_decimals` decimals, leaving off trailing zeros down to
 /// `min_decimals` (`2.5` with 0 to 6 is `2.5`, `20000` is `20000`, with 3 to 6 `20000.000`).
+/// Where fewer decimals read back as the same `f32` (through [`parse_prefix`]), only those are
+/// written: a value typed as `182.051` is written so, not as its float's `182.050995`.
 pub fn write_trimmed(
     out: &mut dyn core::fmt::Write,
     value: f32,
@@ -329,6 +331,9 @@ pub fn write_trimmed(
     max_decimals: u8,
 ) -> core::fmt::Result {
     let max = max_decimals.min(WRITE_MAX_DECIMALS);
+    if let Some(decimals) = (min_decimals..max).find(|&d| reads_back(value, d)) {
+        return write_fixed(out, value, decimals);
+    }
     let mut decimals = max;
     if let Some((_, _, mut fraction)) = split(value, max) {
         while decimals > min_decimals && fraction % 10 == 0 {
@@ -337,6 +342,15 @@ pub fn write_trimmed(
         }
     }
     write_fixed(out, value, decimals)
+}
+
+/// Whether `value` written with `decimals` decimals reads back as `value` itself.
+fn reads_back(value: f32, decimals: u8) -> bool {
+    let Some((_, whole, fraction)) = split(value, decimals) else { return false };
+    let Some(mantissa) = whole.checked_mul(10u64.pow(u32::from(decimals))).map(|w| w + u64::from(fraction)) else {
+        return false;
+    };
+    scale(mantissa, -i32::from(decimals)).unwrap_or(0.0) == value.abs()
 }
 
 /// `value` as (negative, whole part, the first `decimals` decimals as an integer), rounded to
@@ -479,6 +493,22 @@ mod tests {
     }
 
     proptest! {
+        /// A setting typed with three decimals, as GRBL prints them, is written back so that it
+        /// reads as the same value, and as typed below 4096, where an `f32` tells every
+        /// thousandth apart (fewer than 2^24 digits, where the parser is exact).
+        #[test]
+        fn a_value_typed_with_three_decimals_is_written_as_typed(milli in 0u64..(1 << 24)) {
+            let typed = format!("{}.{:03}", milli / 1000, milli % 1000);
+            let (value, _) = read(&typed, SIGNED).unwrap_or((0.0, 0));
+            let written = trimmed(value, 3, 6);
+            prop_assert_eq!(read(&written, SIGNED).map(|r| r.0), Ok(value), "{} written as {}", typed, written);
+            if milli < 4_096_000 {
+                prop_assert_eq!(written, typed);
+            }
+        }
+    }
+
+    proptest! {
         #![proptest_config(ProptestConfig::with_cases(4096))]
 
         /// Against the host's parsers: the precision the module documentation states, checked
@@ -588,6 +618,9 @@ mod tests {
         assert_eq!(trimmed(20_000.0, 0, 6), "20000");
         assert_eq!(trimmed(20_000.0, 3, 6), "20000.000");
         assert_eq!(trimmed(0.02, 3, 6), "0.020");
+        assert_eq!(trimmed(182.051, 3, 6), "182.051", "as typed, not the float's 182.050995");
+        assert_eq!(trimmed(-0.3, 3, 6), "-0.300");
+        assert_eq!(trimmed(1.2000004, 0, 3), "1.2", "nothing shorter reads back: rounded, trimmed");
         assert_eq!(trimmed(0.123456, 3, 6), "0.123456");
     }
 
