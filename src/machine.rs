@@ -40,12 +40,13 @@
 mod from_pulses;
 mod job_queue;
 mod jobs;
+mod path_steps;
 mod published;
 mod pulse_news;
 mod settings;
 
 use core::cell::Cell;
-use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
 use core::task::Waker;
 
 use embassy_sync::blocking_mutex::Mutex;
@@ -63,6 +64,7 @@ use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
 use job_queue::JobQueue;
+use path_steps::PathSteps;
 use published::Published;
 use pulse_news::PulseNews;
 
@@ -163,10 +165,11 @@ pub struct Machine {
     /// Steps emitted so far and the sum of their intervals (written only by the pulse engine).
     emitted_steps: AtomicU32,
     emitted_ticks: AtomicU32,
-    /// The step emitted last: its interval in ticks, and its move (X in the low byte, Y in the
-    /// high byte, as stored), for the speed the pen moves at (written only by the pulse engine).
+    /// The interval of the step emitted last, ticks (written only by the pulse engine), and how
+    /// far the queued steps advance along the ideal curve (written only by the motion task): the
+    /// pen's speed along its path is the one over the other.
     last_interval_ticks: AtomicU32,
-    last_step: AtomicU16,
+    path_steps: PathSteps,
     /// Machine position minus work position, mm (written by the host link's parser).
     work_offset_mm: Mutex<CriticalSectionRawMutex, Cell<[f32; 2]>>,
     /// Times the pulse engine found the queue empty while the motion was not at rest
@@ -238,7 +241,7 @@ impl Machine {
             emitted_steps: AtomicU32::new(0),
             emitted_ticks: AtomicU32::new(0),
             last_interval_ticks: AtomicU32::new(0),
-            last_step: AtomicU16::new(0),
+            path_steps: PathSteps::new(),
             work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
             underruns: AtomicU32::new(0),
             missed_updates: AtomicU32::new(0),
@@ -427,24 +430,31 @@ impl Machine {
         x.store(x.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.x)), Ordering::Relaxed);
         y.store(y.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.y)), Ordering::Relaxed);
         self.last_interval_ticks.store(cmd.interval_ticks, Ordering::Relaxed);
-        self.last_step.store(u16::from_le_bytes([cmd.step.x as u8, cmd.step.y as u8]), Ordering::Relaxed);
         let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
         self.emitted_ticks.store(t, Ordering::Release);
         let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);
         self.emitted_steps.store(n, Ordering::Release);
     }
 
-    /// How fast the pen moves now, mm/min: the step being emitted over its interval; 0 at rest
-    /// (stopped, or held once stopped).
-    pub fn speed_mm_per_min(&self, settings: &Settings) -> f32 {
+    /// How fast the pen moves along its path now, mm/min: how far a step advances along the
+    /// ideal curve over the interval of the step being emitted; 0 at rest (stopped, or held
+    /// once stopped). Not the lattice step's own length: on a line at 30° the steps are X steps
+    /// and diagonal ones, each advancing the same distance along the line at the same pace.
+    pub fn speed_mm_per_min(&self) -> f32 {
         let interval = self.last_interval_ticks.load(Ordering::Relaxed);
         if self.pulses_idle() || interval == 0 {
             return 0.0;
         }
-        let [x, y] = self.last_step.load(Ordering::Relaxed).to_le_bytes();
-        let along = |moved: u8, axis: usize| if moved != 0 { 1.0 / settings.steps_per_mm[axis] } else { 0.0 };
-        let (dx, dy) = (along(x, 0), along(y, 1));
-        crate::math::sqrt(dx * dx + dy * dy) * (60.0 * TICK_HZ as f32) / interval as f32
+        // The step emitted last is the one being timed.
+        let step = self.emitted_steps.load(Ordering::Acquire).wrapping_sub(1);
+        self.path_steps.at(step) * (60.0 * TICK_HZ as f32) / interval as f32
+    }
+
+    /// The steps of a batch queued after `first` steps (counted as `set_queued` counts them)
+    /// each advance `step_mm` along the ideal curve (see
+    /// [`speed_mm_per_min`](Self::speed_mm_per_min)). Only the motion task calls this.
+    pub fn set_path_step_mm(&self, first: u32, step_mm: f32) {
+        self.path_steps.record(first, step_mm);
     }
 
     /// The work coordinate offset the host link's parser plans with (machine = work + offset),

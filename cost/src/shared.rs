@@ -55,7 +55,7 @@ pub fn run() {
         let settings = machine.settings();
         let live = Live {
             now_ms: round as u32,
-            speed_mm_per_min: machine.speed_mm_per_min(&settings),
+            speed_mm_per_min: machine.speed_mm_per_min(),
             work_offset_mm: machine.work_offset_mm(),
             drawn: None,
         };

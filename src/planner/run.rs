@@ -9,6 +9,8 @@ pub(crate) struct Run {
     pub(super) steps: u32,
     pub left: u32,
     pub(super) pace: Pace,
+    /// How far each of its steps advances along the ideal curve, mm (its chunk's `δ_mm`).
+    pub(super) step_mm: f32,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -42,7 +44,7 @@ pub(super) struct Ramp {
 }
 
 impl Run {
-    pub const EMPTY: Run = Run { steps: 0, left: 0, pace: Pace::Cruise { ticks: 0, frac: 0 } };
+    pub const EMPTY: Run = Run { steps: 0, left: 0, pace: Pace::Cruise { ticks: 0, frac: 0 }, step_mm: 0.0 };
 
     /// Ends the run after the steps emitted so far: the next step is planned afresh.
     pub fn cut(&mut self) {

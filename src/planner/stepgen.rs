@@ -29,7 +29,7 @@ const OVER_CAP: f32 = 1.0 + 1.0e-4;
 const HALF_TICK: u32 = 1 << 31;
 
 /// What [`Planner::fill`] wrote, and why it stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Emitted {
     /// Step commands written, from the start of the buffer.
     pub steps: usize,
@@ -37,6 +37,12 @@ pub struct Emitted {
     pub ticks: u32,
     /// Where they take the pen, relative to where it was before them.
     pub moved: Point,
+    /// How far each of them advances along the ideal curve, mm (over its interval, the pen's
+    /// speed along its path): `step_mm` from the step `step_mm_from` on, `step_mm_before` before
+    /// it (the steps of the run before, where the batch spans two). 0 when none was written.
+    pub step_mm: f32,
+    pub step_mm_from: usize,
+    pub step_mm_before: f32,
     /// `None`: the buffer is full or the ticks asked for are written. `Some(Ok(()))`: nothing
     /// more to emit now (the queue is empty, or a hold has stopped the motion).
     /// `Some(Err(e))`: a curve fails after these steps (the machine is then at rest; the next
@@ -82,6 +88,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             self.keep_scanning();
         }
         let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
+        let (mut step_mm, mut step_mm_from, mut step_mm_before) = (0.0, 0, 0.0);
         let end = loop {
             if written >= out.len() || ticks >= ticks_room {
                 break None;
@@ -166,6 +173,11 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 continue;
             }
             self.carry = carry;
+            if written == 0 {
+                (step_mm, step_mm_before) = (self.run.step_mm, self.run.step_mm);
+            } else if self.run.step_mm != step_mm {
+                (step_mm_before, step_mm_from, step_mm) = (step_mm, written, self.run.step_mm);
+            }
             self.steps.drop_front(taken);
             self.pace.emitted += taken;
             self.run.left -= taken as u32;
@@ -177,7 +189,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 self.retire_run();
             }
         };
-        Emitted { steps: written, ticks, moved: Point::new(dx, dy), end }
+        Emitted { steps: written, ticks, moved: Point::new(dx, dy), step_mm, step_mm_from, step_mm_before, end }
     }
 
     /// Keeps the scan ahead: twice what was emitted since it last ran, and a chunk more, while
@@ -311,7 +323,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             if n > 0 {
                 let (ticks, frac) = split_ticks(step_mm / cap * TICK_HZ as f32, min_ticks);
                 self.speed = Some(cap);
-                self.run = Run { steps: n, left: n, pace: Pace::Cruise { ticks, frac } };
+                self.run = Run { steps: n, left: n, pace: Pace::Cruise { ticks, frac }, step_mm };
                 return;
             }
         }
@@ -332,7 +344,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             min_ticks,
         };
         let n = available.min(RAMP_RUN_MAX_STEPS);
-        self.run = Run { steps: n, left: n, pace: Pace::Ramp(ramp) };
+        self.run = Run { steps: n, left: n, pace: Pace::Ramp(ramp), step_mm };
     }
 
     /// Books the steps emitted in the run just ended against its chunk and block; rests when

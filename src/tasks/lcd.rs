@@ -63,7 +63,7 @@ pub async fn run<L: Lcd>(machine: &Machine, panel: &Panel, mut lcd: L) -> ! {
             let running = drawn.follow(menu.run(), status.position, PenLift::of(&settings).draws(machine.pen()));
             let live = Live {
                 now_ms,
-                speed_mm_per_min: machine.speed_mm_per_min(&settings),
+                speed_mm_per_min: machine.speed_mm_per_min(),
                 work_offset_mm: machine.work_offset_mm(),
                 drawn: Some(&drawn.path),
             };

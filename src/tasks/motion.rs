@@ -316,6 +316,14 @@ async fn fill(
         steps_short = steps_short.saturating_sub(emitted.steps as u32);
         steps_left -= emitted.steps as u32;
         work.took(&emitted).await;
+        if emitted.steps > 0 {
+            // Before the pulse engine may take them.
+            if emitted.step_mm_from > 0 {
+                machine.set_path_step_mm(queued.steps, emitted.step_mm_before);
+            }
+            let from = queued.steps.wrapping_add(emitted.step_mm_from as u32);
+            machine.set_path_step_mm(from, emitted.step_mm);
+        }
         steps.publish(emitted.steps);
         if emitted.steps > 0 {
             queued.resting = false;

@@ -134,7 +134,7 @@ impl Host<'_> {
         let overrides = status.overrides.percents();
         let occasional = self.refresh.borrow_mut().next(work_offset_mm, overrides, busy);
         let fields = StatusFields {
-            speed_mm_per_min: machine.speed_mm_per_min(&settings),
+            speed_mm_per_min: machine.speed_mm_per_min(),
             work_offset_mm,
             wco: occasional.wco,
             overrides: occasional.overrides.then_some(overrides),
