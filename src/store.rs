@@ -3,9 +3,13 @@
 //! line), as one [`Record`] in two erase sectors of flash set apart for it.
 //!
 //! It is a log over the two sectors. A sector starts with a header (a magic word and a sequence
-//! number, checksummed) written after each erase; saves append the whole record after the last
-//! one, each with its length and a CRC-32. Reading takes the last record whose CRC holds, in the
-//! sector with the highest sequence number that holds one. A save appends to that sector while
+//! number, checksummed, written twice over) written after each erase; saves append the whole
+//! record after the last one, each with its length and a CRC-32. Reading takes the last record
+//! whose CRC holds, in the sector with the highest sequence number that holds one. Damage does
+//! not hide what lies behind it: a record that fails its CRC is skipped and the scan goes on at
+//! the next word, so every intact record is found; a header needs only one of its two copies,
+//! and a sector whose header is lost still gives its records when the other sector has none.
+//! When anything was skipped, opening the store says so ([`StoreError::Repaired`]). A save appends to that sector while
 //! it has room and nothing but erased flash after its last record; otherwise it erases the
 //! other sector, gives it the next sequence number and writes the record there. So:
 //!
@@ -64,8 +68,10 @@ pub const STORE_SAVE_STALL_MAX_MS: u32 = STORE_SECTOR_ERASE_MAX_MS
 
 /// Starts a sector header: "SPLT".
 const SECTOR_MAGIC: u32 = 0x544c_5053;
-/// Sector header: magic, sequence number, CRC-32 of the two.
-const SECTOR_HEADER_BYTES: usize = 12;
+/// One copy of a sector header: magic, sequence number, CRC-32 of the two.
+const SECTOR_HEADER_COPY_BYTES: usize = 12;
+/// A sector header: two copies, so that one damaged byte does not lose the sector's number.
+const SECTOR_HEADER_BYTES: usize = 2 * SECTOR_HEADER_COPY_BYTES;
 /// Record header: length of the record's bytes (u16), then this.
 const RECORD_MAGIC: u16 = 0x5252;
 /// Record header (length and magic) and CRC-32 trailer.
@@ -88,6 +94,9 @@ pub enum StoreError {
     Invalid,
     /// The flash refused a read, a write or an erase.
     Flash,
+    /// Damaged data (or a save cut short) was skipped: the newest intact record was loaded,
+    /// or the defaults if there is none.
+    Repaired,
 }
 
 impl StoreError {
@@ -98,6 +107,7 @@ impl StoreError {
             StoreError::OtherVersion => "Flash store from another version: defaults loaded",
             StoreError::Invalid => "Flash store holds invalid values: defaults loaded",
             StoreError::Flash => "Flash store failed",
+            StoreError::Repaired => "Flash store: damaged data skipped, the newest intact record loaded",
         }
     }
 }
@@ -111,6 +121,8 @@ struct Sector {
     last: Option<(usize, usize)>,
     /// Where the next record goes, if everything from there on is erased.
     append_at: Option<usize>,
+    /// Something that is neither a whole record nor erased flash was skipped.
+    skipped: bool,
 }
 
 /// The flash store over `F`, in a range of it, and the record it keeps.
@@ -180,14 +192,21 @@ impl<F: NorFlash> Store<F> {
     }
 
     fn load(&mut self) -> Result<(), StoreError> {
-        let mut foreign = false;
+        let (mut foreign, mut skipped) = (false, false);
         for s in 0..STORE_SECTORS {
             let (sector, empty) = self.scan(s).map_err(|_| StoreError::Flash)?;
             self.sectors[s] = sector;
-            foreign |= sector.seq.is_none() && !empty;
+            foreign |= sector.seq.is_none() && sector.last.is_none() && !empty;
+            skipped |= sector.skipped;
         }
         let Some(s) = self.newest() else {
-            return if foreign { Err(StoreError::Corrupt) } else { Ok(()) };
+            return if foreign {
+                Err(StoreError::Corrupt)
+            } else if skipped {
+                Err(StoreError::Repaired)
+            } else {
+                Ok(())
+            };
         };
         let (at, len) = self.sectors[s].last.unwrap_or_default();
         let from = self.sector_start(s) + at as u32 + 4;
@@ -197,53 +216,67 @@ impl<F: NorFlash> Store<F> {
             BadRecord::OtherLayout => StoreError::OtherVersion,
             BadRecord::Invalid => StoreError::Invalid,
         })?;
-        Ok(())
+        if skipped { Err(StoreError::Repaired) } else { Ok(()) }
     }
 
     fn sector_start(&self, s: usize) -> u32 {
         self.start + (s * F::ERASE_SIZE) as u32
     }
 
-    /// Reads sector `s`: its header, its last good record and where a record may go next; and
-    /// whether it holds nothing past a bad header (erased, or a header write cut short).
+    /// Reads sector `s`: its header, its last good record and where a record may go next, and
+    /// whether it holds nothing at all past a header that is not whole (erased, or a header
+    /// write cut short).
     fn scan(&mut self, s: usize) -> Result<(Sector, bool), F::Error> {
         let base = self.sector_start(s);
         let mut header = [0u8; SECTOR_HEADER_BYTES];
         self.flash.read(base, &mut header)?;
-        let mut sector = Sector::default();
-        let [magic, seq, crc] = [0, 4, 8].map(|at| le_u32(&header, at));
-        if magic != SECTOR_MAGIC || crc != crc32(&header[..8]) {
-            // Erased, or a header cut short (erased after it): nothing the store wrote is lost.
-            // Anything else is not the store's.
-            return Ok((sector, self.erased_from(base, SECTOR_HEADER_BYTES)?));
-        }
-        sector.seq = Some(seq);
-        let mut at = SECTOR_HEADER_BYTES;
-        // Records one after another up to the first that is not whole: a torn write, or the
-        // erased end of the log.
+        let mut sector =
+            Sector { seq: header.chunks_exact(SECTOR_HEADER_COPY_BYTES).find_map(header_seq), ..Sector::default() };
+        // Records one after another; anything else is skipped a word at a time, so that the
+        // records after it are still found, up to the erased end of the log.
+        let (mut at, mut end) = (SECTOR_HEADER_BYTES, SECTOR_HEADER_BYTES);
         while at + RECORD_OVERHEAD_BYTES <= F::ERASE_SIZE {
-            let mut head = [0u8; 4];
-            self.flash.read(base + at as u32, &mut head)?;
-            let len = usize::from(u16::from_le_bytes([head[0], head[1]]));
-            let size = (len + RECORD_OVERHEAD_BYTES).next_multiple_of(ALIGN_BYTES);
-            if u16::from_le_bytes([head[2], head[3]]) != RECORD_MAGIC
-                || size > STORE_BUFFER_BYTES
-                || at + size > F::ERASE_SIZE
-            {
+            if let Some((len, size)) = self.record_at(base, at)? {
+                sector.last = Some((at, len));
+                at += size;
+                end = at;
+            } else if self.erased_from(base, at)? {
                 break;
+            } else {
+                sector.skipped = true;
+                at += ALIGN_BYTES;
             }
-            let bytes = &mut self.buf[..size];
-            self.flash.read(base + at as u32, bytes)?;
-            if le_u32(bytes, size - 4) != crc32(&bytes[..size - 4]) {
-                break;
-            }
-            sector.last = Some((at, len));
-            at += size;
         }
-        if sector.seq.is_some() && self.erased_from(base, at)? {
-            sector.append_at = Some(at);
+        if sector.seq.is_none() && sector.last.is_none() {
+            // Erased, or a header cut short in its first copy (erased after it): nothing the
+            // store wrote is lost. Anything else is not the store's.
+            let empty = self.erased_from(base, SECTOR_HEADER_COPY_BYTES)?;
+            return Ok((Sector { skipped: false, ..sector }, empty));
+        }
+        // Records behind a header lost to damage.
+        sector.skipped |= sector.seq.is_none();
+        if sector.seq.is_some() && self.erased_from(base, end)? {
+            sector.append_at = Some(end);
         }
         Ok((sector, false))
+    }
+
+    /// The record at `at` in the sector at `base`, if one is whole there: its length and the
+    /// bytes it takes.
+    fn record_at(&mut self, base: u32, at: usize) -> Result<Option<(usize, usize)>, F::Error> {
+        let mut head = [0u8; 4];
+        self.flash.read(base + at as u32, &mut head)?;
+        let len = usize::from(u16::from_le_bytes([head[0], head[1]]));
+        let size = (len + RECORD_OVERHEAD_BYTES).next_multiple_of(ALIGN_BYTES);
+        if u16::from_le_bytes([head[2], head[3]]) != RECORD_MAGIC
+            || size > STORE_BUFFER_BYTES
+            || at + size > F::ERASE_SIZE
+        {
+            return Ok(None);
+        }
+        let bytes = &mut self.buf[..size];
+        self.flash.read(base + at as u32, bytes)?;
+        Ok((le_u32(bytes, size - 4) == crc32(&bytes[..size - 4])).then_some((len, size)))
     }
 
     /// Whether every byte of the sector at `base` from `at` on is erased.
@@ -275,9 +308,9 @@ impl<F: NorFlash> Store<F> {
         let (s, at) = match newest.filter(|&s| fits(&self.sectors[s])) {
             Some(s) => (s, self.sectors[s].append_at.unwrap_or_default()),
             None => {
-                // Never the sector holding the record kept.
+                // Never the sector holding the record kept; numbered after every other.
                 let s = newest.map_or(0, |n| (n + 1) % STORE_SECTORS);
-                let seq = newest.and_then(|n| self.sectors[n].seq).map_or(1, |q| q.wrapping_add(1));
+                let seq = self.sectors.iter().filter_map(|sector| sector.seq).max().map_or(1, |q| q.wrapping_add(1));
                 self.sectors[s] = Sector::default();
                 let base = self.sector_start(s);
                 self.flash.erase(base, base + F::ERASE_SIZE as u32)?;
@@ -285,7 +318,8 @@ impl<F: NorFlash> Store<F> {
                 header[..4].copy_from_slice(&SECTOR_MAGIC.to_le_bytes());
                 header[4..8].copy_from_slice(&seq.to_le_bytes());
                 let crc = crc32(&header[..8]);
-                header[8..].copy_from_slice(&crc.to_le_bytes());
+                header[8..12].copy_from_slice(&crc.to_le_bytes());
+                header.copy_within(..SECTOR_HEADER_COPY_BYTES, SECTOR_HEADER_COPY_BYTES);
                 self.flash.write(base, &header)?;
                 self.sectors[s].seq = Some(seq);
                 (s, SECTOR_HEADER_BYTES)
@@ -296,6 +330,12 @@ impl<F: NorFlash> Store<F> {
         self.sectors[s].append_at = Some(at + size);
         Ok(())
     }
+}
+
+/// The sequence number of a copy of a sector header, if the copy is whole.
+fn header_seq(copy: &[u8]) -> Option<u32> {
+    let [magic, seq, crc] = [0, 4, 8].map(|at| le_u32(copy, at));
+    (magic == SECTOR_MAGIC && crc == crc32(&copy[..8])).then_some(seq)
 }
 
 /// The little-endian word at `at` in `bytes`.

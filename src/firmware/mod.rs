@@ -75,7 +75,11 @@ fn start(spawner: Spawner) {
     // startup blocks the host link starts with.
     let (store, loaded) = open_store(STORE.uninit(), board.flash);
     let settings = store.kept().settings;
-    let why = if loaded.is_ok() { "kept in the flash store, or the defaults" } else { "the defaults" };
+    let why = match loaded {
+        Ok(()) => "kept in the flash store, or the defaults",
+        Err(StoreError::Repaired) => "the newest intact record in the flash store, or the defaults",
+        Err(_) => "the defaults",
+    };
     info!(
         "settings loaded ({=str}): {} x {} steps/mm, pulses up to {} Hz",
         why, settings.steps_per_mm[0], settings.steps_per_mm[1], settings.max_pulse_rate_hz
