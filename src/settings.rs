@@ -19,6 +19,9 @@ pub enum SettingError {
     Unknown,
     /// The value is outside the setting's range (or not a finite number).
     OutOfRange,
+    /// The change would leave the pen, inside the travel now, outside it (soft limits turned on,
+    /// or the travel made smaller): every move would then be refused, even back inside.
+    StrandsPen,
 }
 
 /// Identifies one setting: its `$` number, its unit and its range. Its name on the LCD is the
@@ -341,6 +344,24 @@ impl Settings {
         next.check()?;
         *self = next;
         Ok(())
+    }
+
+    /// [`set_all`](Self::set_all), refusing ([`SettingError::StrandsPen`]) a change after which
+    /// the pen at `pen` would lie outside the travel it lies inside now.
+    pub fn set_all_around(&mut self, changes: &[(u16, f32)], pen: crate::geom::Point) -> Result<(), SettingError> {
+        let mut next = *self;
+        next.set_all(changes)?;
+        if next.strands(pen) && !self.strands(pen) {
+            return Err(SettingError::StrandsPen);
+        }
+        *self = next;
+        Ok(())
+    }
+
+    /// Whether `pen` lies outside the travel ([`travel_steps`](Self::travel_steps)).
+    pub fn strands(&self, pen: crate::geom::Point) -> bool {
+        let [lx, ly] = self.travel_steps();
+        !(-lx..=lx).contains(&pen.x) || !(-ly..=ly).contains(&pen.y)
     }
 
     /// Settings from one value per setting, in [`SETTING_INFO`] order (as the flash store keeps

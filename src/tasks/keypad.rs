@@ -138,7 +138,8 @@ fn act(machine: &Machine, panel: &Panel, action: MenuAction, building: &mut Opti
 /// Changes settings as one: all of `changes`, or, if they would leave the settings disagreeing,
 /// none, and the menu says so. The serial task keeps them in flash.
 fn change_settings(machine: &Machine, panel: &Panel, changes: &[(u16, f32)]) {
-    if machine.update_settings(|s| s.set_all(changes)).is_err() {
+    let pen = machine.position();
+    if machine.update_settings(|s| s.set_all_around(changes, pen)).is_err() {
         refuse(panel, UiError::Clash);
     }
 }

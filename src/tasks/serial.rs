@@ -67,7 +67,7 @@ use crate::protocol::refresh::Refresh;
 use crate::protocol::report::{Reply, StatusFields};
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
 use crate::protocol::{Command, GcodeState, GrblError, Report};
-use crate::settings::Settings;
+use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
 use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
@@ -555,10 +555,15 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             }
             Command::ProgramEnd => Some(Reply::Message("Pgm End")),
             Command::SetSetting { id, value } => {
-                machine
-                    .update_settings(|s| s.set(id, value))
-                    .map_err(|_| Unfinished::Error(GrblError::InvalidStatement))?;
-                None
+                let pen = machine.position();
+                match machine.update_settings(|s| s.set_all_around(&[(id, value)], pen)) {
+                    Ok(()) => None,
+                    Err(SettingError::StrandsPen) => {
+                        link.send(Reply::Message("The pen would be outside the travel: setting refused")).await;
+                        return Err(Unfinished::Error(GrblError::TravelExceeded));
+                    }
+                    Err(_) => return Err(Unfinished::Error(GrblError::InvalidStatement)),
+                }
             }
             Command::RestoreSettings { startup_lines } => {
                 machine.update_settings(|s| *s = Settings::default());

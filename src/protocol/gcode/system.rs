@@ -90,6 +90,7 @@ impl GcodeState {
         next.set(id, value).map_err(|e| match e {
             SettingError::OutOfRange if value < 0.0 => GrblError::NegativeValue,
             SettingError::Unknown | SettingError::OutOfRange => GrblError::InvalidStatement,
+            SettingError::StrandsPen => GrblError::TravelExceeded,
         })?;
         self.rescale(&next);
         Ok(Command::SetSetting { id, value })
