@@ -1,5 +1,6 @@
 //! The speed a status report gives (`FS:`) is the pen's speed along its path: at cruise, the
-//! programmed feed times the override, whatever the line's direction, the curve or the method.
+//! programmed feed times the override, whatever the line's direction, the curve (circle, arc,
+//! ellipse, sine, function) or the method.
 
 use servoplot::sim::{self, SimConfig, serial::SimSerial};
 
@@ -34,6 +35,8 @@ fn the_speed_read_at_cruise_is_the_feed_on_every_direction_curve_and_method() {
             ("G1 F1200\n$O R40", 1200.0),
             ("G1 F1500\n$E A60 B30", 1500.0),
             ("G1 F1200\n$S A5 W0.1 L150", 1200.0),
+            ("G1 F1200\n$O R40 S30 W250", 1200.0),
+            ("G1 F1200\n$F X-60 U60 Y=10*sin(x/10)", 1200.0),
         ] {
             let program = format!("{method}\n{drawing}\n");
             let got = readings(&program, &at);
