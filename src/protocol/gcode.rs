@@ -191,6 +191,12 @@ impl Default for Pending {
 }
 
 impl Pending {
+    /// Whether the line changes what a power cycle keeps of the parser (a work offset, G28 or
+    /// G30), compared with the parser `now`.
+    pub fn changes_kept(&self, now: &GcodeState) -> bool {
+        self.next.offsets().kept_mm() != now.offsets().kept_mm()
+    }
+
     /// No line.
     pub fn new() -> Pending {
         Pending { next: GcodeState::new(), commands: Commands::default(), curve: None, check: false }

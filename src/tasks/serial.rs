@@ -472,44 +472,54 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     /// Parses one line of `link` and carries it out.
     async fn line(&mut self, link: &Link, line: &str) -> Result<(), Unfinished> {
         let machine = self.host.machine;
-        if machine.plan_epoch() != self.epoch {
-            // An abort (keypad, jog cancel, a curve stopped part way, a reset on another link)
-            // dropped what was planned: plan on from where the pen stops.
-            self.host.machine_stopped().for_line(link).await?;
-            self.epoch = machine.plan_epoch();
-            self.gcode.sync_position(machine.position(), &machine.settings());
-        }
-        let settings = machine.settings();
-        let state = machine.state();
-        if state == RunState::Idle && machine.is_idle() {
-            // The keypad, an abort or a curve that stopped early may have moved the pen
-            // elsewhere than the parser planned. (In check mode the parser plans on from the
-            // lines it checked.)
-            self.gcode.sync_position(machine.position(), &settings);
-        }
-        let mut pending = Pending::new();
-        self.gcode.parse(line, &settings, state, &mut pending).map_err(Unfinished::Error)?;
-        // The line's curve, a slice at a time; the other tasks and the links' receivers run
-        // between slices. A reset on the link drops the line unanswered, the parser unchanged.
         loop {
-            let slice = pending.advance(BUILD_SLICE_STEPS);
-            if slice.steps > 0 {
-                self.between.after(&slice).await;
+            if machine.plan_epoch() != self.epoch {
+                // An abort (keypad, jog cancel, a curve stopped part way, a reset on another
+                // link) dropped what was planned: plan on from where the pen stops.
+                self.host.machine_stopped().for_line(link).await?;
+                self.epoch = machine.plan_epoch();
+                self.gcode.sync_position(machine.position(), &machine.settings());
             }
-            if link.resetting() {
-                return Err(Unfinished::Reset);
+            let settings = machine.settings();
+            let state = machine.state();
+            if state == RunState::Idle && machine.is_idle() {
+                // The keypad, an abort or a curve that stopped early may have moved the pen
+                // elsewhere than the parser planned. (In check mode the parser plans on from the
+                // lines it checked.)
+                self.gcode.sync_position(machine.position(), &settings);
             }
-            if slice.done {
-                break;
+            let mut pending = Pending::new();
+            self.gcode.parse(line, &settings, state, &mut pending).map_err(Unfinished::Error)?;
+            // The line's curve, a slice at a time; the other tasks and the links' receivers run
+            // between slices. A reset on the link drops the line unanswered, the parser
+            // unchanged.
+            loop {
+                let slice = pending.advance(BUILD_SLICE_STEPS);
+                if slice.steps > 0 {
+                    self.between.after(&slice).await;
+                }
+                if link.resetting() {
+                    return Err(Unfinished::Reset);
+                }
+                if slice.done {
+                    break;
+                }
             }
+            if pending.changes_kept(&self.gcode) && !machine.stopped() {
+                // A line that changes what a power cycle keeps (G10, G28.1, G30.1) runs with the
+                // machine stopped, from where the pen stands: a reset meanwhile drops it unrun,
+                // and it is parsed again once the motion before it has ended.
+                self.host.machine_stopped().for_line(link).await?;
+                continue;
+            }
+            let commands = self.gcode.commit(&mut pending, &settings).map_err(Unfinished::Error)?;
+            // A refused line changed no offset.
+            machine.set_work_offset_mm(self.gcode.work_offset_mm());
+            for command in commands {
+                self.carry_out(link, &settings, command).await?;
+            }
+            return Ok(());
         }
-        let commands = self.gcode.commit(&mut pending, &settings).map_err(Unfinished::Error)?;
-        // A refused line changed no offset.
-        machine.set_work_offset_mm(self.gcode.work_offset_mm());
-        for command in commands {
-            self.carry_out(link, &settings, command).await?;
-        }
-        Ok(())
     }
 
     /// Carries out one command of a line of `link`: waits for what it waits for (the machine at
@@ -535,7 +545,11 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Command::Pause | Command::ProgramEnd => Some(host.machine_at_rest()),
             // A setting applies to the motion after it, never under a move: the planner takes
             // new limits at rest (see `Planner::set_limits`), so the lines before it end first.
-            Command::SetSetting { .. } | Command::RestoreSettings { .. } => Some(host.machine_at_rest()),
+            // What a power cycle keeps changes only at rest: a reset meanwhile drops the line.
+            Command::SetSetting { .. }
+            | Command::RestoreSettings { .. }
+            | Command::StoreStartupLine { .. }
+            | Command::StoreBuildInfo(_) => Some(host.machine_at_rest()),
             Command::Home => Some(host.machine_stopped()),
             // The motion task drops what a trip cut short before the pulses may go on.
             Command::Unlock if machine.halted() => Some(host.machine_stopped()),
