@@ -47,3 +47,26 @@ fn a_startup_block_or_a_setting_waiting_for_the_motion_is_dropped_by_a_reset() {
         assert!(report.flash.operations_at_us().is_empty(), "{line}: nothing saved");
     }
 }
+
+#[test]
+fn at_any_instant_a_line_is_answered_and_kept_or_dropped_unrun() {
+    // The move takes about 3 s: resets before, during and after it.
+    let (mut kept_lines, mut dropped_lines) = (0, 0);
+    for reset_ms in (100..4_000).step_by(300) {
+        for (line, kept) in [
+            ("G10 L20 P1 X7 Y7", "[G54:43.000,-7.000,0.000]"),
+            ("G28.1", "[G28:50.000,0.000,0.000]"),
+            ("$110=4000", "$110=4000.000"),
+            ("$N0=G20", "$N0=G20"),
+        ] {
+            let report = run(&format!("G1 X50 F1000\n{line}\n"), reset_ms * 1000, "$#\n$$\n$N\n");
+            let got = lines(&report);
+            let answered = got[2] == "ok";
+            assert_eq!(got.contains(&kept.to_string()), answered, "{line}, reset at {reset_ms} ms: {got:?}");
+            assert_eq!(!report.flash.operations_at_us().is_empty(), answered, "{line}, reset at {reset_ms} ms: saved");
+            (kept_lines, dropped_lines) =
+                if answered { (kept_lines + 1, dropped_lines) } else { (kept_lines, dropped_lines + 1) };
+        }
+    }
+    assert!(kept_lines >= 4 && dropped_lines >= 20, "{kept_lines} kept, {dropped_lines} dropped");
+}
