@@ -10,7 +10,7 @@
 use cortex_m_semihosting::hprintln;
 use servoplot::drawing::{BUILD_SLICE_STEPS, Builder, EllipseParams, Request, SineParams};
 use servoplot::geom::Point;
-use servoplot::interp::{Method, Shape, ShapeKind};
+use servoplot::interp::{Method, Shape};
 use servoplot::job::Job;
 use servoplot::settings::Settings;
 
@@ -97,17 +97,6 @@ fn advance(b: &mut Builder) -> servoplot::drawing::Slice {
     b.advance(BUILD_SLICE_STEPS)
 }
 
-/// The name of a kind in the simulator's model (`cost/f407.txt`).
-fn kind_name(kind: ShapeKind) -> &'static str {
-    match kind {
-        ShapeKind::Straight => "line",
-        ShapeKind::Arc => "arc",
-        ShapeKind::Ellipse => "ellipse",
-        ShapeKind::Sine => "sine",
-        ShapeKind::Function => "function",
-    }
-}
-
 /// Every case whose name contains `only`, with both methods.
 pub fn runs(only: &str) {
     for (name, request) in cases() {
@@ -117,7 +106,7 @@ pub fn runs(only: &str) {
         for method in [Method::Classic, Method::Diagonal] {
             let settings = Settings { method, ..Settings::default() };
             let b = builder(&request, &settings);
-            let kind = kind_name(b.kind());
+            let kind = b.kind().name();
             let (x_steps, ops) = walk(name, method, b);
             hprintln!("walked {} {} {} {} {}", name, method_name(method), kind, x_steps, ops);
         }

@@ -64,6 +64,17 @@ pub enum ShapeKind {
 impl ShapeKind {
     pub const ALL: [ShapeKind; 5] =
         [ShapeKind::Straight, ShapeKind::Arc, ShapeKind::Ellipse, ShapeKind::Sine, ShapeKind::Function];
+
+    /// Its name in the cost model's tables (`cost/f407.txt`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            ShapeKind::Straight => "line",
+            ShapeKind::Arc => "arc",
+            ShapeKind::Ellipse => "ellipse",
+            ShapeKind::Sine => "sine",
+            ShapeKind::Function => "function",
+        }
+    }
 }
 
 impl Shape {

@@ -118,7 +118,7 @@ impl CpuModel {
         };
         for (m, (method, _)) in METHODS.iter().enumerate() {
             for (k, kind) in ShapeKind::ALL.iter().enumerate() {
-                let name = kind_name(*kind);
+                let name = kind.name();
                 model.step_instructions[k][m] = get(&std::format!("{name} {method}"))?;
                 model.step_cycles_per_instruction[k][m] = get(&std::format!("{name} {method} cycles_per_instruction"))?;
                 if *kind != ShapeKind::Straight {
@@ -171,19 +171,8 @@ impl CpuModel {
     }
 }
 
-/// The name of `kind` in a model's table.
-pub fn kind_name(kind: ShapeKind) -> &'static str {
-    match kind {
-        ShapeKind::Straight => "line",
-        ShapeKind::Arc => "arc",
-        ShapeKind::Ellipse => "ellipse",
-        ShapeKind::Sine => "sine",
-        ShapeKind::Function => "function",
-    }
-}
-
 fn kind_of(name: &str) -> Option<ShapeKind> {
-    ShapeKind::ALL.into_iter().find(|k| kind_name(*k) == name)
+    ShapeKind::ALL.into_iter().find(|k| k.name() == name)
 }
 
 fn method_of(name: &str) -> Option<Method> {
