@@ -561,6 +561,16 @@ impl Machine {
         }
     }
 
+    /// The state a host line is judged in: [`state`](Self::state), but [`RunState::Run`] as
+    /// soon as anything is queued, not only once it moves, as GRBL's cycle starts with its first
+    /// block: a jog sent right behind a move is refused, a setting waits for the move to end.
+    pub fn line_state(&self) -> RunState {
+        match self.state() {
+            RunState::Idle if !self.stopped() => RunState::Run,
+            state => state,
+        }
+    }
+
     /// `$SLP` at rest: the servos go off (the board drops SON, see [`servos_on`](Self::servos_on))
     /// until [`wake`](Self::wake). Only the serial task calls this.
     pub fn sleep(&self) {

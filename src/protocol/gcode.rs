@@ -76,9 +76,10 @@
 //! travel and the lattice, from the position the lines before it plan, and nothing moves; `$C`
 //! again leaves it with a soft reset, as GRBL does), `$N` / `$Nn=line` startup blocks (two, run
 //! after every reset; a block is checked when stored and refused, error 3, if it would move,
-//! dwell or stop: no one expects the pen to move at a reset), `$SLP` (at rest or in an alarm,
-//! error 8 otherwise: the servos go off and every line is refused, error 9, until a reset, after
-//! which the machine is in alarm, as in GRBL).
+//! dwell or stop: no one expects the pen to move at a reset), `$SLP` (at rest, in an alarm,
+//! or behind a running program, whose motion it waits for; error 8 held, jogging or homing: the
+//! servos go off and every line is refused, error 9, until a reset, after which the machine is in
+//! alarm, as in GRBL).
 //!
 //! # Plotter curve commands
 //!

@@ -28,7 +28,7 @@
 //! | 3  | `InvalidStatement`        | unknown `$` command, unknown setting number, bad setting value |
 //! | 4  | `NegativeValue`           | negative F, N, P, S, T, or negative size in a curve command |
 //! | 5  | `SettingDisabled`         | `$H`: the plotter has no homing switches |
-//! | 8  | `NotIdle`                 | `$N=`/`$RST=` while moving; `$J=` while drawing, held or in alarm |
+//! | 8  | `NotIdle`                 | `$J=` while a program runs (a move queued or drawing), held or in alarm; a setting, `$Nn=`, `$I=`, `$SLP` while held, jogging or homing (behind a running program they wait for it); `$RST=` and `$C` unless at rest |
 //! | 9  | `Locked`                  | G-code or a curve command while in alarm (unlock with `$X`) or jogging; any line while asleep (`$SLP`, until a reset); a move still waiting for room in the job queue when an abort (keypad D, jog cancel, a curve stopped part way, a reset on the other host link) dropped what was planned |
 //! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`]; a line dropped for want of room in the receive buffer |
 //! | 14 | `LineLengthExceeded`      | a `$Nn=` startup block longer than [`startup::STARTUP_LINE_MAX_BYTES`] |

@@ -385,7 +385,7 @@ pub fn build_info(out: &mut impl Write, info: &str, planner_blocks: usize, rx_bu
 
 /// `$`: the commands the plotter understands.
 pub fn help(out: &mut impl Write) -> fmt::Result {
-    out.write_str("[HLP:$$ $# $G $I $N $x=val $Nx=line $J=line $RST=$ $C $X $E $O $S $F ~ ! ? ctrl-x]\r\n")
+    out.write_str("[HLP:$$ $# $G $I $N $x=val $Nx=line $J=line $RST=$ $SLP $C $X $H $E $O $S $F ~ ! ? ctrl-x]\r\n")
 }
 
 /// `$N`: every startup block, `$Nn=line` per line, empty ones included.
@@ -536,6 +536,10 @@ mod tests {
         assert_eq!(text(|o| message(o, "Pgm End")), "[MSG:Pgm End]\r\n");
         assert_eq!(text(|o| build_info(o, "", 16, 128)), "[VER:1.1h.servoplot:]\r\n[OPT:,16,128]\r\n");
         assert!(text(help).starts_with("[HLP:$$ $# $G $I"));
+        // Every `$` command a user can send is listed, sleep and homing too.
+        for command in ["$SLP", "$H", "$C", "$X", "$J=line", "$RST=$", "$F"] {
+            assert!(text(help).contains(&std::format!(" {command} ")), "{command} missing from the help");
+        }
     }
 
     #[test]

@@ -169,9 +169,9 @@ impl Host<'_> {
         }
     }
 
-    /// Waits until nothing is queued or moving.
+    /// Waits until nothing is queued or moving: idle, or stopped in an alarm.
     fn machine_at_rest(&self) -> Until<'_> {
-        Until { machine: self.machine, line_of: None, done: Machine::is_idle, then_pen: None, then_ms: 0, timer: None }
+        Until { machine: self.machine, line_of: None, done: Machine::at_rest, then_pen: None, then_ms: 0, timer: None }
     }
 
     /// Once nothing is queued or moving, sends the pen to `pen` and waits for it to settle.
@@ -481,8 +481,8 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                 self.gcode.sync_position(machine.position(), &machine.settings());
             }
             let settings = machine.settings();
-            let state = machine.state();
-            if state == RunState::Idle && machine.is_idle() {
+            let state = machine.line_state();
+            if state == RunState::Idle {
                 // The keypad, an abort or a curve that stopped early may have moved the pen
                 // elsewhere than the parser planned. (In check mode the parser plans on from the
                 // lines it checked.)
@@ -549,7 +549,8 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Command::SetSetting { .. }
             | Command::RestoreSettings { .. }
             | Command::StoreStartupLine { .. }
-            | Command::StoreBuildInfo(_) => Some(host.machine_at_rest()),
+            | Command::StoreBuildInfo(_)
+            | Command::Sleep => Some(host.machine_at_rest()),
             Command::Home => Some(host.machine_stopped()),
             // The motion task drops what a trip cut short before the pulses may go on.
             Command::Unlock if machine.halted() => Some(host.machine_stopped()),

@@ -11,6 +11,14 @@ use crate::protocol::startup::{STARTUP_LINES, ascii_line};
 use crate::settings::{SettingError, Settings};
 use crate::status::RunState;
 
+/// Whether a command that acts at rest is taken in `state`: at rest, or while a program runs
+/// (the host link then holds it until the program's motion has ended, so it never changes
+/// anything under a move); refused (`error:8`) while held, jogging or homing, whose end is the
+/// user's, not the program's.
+fn waits_for_rest(state: RunState) -> bool {
+    matches!(state, RunState::Idle | RunState::Run)
+}
+
 impl GcodeState {
     /// A line starting with `$`, its command into `out`; `rest` follows the `$` and is a suffix
     /// of `line`.
@@ -30,7 +38,7 @@ impl GcodeState {
             b"#" => Command::Report(Report::Parameters),
             b"I" => Command::Report(Report::BuildInfo),
             [b'I', b'=', body @ ..] => {
-                if state != RunState::Idle {
+                if !waits_for_rest(state) {
                     return Err(GrblError::NotIdle);
                 }
                 // Compacted text is ASCII: only its length can refuse it.
@@ -45,7 +53,7 @@ impl GcodeState {
             b"H" if !settings.homing => return Err(GrblError::SettingDisabled),
             b"H" if matches!(state, RunState::Idle | RunState::Alarm) => Command::Home,
             b"H" => return Err(GrblError::NotIdle),
-            b"SLP" if matches!(state, RunState::Idle | RunState::Alarm) => Command::Sleep,
+            b"SLP" if waits_for_rest(state) || state == RunState::Alarm => Command::Sleep,
             b"SLP" => return Err(GrblError::NotIdle),
             b"N" => Command::Report(Report::StartupLines),
             [b'N', index @ b'0'..=b'9', b'=', body @ ..] => self.startup_line(*index - b'0', body, settings, state)?,
@@ -75,7 +83,7 @@ impl GcodeState {
 
     /// `$id=value`.
     fn set_setting(&mut self, c: &[u8], settings: &Settings, state: RunState) -> Result<Command, GrblError> {
-        if !matches!(state, RunState::Idle | RunState::Alarm) {
+        if !(waits_for_rest(state) || state == RunState::Alarm) {
             return Err(GrblError::NotIdle);
         }
         let eq = c.iter().position(|&b| b == b'=').ok_or(GrblError::InvalidStatement)?;
@@ -100,7 +108,7 @@ impl GcodeState {
     /// and moves nothing: a startup block runs after every reset, when no one may expect the pen
     /// to move. An empty line clears the block.
     fn startup_line(&self, index: u8, body: &[u8], settings: &Settings, state: RunState) -> Result<Command, GrblError> {
-        if state != RunState::Idle {
+        if !waits_for_rest(state) {
             return Err(GrblError::NotIdle);
         }
         if usize::from(index) >= STARTUP_LINES {
@@ -124,6 +132,7 @@ impl GcodeState {
         if !matches!(what, b'$' | b'#' | b'*') {
             return Err(GrblError::InvalidStatement);
         }
+        // Coordinate data is cleared as the line is parsed: never behind a running program.
         if !matches!(state, RunState::Idle | RunState::Alarm) {
             return Err(GrblError::NotIdle);
         }

@@ -381,7 +381,10 @@ fn alarm_jog_and_homing_lock_out_gcode_but_not_system_commands() {
     refused_in(&mut g, "$F X0 U1 Y=x", RunState::Alarm, 9);
     refused_in(&mut g, "$J=G91 X1 F100", RunState::Alarm, 8);
     refused_in(&mut g, "$J=G91 X1 F100", RunState::Run, 8);
-    refused_in(&mut g, "$100=80", RunState::Run, 8);
+    // A setting behind a running program waits for it (the host link holds it until rest).
+    assert_eq!(run_in(&mut g, "$100=80", RunState::Run), Ok(std::vec![Command::SetSetting { id: 100, value: 80.0 }]));
+    refused_in(&mut g, "$100=80", RunState::Hold, 8);
+    refused_in(&mut g, "$100=80", RunState::Jog, 8);
     refused_in(&mut g, "$RST=$", RunState::Hold, 8);
     assert_eq!(run_in(&mut g, "$X", RunState::Alarm), Ok(std::vec![Command::Unlock]));
     assert_eq!(run_in(&mut g, "$$", RunState::Alarm), Ok(std::vec![Command::Report(Report::Settings)]));
@@ -411,7 +414,10 @@ fn system_commands() {
     assert_eq!(run_in(&mut g, "$C", RunState::Check), Ok(std::vec![Command::CheckMode { on: false }]));
     refused_in(&mut g, "$C", RunState::Run, 8);
     assert_eq!(run(&mut g, "$SLP"), Ok(std::vec![Command::Sleep]));
-    refused_in(&mut g, "$SLP", RunState::Run, 8);
+    // Behind a running program, the sleep waits for it; held or jogging, it is refused.
+    assert_eq!(run_in(&mut g, "$SLP", RunState::Run), Ok(std::vec![Command::Sleep]));
+    refused_in(&mut g, "$SLP", RunState::Hold, 8);
+    refused_in(&mut g, "$SLP", RunState::Jog, 8);
     refused(&mut g, "$N2=G20", 3);
     refused(&mut g, "$Q", 3);
     refused(&mut g, "$GX", 3);
