@@ -46,7 +46,7 @@ mod pulse_news;
 mod settings;
 
 use core::cell::Cell;
-use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
 use core::task::Waker;
 
 use embassy_sync::blocking_mutex::Mutex;
@@ -58,7 +58,7 @@ use crate::inputs::{InputLevels, Trip};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
 use crate::overrides::{OverrideCommand, Overrides};
-use crate::pen::{Pen, PenOrder};
+use crate::pen::{Pen, PenDepth, PenOrder};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
@@ -207,6 +207,8 @@ pub struct Machine {
     /// The last order the pen servo has had its settle time for (written only by the servo
     /// task): the pen has settled while it equals `pen`.
     pen_settled: AtomicU32,
+    /// How deep the pen goes down, per mille ([`PenDepth`]): the last `M3 S…`'s.
+    pen_depth: AtomicU16,
     /// Pulses emitted at machine zero (written only by the homing task, at rest).
     origin: [AtomicI32; 2],
     /// The pulses stopped without braking, or the axes were free (`$SLP`): the position may be
@@ -257,6 +259,7 @@ impl Machine {
             servos_ready: AtomicBool::new(false),
             pen: AtomicU32::new(0),
             pen_settled: AtomicU32::new(u32::MAX),
+            pen_depth: AtomicU16::new(PenDepth::FULL.permille()),
             homing_requested: Signal::new(),
             switch_found: Mutex::new(Cell::new(None)),
             origin: [AtomicI32::new(0), AtomicI32::new(0)],
@@ -612,11 +615,21 @@ impl Machine {
     /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
     /// wait for [`pen_settled`](Self::pen_settled) before anything moves.
     pub fn set_pen(&self, pen: Pen) {
+        let depth = PenDepth::from_permille(self.pen_depth.load(Ordering::Relaxed));
         let sent = self.pen.fetch_update(Ordering::AcqRel, Ordering::Acquire, |bits| {
-            PenOrder::from_bits(bits).then(pen).map(PenOrder::bits)
+            PenOrder::from_bits(bits).then(pen, depth).map(PenOrder::bits)
         });
         if sent.is_ok() {
             self.changed.signal(());
+        }
+    }
+
+    /// How deep the pen goes down from now on (`M3 S…`); a pen down now goes there. The host
+    /// link calls this only at rest, as [`set_pen`](Self::set_pen).
+    pub fn set_pen_depth(&self, depth: PenDepth) {
+        self.pen_depth.store(depth.permille(), Ordering::Relaxed);
+        if self.pen() == Pen::Down {
+            self.set_pen(Pen::Down);
         }
     }
 

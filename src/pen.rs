@@ -6,7 +6,12 @@
 //! `$213` says how the pen is lifted ([`PenLift`]): not at all (no pen servo: the pen is
 //! always down, as on a plotter with a fixed pen), by `M3`/`M4` (down) and `M5` (up), or by
 //! itself as well: up for rapid moves (`G0`), down for every drawing move (`G1`–`G3` and the
-//! curve commands).
+//! curve commands). GRBL's laser mode (`$32`) does the same under `M3`/`M4`: up for rapids,
+//! down for drawing moves.
+//!
+//! How far down the pen goes is a [`PenDepth`]: `M3 S…` sets it from the S word, between `$31`
+//! (the pen-up pulse, `$210`) and `$30` (the pen-down pulse, `$211`), as the pen-plotter G-code
+//! of SVG-to-G-code tools expects; an `M3` before any S word puts the pen fully down.
 
 use crate::settings::Settings;
 
@@ -21,10 +26,46 @@ pub enum Pen {
     Down,
 }
 
-/// One order to the pen: where, and which order it is (bit 0 set for down, above it a count of
-/// the orders). An order the servo task settled is told apart from a later one to the same
-/// place, so a pen sent away and back while the servo task looked elsewhere never counts as
-/// settled early.
+/// How far down the pen goes when it is down, per mille of the way from the pen-up pulse
+/// (`$210`) to the pen-down pulse (`$211`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct PenDepth(u16);
+
+impl PenDepth {
+    /// All the way down: the pulse of `$211`.
+    pub const FULL: PenDepth = PenDepth(PEN_DEPTH_FULL_PERMILLE);
+
+    /// The depth the S word `spindle_speed` of `M3 S…` sets: none at or below `$31`, full at or
+    /// above `$30`, in proportion between; an `M3` with no S word yet (`None`) is full.
+    pub fn of_spindle_speed(settings: &Settings, spindle_speed: Option<f32>) -> PenDepth {
+        let Some(s) = spindle_speed else { return PenDepth::FULL };
+        let (min, max) = (settings.spindle_min, settings.spindle_max);
+        let share = ((s - min) / (max - min)).clamp(0.0, 1.0);
+        PenDepth(crate::math::round(share * f32::from(PEN_DEPTH_FULL_PERMILLE)) as u16)
+    }
+
+    pub const fn permille(self) -> u16 {
+        self.0
+    }
+
+    /// The depth kept as [`permille`](Self::permille), at most [`PenDepth::FULL`].
+    pub fn from_permille(permille: u16) -> PenDepth {
+        PenDepth(permille.min(PEN_DEPTH_FULL_PERMILLE))
+    }
+}
+
+/// [`PenDepth::FULL`], per mille.
+const PEN_DEPTH_FULL_PERMILLE: u16 = 1_000;
+
+/// The bits of a [`PenOrder`] below its count: bit 0 down, then the depth.
+const PEN_ORDER_DEPTH_SHIFT: u32 = 1;
+const PEN_ORDER_COUNT_SHIFT: u32 = 11;
+
+/// One order to the pen: where, how deep, and which order it is (bit 0 set for down, bits 1-10
+/// the depth per mille, above them a count of the orders). An order the servo task settled is
+/// told apart from a later one to the same place, so a pen sent away and back while the servo
+/// task looked elsewhere never counts as settled early.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PenOrder(u32);
 
@@ -43,10 +84,23 @@ impl PenOrder {
         if self.0 & 1 != 0 { Pen::Down } else { Pen::Up }
     }
 
-    /// The order that sends the pen to `pen`; `None` when it is sent there already.
-    pub fn then(self, pen: Pen) -> Option<PenOrder> {
-        let down = u32::from(pen == Pen::Down);
-        (self.0 & 1 != down).then(|| PenOrder(((self.0 >> 1).wrapping_add(1) << 1) | down))
+    /// How deep the pen goes when it is down.
+    pub fn depth(self) -> PenDepth {
+        PenDepth(
+            ((self.0 >> PEN_ORDER_DEPTH_SHIFT) & ((1 << (PEN_ORDER_COUNT_SHIFT - PEN_ORDER_DEPTH_SHIFT)) - 1)) as u16,
+        )
+    }
+
+    /// The order that sends the pen to `pen`, `depth` deep when down; `None` when it is there
+    /// already (up, or down as deep).
+    pub fn then(self, pen: Pen, depth: PenDepth) -> Option<PenOrder> {
+        let down = pen == Pen::Down;
+        let same = self.pen() == pen && (!down || self.depth() == depth);
+        let count = (self.0 >> PEN_ORDER_COUNT_SHIFT).wrapping_add(1);
+        let depth = if down { depth } else { self.depth() };
+        (!same).then(|| {
+            PenOrder((count << PEN_ORDER_COUNT_SHIFT) | (u32::from(depth.0) << PEN_ORDER_DEPTH_SHIFT) | u32::from(down))
+        })
     }
 }
 
@@ -65,7 +119,7 @@ impl PenServo {
         if PenLift::of(settings) == PenLift::None {
             return (None, true);
         }
-        let pulse = pulse_us(settings, order.pen());
+        let pulse = pulse_us(settings, order);
         let mut send = None;
         if self.sent.is_none_or(|(o, p, _)| (o, p) != (order, pulse)) {
             self.sent = Some((order, pulse, now_ms));
@@ -103,11 +157,16 @@ impl PenLift {
     }
 }
 
-/// The servo pulse that holds `pen`, µs.
-pub fn pulse_us(settings: &Settings, pen: Pen) -> u32 {
-    match pen {
+/// The servo pulse that holds the pen where `order` sends it, µs: down, the depth's share of
+/// the way from `$210` to `$211`.
+pub fn pulse_us(settings: &Settings, order: PenOrder) -> u32 {
+    let (up, down) = (settings.pen_up_us as i32, settings.pen_down_us as i32);
+    match order.pen() {
         Pen::Up => settings.pen_up_us,
-        Pen::Down => settings.pen_down_us,
+        Pen::Down => {
+            let depth = i32::from(order.depth().0);
+            (up + (down - up) * depth / i32::from(PEN_DEPTH_FULL_PERMILLE)) as u32
+        }
     }
 }
 
@@ -118,6 +177,8 @@ pub fn for_move(settings: &Settings, rapid: bool, spindle_on: bool) -> Option<Pe
         PenLift::None => None,
         PenLift::Auto if rapid => Some(Pen::Up),
         PenLift::Auto => Some(Pen::Down),
+        // Laser mode: the laser is off in rapids.
+        PenLift::Spindle if settings.laser_mode && rapid => Some(Pen::Up),
         PenLift::Spindle => Some(if spindle_on { Pen::Down } else { Pen::Up }),
     }
 }
@@ -134,16 +195,58 @@ mod tests {
         assert_eq!(for_move(&mode(1), false, false), Some(Pen::Up), "M5: up, drawing or not");
         assert_eq!(for_move(&mode(2), true, true), Some(Pen::Up), "auto: rapids travel up");
         assert_eq!(for_move(&mode(2), false, false), Some(Pen::Down), "auto: drawing moves draw");
+        let laser = Settings { pen_lift: 1, laser_mode: true, ..Settings::default() };
+        assert_eq!(for_move(&laser, true, true), Some(Pen::Up), "laser mode: M3 rapids travel up");
+        assert_eq!(for_move(&laser, false, true), Some(Pen::Down), "laser mode: M3 drawing moves draw");
+        assert_eq!(for_move(&laser, false, false), Some(Pen::Up), "laser mode: M5 keeps the pen up");
         let s = Settings::default();
-        assert_eq!((pulse_us(&s, Pen::Up), pulse_us(&s, Pen::Down)), (1_000, 2_000));
+        let up = PenOrder::from_bits(0);
+        let down = up.then(Pen::Down, PenDepth::FULL).unwrap();
+        assert_eq!((pulse_us(&s, up), pulse_us(&s, down)), (1_000, 2_000));
+    }
+
+    #[test]
+    fn the_s_word_sets_the_pulse_between_the_up_and_down_pulses() {
+        // $31 = 0 holds the pen up, $30 = 1000 puts it fully down (the defaults).
+        let s = Settings::default();
+        let pulse = |speed| {
+            pulse_us(&s, PenOrder::from_bits(0).then(Pen::Down, PenDepth::of_spindle_speed(&s, speed)).unwrap())
+        };
+        assert_eq!(pulse(None), 2_000, "M3 with no S word yet: fully down");
+        assert_eq!(pulse(Some(1_000.0)), 2_000);
+        assert_eq!(pulse(Some(5_000.0)), 2_000, "beyond $30: fully down");
+        assert_eq!(pulse(Some(500.0)), 1_500);
+        assert_eq!(pulse(Some(0.0)), 1_000, "at $31: the pen-up pulse");
+        // An inverted servo ($210 above $211) and a servo-angle S range ($31=20, $30=90).
+        let angles = Settings { pen_up_us: 2_000, pen_down_us: 1_000, spindle_min: 20.0, spindle_max: 90.0, ..s };
+        let at = |speed| {
+            pulse_us(
+                &angles,
+                PenOrder::from_bits(0).then(Pen::Down, PenDepth::of_spindle_speed(&angles, Some(speed))).unwrap(),
+            )
+        };
+        assert_eq!((at(20.0), at(55.0), at(90.0), at(10.0)), (2_000, 1_500, 1_000, 2_000));
+    }
+
+    #[test]
+    fn a_new_depth_is_a_new_order_only_when_down() {
+        let up = PenOrder::from_bits(0);
+        let half = PenDepth::of_spindle_speed(&Settings::default(), Some(500.0));
+        assert_eq!(up.then(Pen::Up, half), None, "up already, whatever the depth");
+        let down = up.then(Pen::Down, PenDepth::FULL).unwrap();
+        assert_eq!(down.then(Pen::Down, PenDepth::FULL), None);
+        let shallower = down.then(Pen::Down, half).unwrap();
+        assert_eq!((shallower.pen(), shallower.depth()), (Pen::Down, half));
+        let raised = shallower.then(Pen::Up, PenDepth::FULL).unwrap();
+        assert_eq!((raised.pen(), raised.depth()), (Pen::Up, half), "raising keeps the depth bits");
     }
 
     #[test]
     fn an_order_counts_and_the_servo_settles_for_the_last_one() {
         let first = PenOrder::from_bits(0);
-        assert_eq!(first.then(Pen::Up), None, "up already");
-        let down = first.then(Pen::Down).unwrap();
-        let up_again = down.then(Pen::Up).unwrap();
+        assert_eq!(first.then(Pen::Up, PenDepth::FULL), None, "up already");
+        let down = first.then(Pen::Down, PenDepth::FULL).unwrap();
+        let up_again = down.then(Pen::Up, PenDepth::FULL).unwrap();
         assert_ne!(up_again, first, "sent away and back: another order");
         let s = Settings { pen_lift: 1, pen_settle_ms: 200, ..Settings::default() };
         let mut servo = PenServo::default();

@@ -59,6 +59,9 @@ pub const PEN_PULSE_MAX_US: u32 = 2_500;
 /// Longest wait for the pen to settle (`$212`).
 pub const PEN_SETTLE_MAX_MS: u32 = 2_000;
 
+/// Highest S word `$30` and `$31` take (GRBL's spindle speeds are floats; a pen needs no more).
+pub const SPINDLE_SPEED_MAX: f32 = 100_000.0;
+
 /// The language of the LCD (`$216`), which the menu also switches.
 pub const LANGUAGE_SETTING: u16 = 216;
 
@@ -82,13 +85,23 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, unit: Unit::Us, min: 2.5, max: 100.0 },
     // 255 always on
     SettingInfo { id: 1, unit: Unit::Ms, min: 0.0, max: 255.0 },
+    // PULS is active high: only 0 (see `step_invert_mask`)
+    SettingInfo { id: 2, unit: Unit::Plain, min: 0.0, max: 0.0 },
     // bit 0 X, bit 1 Y
     SettingInfo { id: 3, unit: Unit::Plain, min: 0.0, max: 3.0 },
+    // SON is active high: only 0 (see `son_invert`)
+    SettingInfo { id: 4, unit: Unit::Plain, min: 0.0, max: 0.0 },
     // 0 normally open, 1 normally closed
     SettingInfo { id: 5, unit: Unit::Plain, min: 0.0, max: 1.0 },
+    // no probe input: kept, no effect
+    SettingInfo { id: 6, unit: Unit::Plain, min: 0.0, max: 1.0 },
     // 1 machine position, +2 buffer state
     SettingInfo { id: 10, unit: Unit::Plain, min: 0.0, max: 3.0 },
     SettingInfo { id: 11, unit: Unit::Mm, min: 0.0, max: 5.0 },
+    // arcs are interpolated step by step: kept, no effect
+    SettingInfo { id: 12, unit: Unit::Mm, min: 0.001, max: 1.0 },
+    // 1: status and `$#` in inches
+    SettingInfo { id: 13, unit: Unit::Plain, min: 0.0, max: 1.0 },
     SettingInfo { id: 20, unit: Unit::Plain, min: 0.0, max: 1.0 },
     SettingInfo { id: 21, unit: Unit::Plain, min: 0.0, max: 1.0 },
     SettingInfo { id: 22, unit: Unit::Plain, min: 0.0, max: 1.0 },
@@ -99,6 +112,11 @@ pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 26, unit: Unit::Ms, min: 0.0, max: HOMING_DEBOUNCE_MAX_MS as f32 },
     SettingInfo { id: 27, unit: Unit::Mm, min: 0.1, max: 20.0 },
     SettingInfo { id: 29, unit: Unit::Us, min: 5.0, max: 100.0 },
+    // the S of `M3 S` that puts the pen fully down, and fully up
+    SettingInfo { id: 30, unit: Unit::Plain, min: 1.0, max: SPINDLE_SPEED_MAX },
+    SettingInfo { id: 31, unit: Unit::Plain, min: 0.0, max: SPINDLE_SPEED_MAX },
+    // 1: the pen up for G0 and down for G1-G3 while M3/M4 is on
+    SettingInfo { id: 32, unit: Unit::Plain, min: 0.0, max: 1.0 },
     SettingInfo { id: 100, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
     SettingInfo { id: 101, unit: Unit::StepsPerMm, min: 1.0, max: 200.0 },
     SettingInfo { id: 110, unit: Unit::MmPerMin, min: 1.0, max: 60_000.0 },
@@ -137,15 +155,30 @@ pub struct Settings {
     /// After this long at rest the servos go off (SON low) until the next move;
     /// [`SERVO_ALWAYS_ON`] keeps them on ($1).
     pub servo_idle_delay_ms: u32,
+    /// GRBL's step pulse invert ($2), 0 only: PULS is active high. A fault (a panic, a
+    /// HardFault, a reset) drives PULS and SON low by register writes that need nothing
+    /// initialised, which stops the drivers only if both are active high. Taken at 0 for the
+    /// senders that write every setting back.
+    pub step_invert_mask: u8,
     /// Bit 0 inverts X's SIGN output, bit 1 Y's ($3).
     pub dir_invert_mask: u8,
+    /// GRBL's step enable invert ($4), 0 only: SON is active high, for the reason given at
+    /// `step_invert_mask`.
+    pub son_invert: bool,
     /// The limit switches are normally closed: pressed reads high ($5).
     pub limit_pins_invert: bool,
+    /// GRBL's probe pin invert ($6): kept, no effect; the plotter has no probe input.
+    pub probe_invert: bool,
     /// What status reports show ($10): bit 0 set, the machine position (`MPos:`), clear, the
     /// work position (`WPos:`); bit 1, the buffer state (`Bf:`).
     pub status_report_mask: u8,
     /// GRBL's junction deviation for look-ahead at corners ($11).
     pub junction_deviation_mm: f32,
+    /// GRBL's arc tolerance ($12): kept, no effect; arcs are interpolated step by step on the
+    /// lattice, never cut into chords.
+    pub arc_tolerance_mm: f32,
+    /// Status reports and `$#` in inches ($13).
+    pub report_inches: bool,
     /// Drawings and jogs that would leave the travel are refused ($20).
     pub soft_limits: bool,
     /// A limit switch pressed while moving towards it stops the machine in an alarm ($21).
@@ -163,6 +196,14 @@ pub struct Settings {
     pub homing_debounce_ms: u32,
     /// How far homing backs off the switch it found ($27).
     pub homing_pull_off_mm: f32,
+    /// The S word of `M3 S…` that puts the pen fully down ($30, GRBL's max spindle speed), and
+    /// the one that holds it up ($31, the min): the pen servo's pulse goes from `$210` at `$31`
+    /// to `$211` at `$30`, in proportion.
+    pub spindle_max: f32,
+    pub spindle_min: f32,
+    /// GRBL's laser mode ($32): with a pen lift, the pen is up for rapids (G0) and down for
+    /// drawing moves while M3/M4 is on, as a laser is off in rapids.
+    pub laser_mode: bool,
     /// Steps per millimetre, X and Y ($100, $101).
     pub steps_per_mm: [f32; 2],
     /// Fastest travel per axis ($110, $111).
@@ -230,10 +271,15 @@ impl Default for Settings {
 const DEFAULT_SETTINGS: Settings = Settings {
     pulse_width_us: 5.0,
     servo_idle_delay_ms: SERVO_ALWAYS_ON,
+    step_invert_mask: 0,
     dir_invert_mask: 0,
+    son_invert: false,
     limit_pins_invert: false,
+    probe_invert: false,
     status_report_mask: 1,
     junction_deviation_mm: 0.02,
+    arc_tolerance_mm: 0.002,
+    report_inches: false,
     soft_limits: true,
     hard_limits: false,
     homing: false,
@@ -242,6 +288,9 @@ const DEFAULT_SETTINGS: Settings = Settings {
     homing_seek_mm_per_min: 1_000.0,
     homing_debounce_ms: 250,
     homing_pull_off_mm: 1.0,
+    spindle_max: 1_000.0,
+    spindle_min: 0.0,
+    laser_mode: false,
     steps_per_mm: [100.0, 100.0],
     max_rate_mm_per_min: [6_000.0, 6_000.0],
     accel_mm_per_s2: [500.0, 500.0],
@@ -291,10 +340,15 @@ impl Settings {
         Some(match id {
             0 => Field::Real(&mut self.pulse_width_us),
             1 => Field::Whole(&mut self.servo_idle_delay_ms),
+            2 => Field::Mask(&mut self.step_invert_mask),
             3 => Field::Mask(&mut self.dir_invert_mask),
+            4 => Field::Flag(&mut self.son_invert),
             5 => Field::Flag(&mut self.limit_pins_invert),
+            6 => Field::Flag(&mut self.probe_invert),
             10 => Field::Mask(&mut self.status_report_mask),
             11 => Field::Real(&mut self.junction_deviation_mm),
+            12 => Field::Real(&mut self.arc_tolerance_mm),
+            13 => Field::Flag(&mut self.report_inches),
             20 => Field::Flag(&mut self.soft_limits),
             21 => Field::Flag(&mut self.hard_limits),
             22 => Field::Flag(&mut self.homing),
@@ -304,6 +358,9 @@ impl Settings {
             26 => Field::Whole(&mut self.homing_debounce_ms),
             27 => Field::Real(&mut self.homing_pull_off_mm),
             29 => Field::Real(&mut self.dir_hold_us),
+            30 => Field::Real(&mut self.spindle_max),
+            31 => Field::Real(&mut self.spindle_min),
+            32 => Field::Flag(&mut self.laser_mode),
             100 | 101 => Field::Real(&mut self.steps_per_mm[usize::from(id - 100)]),
             110 | 111 => Field::Real(&mut self.max_rate_mm_per_min[usize::from(id - 110)]),
             120 | 121 => Field::Real(&mut self.accel_mm_per_s2[usize::from(id - 120)]),
@@ -407,7 +464,10 @@ impl Settings {
     /// Rules that tie settings together.
     fn check(&self) -> Result<(), SettingError> {
         let slowest_max = self.max_rate_mm_per_min[0].min(self.max_rate_mm_per_min[1]);
-        if self.start_rate_mm_per_min > slowest_max || !self.pulse_fits_in_period() {
+        if self.start_rate_mm_per_min > slowest_max
+            || !self.pulse_fits_in_period()
+            || self.spindle_min >= self.spindle_max
+        {
             return Err(SettingError::OutOfRange);
         }
         Ok(())

@@ -4,8 +4,8 @@
 //! and says why. The splash greets in the language kept.
 
 use servoplot::language::Language;
-use servoplot::settings::Settings;
 use servoplot::settings::presets::SpeedPreset;
+use servoplot::settings::{SETTING_INFO, Settings};
 use servoplot::sim::flash::SimFlash;
 use servoplot::sim::keys::KeyScript;
 use servoplot::sim::serial::SimSerial;
@@ -26,14 +26,15 @@ fn power_on(flash: SimFlash, keys: &str, serial: &str) -> SimReport {
     })
 }
 
-/// The settings screen (7), down the list to the `n`th setting (`$0` is the first).
-fn settings_screen_at(n: usize) -> String {
-    format!("7 {}", "B ".repeat(n - 1))
+/// The settings screen (7), down the list to setting `$id`.
+fn settings_screen_at(id: u16) -> String {
+    let index = SETTING_INFO.iter().position(|info| info.id == id).expect("a listed setting");
+    format!("7 {}", "B ".repeat(index))
 }
 
 #[test]
 fn a_setting_typed_on_the_keypad_is_used_reported_and_kept_across_a_power_cycle() {
-    let first = power_on(SimFlash::default(), &format!("{} 4 5 0 0 # wait:500", settings_screen_at(18)), "");
+    let first = power_on(SimFlash::default(), &format!("{} 4 5 0 0 # wait:500", settings_screen_at(110)), "");
     assert_eq!(first.settings.max_rate_mm_per_min, [4500.0, 6000.0]);
     let (_, last) = first.frames.last().unwrap();
     assert_eq!((text(last, 1, 24), text(last, 2, 24)), ("$110 X max rate".into(), "4500 mm/min".into()));
@@ -59,7 +60,7 @@ fn a_speed_preset_writes_its_speeds_and_they_are_kept() {
 #[test]
 fn a_clashing_setting_changes_nothing_and_says_why() {
     // $201, the start rate, above the axes' top speed of 6000 mm/min.
-    let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(25)), "");
+    let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(201)), "");
     let (_, last) = report.frames.last().unwrap();
     assert_eq!(text(last, 1, 24), "$201 Start rate");
     assert_eq!(text(last, 3, 24), "Clashes with $201 or $0");

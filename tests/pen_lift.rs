@@ -80,6 +80,35 @@ fn with_213_2_rapids_lift_the_pen_and_drawing_moves_lower_it() {
 }
 
 #[test]
+fn m3_s_sets_the_pen_between_the_up_and_down_pulses_as_31_and_30_say() {
+    // Servo-angle G-code: $31=20 holds the pen up, $30=90 puts it fully down; S between goes in
+    // proportion. An S word under M3 moves the pen once the motion before it has ended.
+    let report = run("$213=1\n$31=20\n$30=90\nM3 S55\nG1 X10 F3000\nS90\nG1 X20\nM3 S20\nM5\n");
+    let widths: Vec<u16> = report.pen.iter().map(|c| c.1).collect();
+    assert_eq!(widths, [UP_US, 1_500, DOWN_US, UP_US], "{:?}", report.pen);
+    // The first line drawn at the S55 pulse, the second at the full one; each after settling.
+    let at = |x_steps: i32| {
+        let p =
+            report.trace.pulses.iter().filter(|p| p.axis == servoplot::geom::Axis::X).nth(x_steps as usize).unwrap();
+        pen_at(&report, p.t_us)
+    };
+    assert_eq!((at(500), at(1_500)), (Some(1_500), Some(DOWN_US)));
+    assert!(pulses_by_pen(&report).2, "no pulse before the pen settled");
+    // M3 with no S word yet goes fully down, as before.
+    let plain = run("$213=1\nM3\nG1 X10 F3000\n");
+    assert_eq!(plain.pen.iter().map(|c| c.1).collect::<Vec<_>>(), [UP_US, DOWN_US]);
+}
+
+#[test]
+fn laser_mode_lifts_the_pen_for_rapids_under_m3() {
+    // $32=1: as a laser is off in rapids, the pen travels up and draws down while M3 is on.
+    let report = run("$213=1\n$32=1\nM3 S1000\nG0 X10\nG1 X20 F3000\nG0 X30\nM5\nG1 X40\n");
+    let (down, up, settled) = pulses_by_pen(&report);
+    assert_eq!((down, up), (1_000, 3_000), "only G1 X20 under M3 draws");
+    assert!(settled);
+}
+
+#[test]
 fn without_a_pen_lift_nothing_drives_the_pen_servo_and_m3_changes_nothing() {
     let report = run("M3\nG0 X10\nM5\nG1 X0 F3000\n");
     assert!(report.pen.is_empty(), "{:?}", report.pen);

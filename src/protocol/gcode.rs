@@ -126,7 +126,7 @@ use crate::drawing::{self, Builder, Request, Slice};
 use crate::geom::{Axis, Point};
 use crate::interp::ShapeKind;
 use crate::job::{Feed, Job, JobKind};
-use crate::pen::{self, Pen};
+use crate::pen::{self, Pen, PenDepth};
 use crate::protocol::startup::StartupLine;
 use crate::settings::Settings;
 use crate::status::RunState;
@@ -140,8 +140,8 @@ use words::{ProgramStop, compact, parse_block};
 /// [`Command`]s.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Commands {
-    /// M3/M4/M5 with a pen lift: the pen goes there first.
-    pen: Option<Pen>,
+    /// M3/M4/M5, or an S word under M3/M4, with a pen lift: the pen goes there first.
+    pen: Option<(Pen, PenDepth)>,
     dwell_ms: Option<u32>,
     /// The move to the intermediate point of G28 or G30, before `main`.
     via: Option<Command>,
@@ -254,7 +254,7 @@ impl Iterator for Commands {
 
     fn next(&mut self) -> Option<Command> {
         if let Some(pen) = self.pen.take() {
-            return Some(Command::Pen(pen));
+            return Some(Command::Pen(pen.0, pen.1));
         }
         if let Some(ms) = self.dwell_ms.take() {
             return Some(Command::Dwell { ms });
@@ -343,8 +343,9 @@ pub enum Command {
     Unlock,
     /// `$H`: run the homing cycle; `ok` once the machine is homed.
     Home,
-    /// M3/M4 (down) or M5 (up) with a pen lift (`$213`): at rest, the pen moves and settles.
-    Pen(Pen),
+    /// M3/M4 (down, as deep as the S word says) or M5 (up) with a pen lift (`$213`): at rest,
+    /// the pen moves and settles.
+    Pen(Pen, PenDepth),
     /// `$C`: enter check mode (`[MSG:Enabled]`), or leave it (`[MSG:Disabled]`, then a soft
     /// reset once the line is answered, as GRBL does, so the parser plans from the pen again).
     CheckMode { on: bool },
@@ -361,7 +362,8 @@ pub struct GcodeState {
     coolant: Coolant,
     /// `None` until an F word: the default feed rate applies.
     feed_mm_per_min: Option<f32>,
-    spindle_speed: f32,
+    /// The last S word, `None` until one is given.
+    spindle_speed: Option<f32>,
     tool: u8,
     /// Planned position, machine coordinates.
     position_mm: [f32; 2],
@@ -389,7 +391,7 @@ impl GcodeState {
             spindle: Spindle::Off,
             coolant: Coolant::Off,
             feed_mm_per_min: None,
-            spindle_speed: 0.0,
+            spindle_speed: None,
             tool: 0,
             position_mm: [0.0; 2],
             position: Point::ORIGIN,
@@ -465,7 +467,7 @@ impl GcodeState {
         self.coolant
     }
 
-    pub fn spindle_speed(&self) -> f32 {
+    pub fn spindle_speed(&self) -> Option<f32> {
         self.spindle_speed
     }
 

@@ -11,6 +11,7 @@
 use core::fmt::{self, Write};
 
 use super::GrblError;
+use super::gcode::MM_PER_INCH;
 use super::gcode::{Coolant, Distance, GcodeState, MotionMode, Spindle, StoredPosition, Units, WorkSystem};
 use crate::decimal::Int;
 use crate::drawing::DrawError;
@@ -52,7 +53,7 @@ pub enum Reply<'a> {
     Help,
     Settings(&'a Settings),
     ParserState(&'a GcodeState, &'a Settings),
-    Parameters(&'a GcodeState),
+    Parameters(&'a GcodeState, &'a Settings),
     BuildInfo {
         info: &'a str,
         planner_blocks: usize,
@@ -75,7 +76,7 @@ impl Reply<'_> {
             Reply::Help => help(out),
             Reply::Settings(s) => settings(out, s),
             Reply::ParserState(gcode, s) => parser_state(out, gcode, s),
-            Reply::Parameters(gcode) => parameters(out, gcode),
+            Reply::Parameters(gcode, s) => parameters(out, gcode, s),
             Reply::BuildInfo { info, planner_blocks, rx_buffer_bytes } => {
                 build_info(out, info, planner_blocks, rx_buffer_bytes)
             }
@@ -99,7 +100,7 @@ pub fn error(out: &mut impl Write, error: GrblError) -> fmt::Result {
         }
         GrblError::FunctionUndefined { x_mm, error } => {
             out.write_str("[MSG:Function undefined at x=")?;
-            mm(out, x_mm)?;
+            ReportUnits::Mm.length(out, x_mm)?;
             write!(out, ": {}]\r\n", Text(error.message()))?;
         }
         GrblError::Drawing(e) => drawing_refused(out, e)?,
@@ -124,7 +125,7 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
                 _ => "is undefined",
             });
             write!(out, "Function {why} after x=")?;
-            mm(out, x_mm)?;
+            ReportUnits::Mm.length(out, x_mm)?;
         }
     }
     out.write_str("]\r\n")
@@ -259,20 +260,21 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
         RunState::Home => "Home",
     };
     let machine = settings.status_report_mask & 1 != 0;
+    let units = ReportUnits::of(settings);
     write!(out, "<{}|{}:", Text(state), Text(if machine { "MPos" } else { "WPos" }))?;
     let [ox, oy] = if machine { [0.0; 2] } else { fields.work_offset_mm };
     let x = settings.steps_to_mm(Axis::X, status.position.x) - ox;
     let y = settings.steps_to_mm(Axis::Y, status.position.y) - oy;
-    xyz(out, x, y)?;
+    units.xyz(out, [x, y])?;
     if settings.status_report_mask & 2 != 0 {
         write!(out, "|Bf:{},{}", Int::from(fields.buffer.0), Int::from(fields.buffer.1))?;
     }
-    let speed = fields.speed_mm_per_min;
-    let feed = if speed.is_finite() { crate::math::round(speed.abs()) as u32 } else { 0 };
-    write!(out, "|FS:{},0", Int::from(feed))?;
+    out.write_str("|FS:")?;
+    units.rate(out, fields.speed_mm_per_min)?;
+    out.write_str(",0")?;
     if fields.wco {
         out.write_str("|WCO:")?;
-        xyz(out, fields.work_offset_mm[0], fields.work_offset_mm[1])?;
+        units.xyz(out, fields.work_offset_mm)?;
     }
     if let Some([feed, rapid, spindle]) = fields.overrides {
         write!(out, "|Ov:{},{},{}", Int::from(feed), Int::from(rapid), Int::from(spindle))?;
@@ -331,7 +333,7 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
         Spindle::Off => "M5",
     };
     let feed = crate::math::round(gcode.feed_mm_per_min(settings)) as u32;
-    let speed = crate::math::round(gcode.spindle_speed()) as u32;
+    let speed = crate::math::round(gcode.spindle_speed().unwrap_or(0.0)) as u32;
     let coolant = match gcode.coolant() {
         Coolant::Flood => "M8",
         Coolant::Off => "M9",
@@ -344,11 +346,12 @@ pub fn parser_state(out: &mut impl Write, gcode: &GcodeState, settings: &Setting
     write!(out, "[GC:{motion} G{system} G17 {units} {distance} G94 {spindle} {coolant} T{tool} F{feed} S{speed}]\r\n")
 }
 
-/// `$#`: GRBL's coordinate data, in GRBL's order and format, millimetres: the offsets of G54 to
-/// G59, the G28 and G30 positions (machine coordinates), the G92 offset, then the tool length
-/// offset and the last probe, always zero on the plotter (no tool, no probe). G54–G59, G28 and
-/// G30 outlive a power cycle (the flash store keeps them); G92 does not.
-pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
+/// `$#`: GRBL's coordinate data, in GRBL's order and format, in the report units (`$13`): the
+/// offsets of G54 to G59, the G28 and G30 positions (machine coordinates), the G92 offset, then
+/// the tool length offset and the last probe, always zero on the plotter (no tool, no probe).
+/// G54–G59, G28 and G30 outlive a power cycle (the flash store keeps them); G92 does not.
+pub fn parameters(out: &mut impl Write, gcode: &GcodeState, settings: &Settings) -> fmt::Result {
+    let units = ReportUnits::of(settings);
     let offsets = gcode.offsets();
     let stored = [
         (28, offsets.stored_mm(StoredPosition::G28)),
@@ -357,15 +360,14 @@ pub fn parameters(out: &mut impl Write, gcode: &GcodeState) -> fmt::Result {
     ];
     for (g, xy) in WorkSystem::all().map(|system| (system.gcode(), offsets.system_mm(system))).chain(stored) {
         write!(out, "[G{}:", Int::from(g))?;
-        xyz_line_end(out, xy)?;
+        units.xyz(out, xy)?;
+        out.write_str("]\r\n")?;
     }
-    out.write_str("[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n")
-}
-
-/// `x,y,0.000]` and the line end.
-fn xyz_line_end(out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
-    xyz(out, x, y)?;
-    out.write_str("]\r\n")
+    out.write_str("[TLO:")?;
+    units.length(out, 0.0)?;
+    out.write_str("]\r\n[PRB:")?;
+    units.xyz(out, [0.0; 2])?;
+    out.write_str(":0]\r\n")
 }
 
 /// `$I`: version and GRBL's `[OPT:codes,blocks,rx]` line. Senders size their character-counting
@@ -406,16 +408,47 @@ pub fn startup_result(out: &mut impl Write, line: &str, result: Result<(), GrblE
 }
 
 /// `x,y,0.000` in millimetres.
-fn xyz(out: &mut impl Write, x: f32, y: f32) -> fmt::Result {
-    mm(out, x)?;
-    out.write_char(',')?;
-    mm(out, y)?;
-    out.write_str(",0.000")
+/// The units positions and speeds are reported in (`$13`), with GRBL's decimals for each.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum ReportUnits {
+    /// Millimetres with three decimals, mm/min whole.
+    Mm,
+    /// Inches with four decimals, inches/min with one.
+    Inch,
 }
 
-/// Millimetres with exactly three decimals, rounded to the micrometre; never `-0.000`.
-fn mm(out: &mut impl Write, value: f32) -> fmt::Result {
-    crate::decimal::write_fixed(out, if value.is_finite() { value } else { 0.0 }, 3)
+impl ReportUnits {
+    fn of(settings: &Settings) -> ReportUnits {
+        if settings.report_inches { ReportUnits::Inch } else { ReportUnits::Mm }
+    }
+
+    /// `value_mm` in these units, with their decimals; never `-0.000`.
+    fn length(self, out: &mut impl Write, value_mm: f32) -> fmt::Result {
+        let value_mm = if value_mm.is_finite() { value_mm } else { 0.0 };
+        match self {
+            ReportUnits::Mm => crate::decimal::write_fixed(out, value_mm, 3),
+            ReportUnits::Inch => crate::decimal::write_fixed(out, value_mm / MM_PER_INCH, 4),
+        }
+    }
+
+    /// `x,y,z` (z always zero: no Z axis).
+    fn xyz(self, out: &mut impl Write, [x, y]: [f32; 2]) -> fmt::Result {
+        self.length(out, x)?;
+        out.write_char(',')?;
+        self.length(out, y)?;
+        out.write_char(',')?;
+        self.length(out, 0.0)
+    }
+
+    /// A speed, given in mm/min, as GRBL writes a rate: whole mm/min, or inches/min with one
+    /// decimal.
+    fn rate(self, out: &mut impl Write, mm_per_min: f32) -> fmt::Result {
+        let speed = if mm_per_min.is_finite() { mm_per_min.abs() } else { 0.0 };
+        match self {
+            ReportUnits::Mm => write!(out, "{}", Int::from(crate::math::round(speed) as u32)),
+            ReportUnits::Inch => crate::decimal::write_fixed(out, speed / MM_PER_INCH, 1),
+        }
+    }
 }
 
 /// A setting's value: at least three decimals like GRBL, more (up to six) when it has them.
@@ -500,8 +533,8 @@ mod tests {
             "<Idle|MPos:-0.013,-0.005,0.000|FS:0,0>\r\n"
         );
         // -0.0004 mm rounds to zero and shows as zero.
-        assert_eq!(text(|o| mm(o, -0.0004)), "0.000");
-        assert_eq!(text(|o| mm(o, 499.9996)), "500.000");
+        assert_eq!(text(|o| ReportUnits::Mm.length(o, -0.0004)), "0.000");
+        assert_eq!(text(|o| ReportUnits::Mm.length(o, 499.9996)), "500.000");
     }
 
     #[test]
@@ -596,7 +629,7 @@ mod tests {
         g.execute("G91 G20 G1 F10 M3", &s, RunState::Idle).unwrap();
         g.execute("G90 G21 G0 X10 Y-5", &s, RunState::Idle).unwrap();
         g.execute("G92 X0 Y0", &s, RunState::Idle).unwrap();
-        let p = text(|o| parameters(o, &g));
+        let p = text(|o| parameters(o, &g, &Settings::default()));
         assert!(p.starts_with("[G54:0.000,0.000,0.000]\r\n"));
         assert!(p.contains("[G92:10.000,-5.000,0.000]\r\n"));
         assert!(p.ends_with("[TLO:0.000]\r\n[PRB:0.000,0.000,0.000:0]\r\n"));

@@ -59,7 +59,7 @@ use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::overrides::Overrides;
-use crate::pen::{Pen, PenLift};
+use crate::pen::{Pen, PenDepth, PenLift};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::gcode::{Offsets, Pending};
@@ -174,9 +174,10 @@ impl Host<'_> {
         Until { machine: self.machine, line_of: None, done: Machine::at_rest, then_pen: None, then_ms: 0, timer: None }
     }
 
-    /// Once nothing is queued or moving, sends the pen to `pen` and waits for it to settle.
-    fn pen_to(&self, pen: Pen) -> Until<'_> {
-        Until { then_pen: Some(pen), ..self.machine_at_rest() }
+    /// Once nothing is queued or moving, sends the pen to `pen` (`depth` deep when down) and
+    /// waits for it to settle.
+    fn pen_to(&self, pen: Pen, depth: PenDepth) -> Until<'_> {
+        Until { then_pen: Some((pen, depth)), ..self.machine_at_rest() }
     }
 
     /// Once nothing is queued or moving, waits `ms` milliseconds (G4).
@@ -201,7 +202,7 @@ struct Until<'m> {
     line_of: Option<&'m Link>,
     done: fn(&Machine) -> bool,
     /// Once `done` holds: send the pen here, then wait until it has settled.
-    then_pen: Option<Pen>,
+    then_pen: Option<(Pen, PenDepth)>,
     /// Then wait this long.
     then_ms: u32,
     timer: Option<Timer>,
@@ -232,7 +233,8 @@ impl Future for Until<'_> {
             }
             let wait_ms = if !(self.done)(self.machine) {
                 SERIAL_IDLE_POLL_MS
-            } else if let Some(pen) = self.then_pen.take() {
+            } else if let Some((pen, depth)) = self.then_pen.take() {
+                self.machine.set_pen_depth(depth);
                 self.machine.set_pen(pen);
                 self.done = Machine::pen_settled;
                 continue;
@@ -539,9 +541,9 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         // One wait for every command that waits before it acts.
         let wait = match command {
             Command::Dwell { ms } => Some(host.dwell(ms)),
-            Command::Pen(pen) => Some(host.pen_to(pen)),
+            Command::Pen(pen, depth) => Some(host.pen_to(pen, depth)),
             // M2/M30 turn the spindle off: a pen lift raises the pen.
-            Command::ProgramEnd if PenLift::of(settings) != PenLift::None => Some(host.pen_to(Pen::Up)),
+            Command::ProgramEnd if PenLift::of(settings) != PenLift::None => Some(host.pen_to(Pen::Up, PenDepth::FULL)),
             Command::Pause | Command::ProgramEnd => Some(host.machine_at_rest()),
             // A setting applies to the motion after it, never under a move: the planner takes
             // new limits at rest (see `Planner::set_limits`), so the lines before it end first.
@@ -563,7 +565,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         let startup;
         let reply = match command {
             // Queued, or done waiting, above.
-            Command::Job(_) | Command::Dwell { .. } | Command::Pen(_) => None,
+            Command::Job(_) | Command::Dwell { .. } | Command::Pen(..) => None,
             Command::Pause => {
                 machine.request(Control::Hold);
                 None
@@ -602,7 +604,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                     Report::Help => Reply::Help,
                     Report::Settings => Reply::Settings(settings),
                     Report::ParserState => Reply::ParserState(gcode, settings),
-                    Report::Parameters => Reply::Parameters(gcode),
+                    Report::Parameters => Reply::Parameters(gcode, settings),
                     Report::BuildInfo => Reply::BuildInfo {
                         info: &startup.build_info,
                         planner_blocks: PLANNER_SEGMENTS,

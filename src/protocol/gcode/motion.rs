@@ -12,7 +12,7 @@ use super::{
 use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
 use crate::job::{Feed, JobKind};
-use crate::pen::{Pen, PenLift};
+use crate::pen::{Pen, PenDepth, PenLift};
 use crate::protocol::GrblError;
 use crate::settings::Settings;
 
@@ -48,17 +48,20 @@ impl GcodeState {
         if let Some(f) = words.take(b'F') {
             self.feed_mm_per_min = Some(f * scale);
         }
-        if let Some(s) = words.take(b'S') {
-            self.spindle_speed = s;
+        let speed = words.take(b'S');
+        if speed.is_some() {
+            self.spindle_speed = speed;
         }
         if let Some(t) = words.take(b'T') {
             self.tool = t as u8; // 0..=255, checked when parsed
         }
 
-        if let Some(s) = block.spindle
-            && PenLift::of(settings) != PenLift::None
-        {
-            out.pen = Some(if s == Spindle::Off { Pen::Up } else { Pen::Down });
+        // M3/M4/M5, or a new S word under M3/M4 (how deep the pen goes), moves the pen, as
+        // GRBL's spindle changes with them once the motion before has ended.
+        let spindle_on = self.spindle != Spindle::Off;
+        if PenLift::of(settings) != PenLift::None && (block.spindle.is_some() || (speed.is_some() && spindle_on)) {
+            let depth = PenDepth::of_spindle_speed(settings, self.spindle_speed);
+            out.pen = Some((if spindle_on { Pen::Down } else { Pen::Up }, depth));
         }
         if block.non_modal == Some(NonModal::Dwell) {
             let p = words.take(b'P').ok_or(GrblError::ValueWordMissing)?;

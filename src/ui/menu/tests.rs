@@ -276,11 +276,11 @@ fn mode_list_by_digit_and_by_navigation() {
 #[test]
 fn a_setting_is_typed_checked_and_handed_on() {
     let mut m = Menu::new();
-    // $0, then down the list to $110 (the 18th).
+    // $0, then down the list to $110 (the 26th).
     type_keys(&mut m, "7", &idle());
     let Screen::Settings(page) = m.screen() else { panic!("{:?}", m.screen()) };
     assert_eq!(page.info().id, 0);
-    type_keys(&mut m, &"B".repeat(17), &idle());
+    type_keys(&mut m, &"B".repeat(25), &idle());
     let Screen::Settings(page) = m.screen() else { panic!("{:?}", m.screen()) };
     assert_eq!(page.info().id, 110);
     // Out of range (1..60000): said, and the value stays to be corrected.
@@ -288,7 +288,7 @@ fn a_setting_is_typed_checked_and_handed_on() {
     assert_eq!(m.message(), Some(UiError::OutOfRange { min: 1.0, max: 60_000.0, unit: Unit::MmPerMin }));
     assert_eq!(type_keys(&mut m, "B #", &idle()), [Did::Act(MenuAction::SetSetting { id: 110, value: 7000.0 })]);
     // A whole-number setting ($1) refuses a fraction; D drops the value, then leaves.
-    type_keys(&mut m, &"A".repeat(16), &idle());
+    type_keys(&mut m, &"A".repeat(24), &idle());
     assert_eq!(type_keys(&mut m, "2 * 5 #", &idle()), []);
     assert_eq!(m.message(), Some(UiError::NotWhole));
     type_keys(&mut m, "D", &idle());

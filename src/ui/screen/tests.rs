@@ -174,8 +174,8 @@ fn mode_list_jog_and_settings_screens() {
     press(&mut m, "BBBBBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], [">7 Settings", " 8 Home ($H)"]);
     press(&mut m, "#", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s)), ["SETTINGS 1/40       IDLE", "$0 Pulse width", "5 us", "2.5..100 # edit"]);
-    press(&mut m, "BBBBBBBBBBBBBBBBBBBBBBBBB", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s)), ["SETTINGS 1/48       IDLE", "$0 Pulse width", "5 us", "2.5..100 # edit"]);
+    press(&mut m, &"B".repeat(33), &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$202 Diagonal steps", "1", "0..1 # edit"]);
     press(&mut m, "BBBB 1*5", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set *. Bdel Dback"]);

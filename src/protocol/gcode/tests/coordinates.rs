@@ -238,14 +238,14 @@ fn parser_state_and_parameters_report_the_coordinate_data() {
                     [G92:1.000,1.000,0.000]\r\n\
                     [TLO:0.000]\r\n\
                     [PRB:0.000,0.000,0.000:0]\r\n";
-    assert_eq!(text(|o| report::parameters(o, &g)), expected);
+    assert_eq!(text(|o| report::parameters(o, &g, &Settings::default())), expected);
     assert_eq!(text(|o| report::parser_state(o, &g, &s)), "[GC:G1 G55 G17 G21 G90 G94 M5 M9 T0 F200 S0]\r\n");
     ok_all(&mut g, &["G59"]);
     assert!(text(|o| report::parser_state(o, &g, &s)).starts_with("[GC:G1 G59 G17 "));
     // Program end selects G54 again (GRBL's rule) and keeps the data.
     ok_all(&mut g, &["M2"]);
     assert!(text(|o| report::parser_state(o, &g, &s)).starts_with("[GC:G1 G54 G17 "));
-    assert_eq!(text(|o| report::parameters(o, &g)), expected);
+    assert_eq!(text(|o| report::parameters(o, &g, &Settings::default())), expected);
 }
 
 #[test]
