@@ -10,7 +10,8 @@
 //!   stopping at the ends); `#` enters the mode under the cursor.
 //! - Everywhere: `D` goes back to the mode list; while the machine moves (run, hold, jog) `D`
 //!   aborts instead, and while a keypad jog is held it stops the jog. `C` holds a running job
-//!   and resumes a held one. While a job runs or is held, every other key is ignored.
+//!   and resumes a held one. While a job runs or is held, every other key is ignored. An abort
+//!   is said until the next key; once the machine is at rest, that key does nothing else.
 //! - Number fields: digits; `*` decimal point; `A` sign; `B` deletes the last character (held,
 //!   it repeats but stays in the field; pressed on an empty field it goes back to the previous
 //!   field); `C` clears the field; `#` checks the value and moves on, and on the last field
@@ -332,7 +333,7 @@ impl Menu {
     }
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
-        self.message = None;
+        let shown = self.message.take();
         if let Some(form) = self.form_mut().filter(|f| f.building) {
             // A drawing is being built: `D` drops it, the rest waits for it.
             if key != Key::D {
@@ -344,6 +345,11 @@ impl Menu {
         if self.run.as_ref().is_some_and(|r| r.ended_ms.is_some()) {
             // The end screen: the key only puts it away.
             self.run = None;
+            return MenuAction::None;
+        }
+        if shown == Some(UiError::Aborted) && !self.running() && !status.state.moving() {
+            // The abort, said at rest: the key only acknowledges it (a `#` after an aborted
+            // homing does not run the cycle again).
             return MenuAction::None;
         }
         if key == Key::D {

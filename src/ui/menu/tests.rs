@@ -204,7 +204,9 @@ fn run_hold_resume_abort() {
     assert_eq!(type_keys(&mut m, "D", &hold), [Did::Act(MenuAction::Control(Control::Abort))]);
     assert_eq!(form(&m).entry().digits(), "1");
     assert_eq!(m.message(), Some(UiError::Aborted), "an abort is said until the next key");
-    // Idle again: D goes back to the mode list.
+    // At rest, the next key only acknowledges it; then D goes back to the mode list.
+    assert_eq!(type_keys(&mut m, "D", &idle()), []);
+    assert_eq!((m.message(), form(&m).entry().digits()), (None, "1"));
     assert_eq!(type_keys(&mut m, "D", &idle()), []);
     assert_eq!(*m.screen(), Screen::Modes);
 }
@@ -403,6 +405,11 @@ fn home_runs_the_homing_cycle_when_homing_is_on_and_d_aborts_it() {
     let running = Status { state: RunState::Home, ..Status::default() };
     assert_eq!(m.handle(KeyEvent::Press(Key::Digit(2)), &running, &homing), MenuAction::None, "busy");
     assert_eq!(m.handle(KeyEvent::Press(Key::D), &running, &homing), MenuAction::Control(Control::Abort));
+    // Stopped in an alarm: the key that acknowledges the abort does not home again, the next does.
+    let aborted = Status { state: RunState::Alarm, ..Status::default() };
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &aborted, &homing), MenuAction::None);
+    assert_eq!((m.message(), m.selected()), (None, Mode::Home));
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &aborted, &homing), MenuAction::Home);
 }
 
 #[test]
