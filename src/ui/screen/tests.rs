@@ -377,3 +377,56 @@ fn every_screen_speaks_chinese_when_set() {
     assert_eq!(texts(&view(&m, &stopped, &s))[3], "停止: 除以 0");
     assert_eq!(texts(&view(&m, &stopped, &Settings::default()))[3], "Stopped: division by 0");
 }
+
+#[test]
+fn homing_says_homing_and_d_aborts_it() {
+    let m = Menu::new();
+    let s = Settings { homing: true, ..Settings::default() };
+    let homing = Status { state: RunState::Home, ..Status::default() };
+    let v = texts(&view(&m, &homing, &s));
+    assert_eq!(v, ["SERVOPLOT           HOME", "X    0.000 Y    0.000", "Homing", "D abort"]);
+}
+
+#[test]
+fn a_lock_with_nothing_to_tell_says_how_to_unlock() {
+    let m = Menu::new();
+    let locked = Status { state: RunState::Alarm, ..Status::default() };
+    let homing = Settings { homing: true, ..Settings::default() };
+    let v = view(&m, &locked, &homing);
+    assert_eq!((v.lines[3].text.as_str(), v.lines[3].inverted), ("Locked: 8 home, or $X", true));
+    assert_eq!(texts(&view(&m, &locked, &Settings::default()))[3], "Locked: $X unlocks");
+    let chinese = Settings { language: crate::language::Language::Chinese, ..homing };
+    assert_eq!(texts(&view(&m, &locked, &chinese))[3], "已锁定: 8回零, 或$X");
+    // A lock with a cause says the cause.
+    let tripped = Status { fault: Some(MotionFault::Tripped(Trip::EStop)), ..locked };
+    assert_eq!(texts(&view(&m, &tripped, &homing))[3], "Stopped: E-stop");
+}
+
+#[test]
+fn a_released_jog_says_it_is_stopping_while_the_title_says_jog() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    press(&mut m, "1", &Status::default());
+    m.handle(KeyEvent::Press(Key::Digit(6)), &Status::default(), &s);
+    let jogging = Status { state: RunState::Jog, ..Status::default() };
+    assert_eq!(texts(&view(&m, &jogging, &s))[2..], ["Moving +X", "Release to stop"]);
+    m.handle(KeyEvent::Release(Key::Digit(6)), &jogging, &s);
+    let v = texts(&view(&m, &jogging, &s));
+    assert_eq!(v, [std::format!("{:<21}JOG", "JOG").as_str(), "X    0.000 Y    0.000", "Stopping", "D abort"]);
+    assert_eq!(texts(&view(&m, &Status::default(), &s))[2], "2 +Y 8 -Y 4 -X 6 +X", "at rest");
+}
+
+#[test]
+fn a_run_stopped_by_an_alarm_says_alarm_not_done() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    assert!(m.observe(&Status { state: RunState::Run, work_left: true, ..Status::default() }, 0));
+    let alarm = Status { state: RunState::Alarm, fault: Some(MotionFault::Tripped(Trip::EStop)), ..Status::default() };
+    assert!(m.observe(&alarm, 1_000));
+    let v = texts(&view(&m, &alarm, &s));
+    assert!(v[0].ends_with(" ALARM"), "{v:?}");
+    let mut done = Menu::new();
+    done.observe(&Status { state: RunState::Run, work_left: true, ..Status::default() }, 0);
+    done.observe(&Status::default(), 1_000);
+    assert!(texts(&view(&done, &Status::default(), &s))[0].ends_with(" DONE"));
+}
