@@ -168,7 +168,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     let text = typed.text();
                     let shown = text.get(text.len().saturating_sub(SCREEN_COLUMNS - 3)..).unwrap_or(text);
                     *l2 = TextLine::new(format_args!("y={}_", Text(shown)), false);
-                    *l3 = TextLine::new(format_args!("A>{} {}", Text(typed.token()), say(Msg::KeysTyping)), false);
+                    *l3 = TextLine::new(format_args!("A<{}>B {}", Text(typed.token()), say(Msg::KeysTyping)), false);
                 }
                 None => {
                     let p = form.preset();
@@ -330,7 +330,9 @@ impl fmt::Display for ErrorText {
             UiError::HomingOff => Msg::ErrHomingOff,
             UiError::Aborted => Msg::ErrAborted,
             UiError::NotWhole => Msg::ErrWhole,
-            UiError::Clash => Msg::ErrClash,
+            UiError::Clash { with, .. } => return write!(f, "{} ${}", say(Msg::ErrClash), Int::from(with)),
+            UiError::StrandsPen { .. } => Msg::ErrStrands,
+            UiError::UndefinedAtStart(e) => return write!(f, "{} {}", say(Msg::ErrAtX0), say(Msg::from(e))),
         };
         write!(f, "{}", say(msg))
     }

@@ -178,12 +178,13 @@ fn mode_list_jog_and_settings_screens() {
     press(&mut m, "BBBBBBBBBBBBBBBBBBBBBBBBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$202 Diagonal steps", "1", "0..1 # edit"]);
     press(&mut m, "BBBB 1*5", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set *. Bdel Dback"]);
+    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set Cnext *. Bdel Dback"]);
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Whole numbers only");
     press(&mut m, "DDBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], [">9 Speed presets", " 0 Language 语言"]);
-    press(&mut m, "#B", &idle);
+    // The presets open on the one in force.
+    press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["F3000 R6000 A500", ">2 Felt tip *", " 3 Fast draft"]);
     press(&mut m, "D1", &idle);
     m.handle(KeyEvent::Press(Key::Digit(3)), &idle, &s);
@@ -327,10 +328,12 @@ fn a_typed_function_shows_its_end_the_wheel_and_its_error() {
     let s = Settings::default();
     press(&mut m, "6", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], ["f1 y=x^2/20", "1-5/AB pick C type # ok"]);
-    press(&mut m, "C A A", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["y=x^2/20_", "A>) C put B del #"]);
+    press(&mut m, "C B B", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["y=x^2/20_", "A<)>B C put D del"]);
+    press(&mut m, "A A A", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[3], "A<,>B C put D del", "back past the first token");
     // A long text shows its end, where it is typed.
-    press(&mut m, "C C C C C C C C C C C C C C C C C C C C", &idle);
+    press(&mut m, "B B B C C C C C C C C C C C C C C C C C C C C", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2], "y=0))))))))))))))))))))_");
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Col 7 unmatched ( or )");
@@ -429,4 +432,22 @@ fn a_run_stopped_by_an_alarm_says_alarm_not_done() {
     done.observe(&Status { state: RunState::Run, work_left: true, ..Status::default() }, 0);
     done.observe(&Status::default(), 1_000);
     assert!(texts(&view(&done, &Status::default(), &s))[0].ends_with(" DONE"));
+}
+
+#[test]
+fn refusals_say_why_in_either_language() {
+    let mut m = Menu::new();
+    let idle = Status::default();
+    let chinese = Settings { language: crate::language::Language::Chinese, ..Settings::default() };
+    let cases = [
+        (UiError::Clash { set: 201, with: 110 }, "Clashes with $110", "冲突: $110"),
+        (UiError::StrandsPen { set: 130 }, "Pen beyond new travel", "笔将超出行程"),
+        (UiError::UndefinedAtStart(crate::expr::EvalError::SqrtOfNegative), "x0: sqrt of a negative", "x0: 负数开方"),
+        (UiError::UndefinedAtStart(crate::expr::EvalError::DivisionByZero), "x0: division by 0", "x0: 除以 0"),
+    ];
+    for (why, english, zh) in cases {
+        m.refuse(why);
+        assert_eq!(texts(&view(&m, &idle, &Settings::default()))[3], english);
+        assert_eq!(texts(&view(&m, &idle, &chinese))[3], zh);
+    }
 }
