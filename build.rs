@@ -99,25 +99,38 @@ impl DrawTarget for Cell {
     }
 }
 
+/// The glyph drawn for `*`, rows from the top, `#` lit: a multiplication sign centred where
+/// `+` crosses, as the expressions on the screen use `*` (the font's own asterisk, a star of
+/// dots, reads as `%` at this size).
+const MULTIPLICATION_SIGN: [&str; 7] = [".....", ".....", ".#.#.", "..#..", ".#.#.", ".....", "....."];
+
 /// `$OUT_DIR/font5x7.rs`: embedded-graphics' 5x7 font, the printable ASCII characters ' '..='~'
-/// each rendered by its own text renderer, as one run of bits (see the table's comment). Its
-/// ASCII fonts' one other glyph, DEL's, is a copy of '?', which the firmware draws for any
-/// character outside the table.
+/// each rendered by its own text renderer (but `*`, drawn as [`MULTIPLICATION_SIGN`]), as one
+/// run of bits (see the table's comment). Its ASCII fonts' one other glyph, DEL's, is a copy
+/// of '?', which the firmware draws for any character outside the table.
 fn write_font(out: &Path) {
     let style = MonoTextStyle::new(&FONT_5X7, BinaryColor::On);
     let mut bits = Vec::new();
     for c in ' '..='~' {
         let mut cell = Cell::new(5);
-        let mut buf = [0; 4];
-        Text::with_baseline(c.encode_utf8(&mut buf), Point::zero(), style, Baseline::Top)
-            .draw(&mut cell)
-            .expect("drawing into memory cannot fail");
+        if c == '*' {
+            for (y, row) in MULTIPLICATION_SIGN.iter().enumerate() {
+                for (x, _) in row.bytes().enumerate().filter(|&(_, b)| b == b'#') {
+                    cell.bits |= 1 << (7 * x + y);
+                }
+            }
+        } else {
+            let mut buf = [0; 4];
+            Text::with_baseline(c.encode_utf8(&mut buf), Point::zero(), style, Baseline::Top)
+                .draw(&mut cell)
+                .expect("drawing into memory cannot fail");
+        }
         bits.extend((0..35).map(|k| cell.bits >> k & 1 != 0));
     }
     let mut src = format!(
-        "/// embedded-graphics' `FONT_5X7`, ' '..='~', written by build.rs: 35 bits per character, bit\n\
-         /// `35 * (c - ' ') + 7 * x + y` (bit n is bit n % 8 of byte n / 8) set where the pixel x from\n\
-         /// the left, y from the top of c's 5x7 cell is lit.\n\
+        "/// embedded-graphics' `FONT_5X7`, ' '..='~' (`*` a multiplication sign), written by build.rs:\n\
+         /// 35 bits per character, bit `35 * (c - ' ') + 7 * x + y` (bit n is bit n % 8 of byte n / 8)\n\
+         /// set where the pixel x from the left, y from the top of c's 5x7 cell is lit.\n\
          pub const GLYPHS_5X7: [u8; {}] = [\n",
         bits.len().div_ceil(8)
     );

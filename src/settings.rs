@@ -463,14 +463,38 @@ impl Settings {
 
     /// Rules that tie settings together.
     fn check(&self) -> Result<(), SettingError> {
-        let slowest_max = self.max_rate_mm_per_min[0].min(self.max_rate_mm_per_min[1]);
-        if self.start_rate_mm_per_min > slowest_max
-            || !self.pulse_fits_in_period()
-            || self.spindle_min >= self.spindle_max
-        {
-            return Err(SettingError::OutOfRange);
+        match self.disagreeing() {
+            Some(_) => Err(SettingError::OutOfRange),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// The two settings that disagree, if any: a start rate (`$201`) above the slower axis' top
+    /// speed (`$110` or `$111`), a pulse (`$0`) too wide for the pulse rate (`$205`), or the S
+    /// that holds the pen up (`$31`) not below the one that puts it down (`$30`).
+    pub fn disagreeing(&self) -> Option<[u16; 2]> {
+        let [x, y] = self.max_rate_mm_per_min;
+        let (slowest_id, slowest_max) = if x <= y { (110, x) } else { (111, y) };
+        if self.start_rate_mm_per_min > slowest_max {
+            return Some([201, slowest_id]);
+        }
+        if !self.pulse_fits_in_period() {
+            return Some([0, 205]);
+        }
+        if self.spindle_min >= self.spindle_max {
+            return Some([31, 30]);
+        }
+        None
+    }
+
+    /// The two settings `changes` (each in its range) would leave disagreeing, if any: why
+    /// [`set_all`](Self::set_all) refuses them.
+    pub fn clash(&self, changes: &[(u16, f32)]) -> Option<[u16; 2]> {
+        let mut next = *self;
+        for &(id, value) in changes {
+            next.assign(id, value).ok()?;
+        }
+        next.disagreeing()
     }
 
     /// True when a pulse of `$0` and as long again with PULS low fit in one period of `$205`,
@@ -547,6 +571,16 @@ mod tests {
         // A start rate above the slowest axis' max rate would stall nothing but make no sense.
         assert_eq!(s.set(201, 7_000.0), Err(SettingError::OutOfRange));
         assert_eq!(s, Settings::default());
+    }
+
+    #[test]
+    fn a_clash_names_the_two_settings_that_disagree() {
+        let s = Settings::default();
+        assert_eq!(s.clash(&[(201, 7_000.0)]), Some([201, 110]));
+        assert_eq!(s.clash(&[(111, 3_000.0), (201, 4_000.0)]), Some([201, 111]), "the slower axis");
+        assert_eq!(s.clash(&[(0, 100.0)]), Some([0, 205]));
+        assert_eq!(s.clash(&[(201, 500.0)]), None, "they agree");
+        assert_eq!(s.clash(&[(100, 0.0)]), None, "out of range: no clash");
     }
 
     #[test]

@@ -4,6 +4,8 @@
 use servoplot::geom::Point;
 use servoplot::sim;
 
+mod support;
+
 #[test]
 fn the_line_mode_draws_the_same_line_as_g1_x10_y5() {
     // Mode 2 (line), dX 10 mm #, dY 5 mm #, and # to draw what the preview shows.
@@ -85,11 +87,23 @@ fn the_lcd_redraws_at_most_ten_times_a_second_and_only_on_change() {
 
 #[test]
 fn a_function_typed_on_the_keypad_draws_what_the_host_link_draws() {
-    // Function mode (6), C to type from the first preset (x^2/20), B B B leaves x^2, then A
-    // turns the wheel to / and C puts it, 4 0 divides by 40: x^2/40 from x0 = 0 to x1 = 20 mm.
-    let keys = sim::run_keys("6 C B B B A A A A A A C 4 0 # 0 # 2 0 # #").unwrap();
+    // Function mode (6), C to type from the first preset (x^2/20), D D D leaves x^2, then B
+    // turns the wheel on to ^, A one back to /, C puts it, 4 0 divides by 40: x^2/40 from
+    // x0 = 0 to x1 = 20 mm.
+    let keys = sim::run_keys("6 C D D D B B B B B B B A C 4 0 # 0 # 2 0 # #").unwrap();
     let serial = sim::run_serial("$F X0 U20 Y=x^2/40\n");
     assert!(serial.answers().contains("ok"), "{}", serial.answers());
     assert_eq!(keys.path(), serial.path(), "same steps in the same order");
     assert_eq!(keys.position, Point::new(2000, 1000));
+}
+
+#[test]
+fn a_function_undefined_at_the_pen_says_why_as_the_host_link_does() {
+    // Function mode (6), the third preset (5*sqrt(x)), from x0 = -4 to 9 mm: nothing moves.
+    let keys = sim::run_keys("6 3 # A 4 # 9 # wait:300").unwrap();
+    let serial = sim::run_serial("$F X-4 U9 Y=5*sqrt(x)\n");
+    assert!(serial.answers().contains("sqrt of a negative number"), "{}", serial.answers());
+    assert_eq!((keys.trace.counts(), serial.trace.counts()), ([0; 4], [0; 4]));
+    let (_, last) = keys.frames.last().unwrap();
+    assert_eq!(support::text(last, 3, 24), "x0: sqrt of a negative");
 }

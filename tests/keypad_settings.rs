@@ -63,9 +63,41 @@ fn a_clashing_setting_changes_nothing_and_says_why() {
     let report = power_on(SimFlash::default(), &format!("{} 7 0 0 0 # wait:500", settings_screen_at(201)), "");
     let (_, last) = report.frames.last().unwrap();
     assert_eq!(text(last, 1, 24), "$201 Start rate");
-    assert_eq!(text(last, 3, 24), "Clashes with $201 or $0");
+    assert_eq!(text(last, 3, 24), "Clashes with $110", "the setting it clashes with");
     assert_eq!(report.settings, Settings::default());
     assert_eq!(report.flash.bytes_changed(), 0);
+}
+
+#[test]
+fn c_sets_a_value_and_moves_on_to_the_next_setting() {
+    // $110 to 4500 and, with C, on to $111: 5000 and # (set, and stay).
+    let report =
+        power_on(SimFlash::default(), &format!("{} 4 5 0 0 C 5 0 0 0 # wait:500", settings_screen_at(110)), "");
+    assert_eq!(report.settings.max_rate_mm_per_min, [4500.0, 5000.0]);
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!((text(last, 1, 24), text(last, 2, 24)), ("$111 Y max rate".into(), "5000 mm/min".into()));
+    // The pen drawn 100 mm out (D puts the drawing's end screen away), and a travel set
+    // smaller than where it is: refused, saying why.
+    let report = sim::run(SimConfig {
+        keys: KeyScript::parse(&format!("wait:500 D {} 5 0 # wait:500", settings_screen_at(130))).unwrap(),
+        serial: SimSerial::with_input(b"G0 X100\n"),
+        keys_start: sim::KeysStart::AfterSerial,
+        ..SimConfig::default()
+    });
+    assert_eq!(report.settings, Settings::default());
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!((text(last, 1, 24), text(last, 3, 24)), ("$130 X travel".into(), "Pen beyond new travel".into()));
+}
+
+#[test]
+fn the_presets_open_on_the_preset_in_force() {
+    // The defaults are the felt tip's; after the fast draft is written, 9 opens on it.
+    let report = power_on(SimFlash::default(), "9 wait:300", "");
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!((text(last, 2, 24), text(last, 3, 24)), (">2 Felt tip *".into(), " 3 Fast draft".into()));
+    let report = power_on(SimFlash::default(), "9 3 # D 9 wait:500", "");
+    let (_, last) = report.frames.last().unwrap();
+    assert_eq!(text(last, 3, 24), ">3 Fast draft *");
 }
 
 #[test]

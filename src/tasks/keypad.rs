@@ -135,12 +135,14 @@ fn act(machine: &Machine, panel: &Panel, action: MenuAction, building: &mut Opti
     }
 }
 
-/// Changes settings as one: all of `changes`, or, if they would leave the settings disagreeing,
-/// none, and the menu says so. The serial task keeps them in flash.
+/// Changes settings as one: all of `changes`, or, if they would leave the settings disagreeing
+/// or the pen outside the travel, none, and the menu says why. The serial task keeps them in
+/// flash.
 fn change_settings(machine: &Machine, panel: &Panel, changes: &[(u16, f32)]) {
     let pen = machine.position();
-    if machine.update_settings(|s| s.set_all_around(changes, pen)).is_err() {
-        refuse(panel, UiError::Clash);
+    let before = machine.settings();
+    if let Err(e) = machine.update_settings(|s| s.set_all_around(changes, pen)) {
+        refuse(panel, UiError::settings_refused(&before, changes, e));
     }
 }
 

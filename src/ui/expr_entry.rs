@@ -1,7 +1,8 @@
 //! Typing a function y = f(x) on 16 keys. Digits and `*` (the decimal point) type themselves;
 //! every other token of the expression language (x, the operators, parentheses, the functions,
-//! pi) comes from a wheel: `A` turns it, `C` puts its token. `B` deletes the last character, or
-//! a whole function name with its parenthesis. The text goes to the host link's parser
+//! pi) comes from a wheel: `A` turns it back, `B` on (as they move up and down the menu's lists),
+//! `C` puts its token. `D` deletes the last character, or a whole function name with its
+//! parenthesis. The text goes to the host link's parser
 //! ([`crate::expr`]), so a typed function is the very expression a sender would send, and is
 //! refused with the same column-numbered errors.
 
@@ -13,7 +14,7 @@ use crate::keypad::Key;
 /// Longest expression typed on the keypad.
 pub const EXPR_ENTRY_MAX_CHARS: usize = 40;
 
-/// The wheel's tokens, the most used first; `A` steps through them and wraps.
+/// The wheel's tokens, the most used first; `B` steps on through them, `A` back, and both wrap.
 pub const EXPR_TOKENS: [&str; 25] = [
     "x", "(", ")", "+", "-", "*", "/", "^", "sin(", "cos(", "sqrt(", "exp(", "ln(", "abs(", "tan(", "pi", "asin(",
     "acos(", "atan(", "log10(", "floor(", "ceil(", "min(", "max(", ",",
@@ -43,20 +44,24 @@ impl ExprEntry {
         EXPR_TOKENS[self.wheel % EXPR_TOKENS.len()]
     }
 
-    /// Takes a key: digits, `*`, `A` (turn the wheel), `C` (put its token), `B` (delete).
-    /// Returns false for `B` on an empty text (nothing to delete), true otherwise; `#` and `D`
-    /// are the form's. A full text refuses more as the parser refuses a text too long.
+    /// Takes a key: digits, `*`, `A`/`B` (turn the wheel back/on), `C` (put its token), `D`
+    /// (delete). Returns false for `D` on an empty text (nothing to delete), true otherwise; `#`
+    /// is the form's. A full text refuses more as the parser refuses a text too long.
     pub fn press(&mut self, key: Key) -> Result<bool, ParseError> {
         let put = match key {
             Key::Digit(d) => self.text.push(char::from(b'0' + d % 10)),
             Key::Star => self.text.push('.'),
             Key::C => self.text.push_str(self.token()),
             Key::A => {
+                self.wheel = (self.wheel + EXPR_TOKENS.len() - 1) % EXPR_TOKENS.len();
+                Ok(())
+            }
+            Key::B => {
                 self.wheel = (self.wheel + 1) % EXPR_TOKENS.len();
                 Ok(())
             }
-            Key::B => return Ok(self.delete()),
-            Key::D | Key::Hash => Ok(()),
+            Key::D => return Ok(self.delete()),
+            Key::Hash => Ok(()),
         };
         put.map(|()| true).map_err(|_| ParseError { kind: ParseErrorKind::TooLong, pos: self.text.len() })
     }
@@ -79,7 +84,7 @@ impl ExprEntry {
 mod tests {
     use super::*;
 
-    /// Presses `keys` (spaces ignored) on `entry`: digits, `*`, `A`, `B`, `C`.
+    /// Presses `keys` (spaces ignored) on `entry`: digits, `*`, `A`, `B`, `C`, `D`.
     fn press(entry: &mut ExprEntry, keys: &str) -> Result<(), ParseError> {
         for c in keys.chars().filter(|c| !c.is_whitespace()) {
             let key = match c {
@@ -88,6 +93,7 @@ mod tests {
                 'A' => Key::A,
                 'B' => Key::B,
                 'C' => Key::C,
+                'D' => Key::D,
                 _ => panic!("no key {c}"),
             };
             entry.press(key)?;
@@ -95,13 +101,13 @@ mod tests {
         Ok(())
     }
 
-    /// The keys that turn the wheel from where it stands to `token` and put it.
+    /// The keys that turn the wheel on from where it stands to `token` and put it.
     fn put(entry: &ExprEntry, token: &str) -> String<32> {
         let mut keys = String::new();
         let mut probe = entry.clone();
         while probe.token() != token {
-            probe.press(Key::A).unwrap();
-            keys.push('A').unwrap();
+            probe.press(Key::B).unwrap();
+            keys.push('B').unwrap();
         }
         keys.push('C').unwrap();
         keys
@@ -118,7 +124,7 @@ mod tests {
         assert_eq!(e.text(), "20*exp(-x^2/200)");
         assert!(crate::expr::parse(e.text()).is_ok());
         // * types the decimal point.
-        press(&mut e, "B B B B B B 1 * 5").unwrap();
+        press(&mut e, "D D D D D D 1 * 5").unwrap();
         let close = put(&e, ")");
         press(&mut e, &close).unwrap();
         assert_eq!(e.text(), "20*exp(-x^1.5)");
@@ -127,13 +133,13 @@ mod tests {
     #[test]
     fn delete_takes_a_function_name_with_its_parenthesis() {
         let mut e = ExprEntry::new("2*sqrt(");
-        press(&mut e, "B").unwrap();
+        press(&mut e, "D").unwrap();
         assert_eq!(e.text(), "2*");
-        press(&mut e, "B B").unwrap();
+        press(&mut e, "D D").unwrap();
         assert_eq!(e.text(), "");
-        assert_eq!(e.press(Key::B), Ok(false), "nothing left to delete");
+        assert_eq!(e.press(Key::D), Ok(false), "nothing left to delete");
         let mut e = ExprEntry::new("(x+1)*(");
-        press(&mut e, "B").unwrap();
+        press(&mut e, "D").unwrap();
         assert_eq!(e.text(), "(x+1)*");
     }
 
@@ -146,8 +152,22 @@ mod tests {
         assert_eq!(e.text().len(), EXPR_ENTRY_MAX_CHARS);
         // The wheel wraps.
         for _ in 0..EXPR_TOKENS.len() {
-            e.press(Key::A).unwrap();
+            e.press(Key::B).unwrap();
         }
         assert_eq!(e.token(), "x");
+    }
+
+    #[test]
+    fn the_wheel_turns_both_ways() {
+        let mut e = ExprEntry::new("");
+        press(&mut e, "B B B").unwrap();
+        assert_eq!(e.token(), "+");
+        press(&mut e, "A").unwrap();
+        assert_eq!(e.token(), ")");
+        // Back from the first token to the last: `,` is one key away from `x`.
+        press(&mut e, "A A A").unwrap();
+        assert_eq!(e.token(), ",");
+        press(&mut e, "C B C").unwrap();
+        assert_eq!(e.text(), ",x");
     }
 }

@@ -10,12 +10,17 @@
 //!   stopping at the ends); `#` enters the mode under the cursor.
 //! - Everywhere: `D` goes back to the mode list; while the machine moves (run, hold, jog) `D`
 //!   aborts instead, and while a keypad jog is held it stops the jog. `C` holds a running job
-//!   and resumes a held one. While a job runs or is held, every other key is ignored.
+//!   and resumes a held one. While a job runs or is held, every other key is ignored. An abort
+//!   is said until the next key; once the machine is at rest, that key does nothing else.
 //! - Number fields: digits; `*` decimal point; `A` sign; `B` deletes the last character (held,
 //!   it repeats but stays in the field; pressed on an empty field it goes back to the previous
 //!   field); `C` clears the field; `#` checks the value and moves on, and on the last field
 //!   builds the drawing and shows its preview. A value that is refused shows why and stays for
 //!   correction.
+//! - Function field (`6`): `1`..`5` or `A`/`B` pick a preset; `C` types a function, starting
+//!   from it ([`ExprEntry`](crate::ui::expr_entry::ExprEntry)): digits and `*` type themselves,
+//!   `A`/`B` turn the token wheel back/on, `C` puts its token, `D` deletes the last one (on an
+//!   empty text, back to the presets).
 //! - Preview: the whole planned path; `#` starts the drawing, `D` goes back to the form.
 //! - While a drawing is built (after the last `#` of a form, or `#` on the preview: the keypad
 //!   task builds it a slice at a time, see [`MenuAction::Build`]), `D` drops it and the screen
@@ -26,9 +31,10 @@
 //! - Jog: hold `1`-`4`, `6`-`9` to move (see [`JOG_KEYS`]); releasing the key stops.
 //! - Home (`8`): runs the homing cycle at once when homing is on (`$22`); `D` aborts it.
 //! - Settings (`7`): one `$` setting at a time ([`SettingPage`]): `A`/`B` step through them; a
-//!   number key or `#` types a new value (keys as in number fields), `#` sets it, `D` drops it.
-//! - Speed presets (`9`): `1`..`3` or `A`/`B` pick one, `#` writes it into the settings
-//!   ([`SpeedPreset`]).
+//!   number key or `#` types a new value (keys as in number fields, but no sign: no setting is
+//!   negative), `#` sets it, `C` sets it and moves on to the next setting, `D` drops it.
+//! - Speed presets (`9`): the cursor starts on the preset in force; `1`..`3` or `A`/`B` pick
+//!   one, `#` writes it into the settings ([`SpeedPreset`]).
 //!
 //! Every keypad drawing starts at the pen and is typed relative to it: a line is typed as its
 //! offset (dX, dY) from the pen; curves are placed as described in [`crate::drawing`]. So
@@ -197,6 +203,12 @@ impl Menu {
         if let Some(form) = self.form_mut() {
             form.building = false;
         }
+        // A setting refused shows again (`C` may have moved on), with why.
+        if let (Screen::Settings(page), UiError::Clash { set, .. } | UiError::StrandsPen { set }) =
+            (&mut self.screen, why)
+        {
+            page.show(set);
+        }
     }
 
     /// True while the menu waits for a drawing it asked to be built: the form's (its last `#`)
@@ -313,7 +325,8 @@ impl Menu {
     }
 
     /// True when a held `key` repeats on the current screen: only moves through lists and
-    /// deleting characters, never anything that starts motion or leaves a screen.
+    /// deleting characters, never anything that starts motion or leaves a screen (a held `D`
+    /// deleting a typed function stops at its empty text).
     fn repeats(&self, key: Key, status: &Status) -> bool {
         if self.is_busy(status) || self.building() {
             return false;
@@ -323,6 +336,7 @@ impl Menu {
             Screen::Settings(page) if page.edit().is_some() => key == Key::B,
             Screen::Settings(_) => matches!(key, Key::A | Key::B),
             Screen::Form(form) => match form.field() {
+                Some(Field::Preset) if form.typing() => matches!(key, Key::A | Key::B | Key::D),
                 Some(Field::Preset) => matches!(key, Key::A | Key::B),
                 Some(Field::Number(_)) => key == Key::B,
                 None => false,
@@ -332,7 +346,7 @@ impl Menu {
     }
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
-        self.message = None;
+        let shown = self.message.take();
         if let Some(form) = self.form_mut().filter(|f| f.building) {
             // A drawing is being built: `D` drops it, the rest waits for it.
             if key != Key::D {
@@ -344,6 +358,11 @@ impl Menu {
         if self.run.as_ref().is_some_and(|r| r.ended_ms.is_some()) {
             // The end screen: the key only puts it away.
             self.run = None;
+            return MenuAction::None;
+        }
+        if shown == Some(UiError::Aborted) && !self.running() && !status.state.moving() {
+            // The abort, said at rest: the key only acknowledges it (a `#` after an aborted
+            // homing does not run the cycle again).
             return MenuAction::None;
         }
         if key == Key::D {
@@ -365,7 +384,7 @@ impl Menu {
                     return MenuAction::None;
                 }
                 Screen::Form(form) if form.typing() => {
-                    form.stop_typing();
+                    form.delete_typed(repeated);
                     return MenuAction::None;
                 }
                 _ => Screen::Modes,
@@ -436,7 +455,10 @@ impl Menu {
         self.screen = match mode {
             Mode::Jog => Screen::Jog,
             Mode::Settings => Screen::Settings(SettingPage::new()),
-            Mode::Presets => Screen::Presets(SpeedPreset::FinePen),
+            // On the preset in force, if one is.
+            Mode::Presets => Screen::Presets(
+                SpeedPreset::ALL.into_iter().find(|p| p.is_set(settings)).unwrap_or(SpeedPreset::FinePen),
+            ),
             Mode::Home if !settings.homing => return Err(UiError::HomingOff),
             Mode::Home => return Ok(MenuAction::Home),
             Mode::Language => {

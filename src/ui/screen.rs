@@ -72,6 +72,10 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> S
         v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error, language)), true);
     } else if let (RunState::Idle | RunState::Alarm, Some(fault)) = (status.state, status.fault) {
         v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault, language)), true);
+    } else if status.state == RunState::Alarm {
+        // Locked with no fault to tell (at power-on with homing on): how to unlock.
+        let how = if settings.homing { Msg::LockedHome } else { Msg::LockedUnlock };
+        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", Say(how, language)), true);
     }
     v
 }
@@ -133,12 +137,17 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                 *line = TextLine::new(format_args!("{marker}{digit} {}", say(mode.label())), false);
             }
         }
-        Screen::Jog => match menu.jog() {
-            Some(jog) => {
+        Screen::Jog => match (menu.jog(), status.state) {
+            (Some(jog), _) => {
                 *l2 = TextLine::new(format_args!("{} {}", say(Msg::JogMoving), Direction(jog.step)), false);
                 *l3 = TextLine::say(Msg::JogRelease, language);
             }
-            None => {
+            // Released: the machine slows to a stop, as the title's JOG says.
+            (None, RunState::Jog) => {
+                *l2 = TextLine::say(Msg::JogStopping, language);
+                *l3 = TextLine::say(Msg::KeysAbort, language);
+            }
+            (None, _) => {
                 *l2 = TextLine::plain("2 +Y 8 -Y 4 -X 6 +X");
                 *l3 = TextLine::say(Msg::JogKeys, language);
             }
@@ -159,7 +168,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
                     let text = typed.text();
                     let shown = text.get(text.len().saturating_sub(SCREEN_COLUMNS - 3)..).unwrap_or(text);
                     *l2 = TextLine::new(format_args!("y={}_", Text(shown)), false);
-                    *l3 = TextLine::new(format_args!("A>{} {}", Text(typed.token()), say(Msg::KeysTyping)), false);
+                    *l3 = TextLine::new(format_args!("A<{}>B {}", Text(typed.token()), say(Msg::KeysTyping)), false);
                 }
                 None => {
                     let p = form.preset();
@@ -212,6 +221,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         let (doing, keys) = match status.state {
             RunState::Hold => (Msg::BusyHeld, Msg::KeysHeld),
             RunState::Jog => (Msg::BusyJogging, Msg::KeysAbort),
+            RunState::Home => (Msg::BusyHoming, Msg::KeysAbort),
             _ => (Msg::BusyDrawing, Msg::KeysDrawing),
         };
         // A drawing at another feed than programmed says so.
@@ -320,7 +330,9 @@ impl fmt::Display for ErrorText {
             UiError::HomingOff => Msg::ErrHomingOff,
             UiError::Aborted => Msg::ErrAborted,
             UiError::NotWhole => Msg::ErrWhole,
-            UiError::Clash => Msg::ErrClash,
+            UiError::Clash { with, .. } => return write!(f, "{} ${}", say(Msg::ErrClash), Int::from(with)),
+            UiError::StrandsPen { .. } => Msg::ErrStrands,
+            UiError::UndefinedAtStart(e) => return write!(f, "{} {}", say(Msg::ErrAtX0), say(Msg::from(e))),
         };
         write!(f, "{}", say(msg))
     }

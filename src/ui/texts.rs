@@ -12,7 +12,7 @@
 
 use core::fmt::{self, Write};
 
-use crate::expr::ParseErrorKind;
+use crate::expr::{EvalError, ParseErrorKind};
 use crate::language::Language;
 
 include!(concat!(env!("OUT_DIR"), "/texts.rs"));
@@ -92,6 +92,22 @@ impl From<ParseErrorKind> for Msg {
             ParseErrorKind::TooComplex => Msg::ExprTooComplex,
             ParseErrorKind::WrongArgCount => Msg::ExprArgCount,
             ParseErrorKind::NumberOutOfRange => Msg::ExprNumber,
+        }
+    }
+}
+
+/// Why a function cannot be evaluated: on the LCD (the host link says it at length, with
+/// [`EvalError::message`]).
+impl From<EvalError> for Msg {
+    fn from(e: EvalError) -> Msg {
+        match e {
+            EvalError::SqrtOfNegative => Msg::EvalSqrt,
+            EvalError::LogOfNonPositive => Msg::EvalLog,
+            EvalError::ArcOutOfRange => Msg::EvalArc,
+            EvalError::PowerOfNegative => Msg::EvalPower,
+            EvalError::TanPole => Msg::EvalTan,
+            EvalError::DivisionByZero => Msg::FaultDivision,
+            EvalError::Overflow => Msg::FaultOverflow,
         }
     }
 }

@@ -43,10 +43,20 @@ impl DrawTarget for Canvas {
     }
 }
 
-/// The 5x7 glyphs of the printable ASCII characters.
+/// The LCD's `*`: a multiplication sign, 3x3 pixels centred where `+` crosses.
+const MULTIPLICATION_SIGN: [[bool; 5]; 7] = {
+    let (o, x) = (false, true);
+    [[o; 5], [o; 5], [o, x, o, x, o], [o, o, x, o, o], [o, x, o, x, o], [o; 5], [o; 5]]
+};
+
+/// The 5x7 glyphs of the printable ASCII characters: embedded-graphics' font, and `*` as a
+/// multiplication sign.
 pub fn glyphs() -> Vec<(char, [[bool; 5]; 7])> {
     (' '..='~')
         .map(|c| {
+            if c == '*' {
+                return (c, MULTIPLICATION_SIGN);
+            }
             let mut canvas = Canvas([[false; W]; H]);
             let style = MonoTextStyle::new(&FONT_5X7, BinaryColor::On);
             Text::with_baseline(&c.to_string(), Px::zero(), style, Baseline::Top).draw(&mut canvas).unwrap();

@@ -100,7 +100,8 @@ pub(super) fn ranged_value(
 #[derive(Clone, Debug, PartialEq)]
 pub enum Field {
     Number(NumberField),
-    /// Choice of a [`FunctionPreset`]: `1`..`5` pick, `A`/`B` step, `#` confirms.
+    /// Choice of a [`FunctionPreset`]: `1`..`5` pick, `A`/`B` step, `#` confirms; or, after `C`,
+    /// a function typed ([`ExprEntry`]).
     Preset,
 }
 
@@ -216,9 +217,15 @@ impl Form {
         self.typed.is_some() && self.field() == Some(&Field::Preset)
     }
 
-    /// `D` while a function is typed: back to the presets.
-    pub(super) fn stop_typing(&mut self) {
-        self.typed = None;
+    /// `D` while a function is typed: deletes its last character (or function name); on an
+    /// empty text, a fresh press goes back to the presets.
+    pub(super) fn delete_typed(&mut self, repeated: bool) {
+        if let Some(typed) = &mut self.typed
+            && !typed.press(Key::D).unwrap_or(true)
+            && !repeated
+        {
+            self.typed = None;
+        }
     }
 
     /// Takes a key; `#` on the last field gives the drawing to build for the preview.
@@ -238,10 +245,7 @@ impl Form {
             (_, Key::Hash) => return self.confirm(status, settings),
             (Field::Preset, key) => match &mut self.typed {
                 Some(typed) => {
-                    // An empty text gives way to the presets, on a fresh press only.
-                    if !typed.press(key).map_err(UiError::Expression)? && !repeated {
-                        self.typed = None;
-                    }
+                    typed.press(key).map_err(UiError::Expression)?;
                 }
                 None if key == Key::C => self.typed = Some(ExprEntry::new(self.preset.expression())),
                 None => {
@@ -353,7 +357,10 @@ impl Form {
                 if x0_mm == x1_mm {
                     return Err(UiError::SameEnds);
                 }
-                Request::Function { expr: self.function()?, x0_mm, x1_mm }
+                let expr = self.function()?;
+                // Undefined where the pen is: say why, as the host link's `$F` does.
+                expr.eval(x0_mm).map_err(UiError::UndefinedAtStart)?;
+                Request::Function { expr, x0_mm, x1_mm }
             }
             Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => return Err(UiError::Empty),
         })

@@ -204,7 +204,9 @@ fn run_hold_resume_abort() {
     assert_eq!(type_keys(&mut m, "D", &hold), [Did::Act(MenuAction::Control(Control::Abort))]);
     assert_eq!(form(&m).entry().digits(), "1");
     assert_eq!(m.message(), Some(UiError::Aborted), "an abort is said until the next key");
-    // Idle again: D goes back to the mode list.
+    // At rest, the next key only acknowledges it; then D goes back to the mode list.
+    assert_eq!(type_keys(&mut m, "D", &idle()), []);
+    assert_eq!((m.message(), form(&m).entry().digits()), (None, "1"));
     assert_eq!(type_keys(&mut m, "D", &idle()), []);
     assert_eq!(*m.screen(), Screen::Modes);
 }
@@ -269,7 +271,12 @@ fn mode_list_by_digit_and_by_navigation() {
     assert_eq!(form(&m).mode(), Mode::Ellipse);
     type_keys(&mut m, "D 7", &idle());
     assert_eq!(*m.screen(), Screen::Settings(SettingPage::new()));
+    // The presets open on the one in force (the defaults are the felt tip's), else on the first.
     type_keys(&mut m, "D 9", &idle());
+    assert_eq!(*m.screen(), Screen::Presets(SpeedPreset::FeltTip));
+    let own = Settings { default_feed_mm_per_min: 1234.0, ..Settings::default() };
+    type_keys(&mut m, "D", &idle());
+    m.handle(KeyEvent::Press(Key::Digit(9)), &idle(), &own);
     assert_eq!(*m.screen(), Screen::Presets(SpeedPreset::FinePen));
 }
 
@@ -296,6 +303,27 @@ fn a_setting_is_typed_checked_and_handed_on() {
     assert_eq!((page.info().id, page.edit()), (1, None));
     type_keys(&mut m, "D", &idle());
     assert_eq!(*m.screen(), Screen::Modes);
+}
+
+#[test]
+fn a_setting_is_set_and_left_with_c_and_a_is_no_sign() {
+    let mut m = Menu::new();
+    let page = |m: &Menu| match m.screen() {
+        Screen::Settings(page) => {
+            (page.info().id, page.edit().map(|e| (e.is_negative(), std::string::String::from(e.digits()))))
+        }
+        s => panic!("{s:?}"),
+    };
+    // $201: A types no minus; C sets the value and moves on to $202.
+    let index = crate::settings::SETTING_INFO.iter().position(|info| info.id == 201).unwrap();
+    type_keys(&mut m, &std::format!("7 {}", "B".repeat(index)), &idle());
+    assert_eq!(type_keys(&mut m, "7 A 0 0 0", &idle()), []);
+    assert_eq!(page(&m), (201, Some((false, "7000".into()))));
+    assert_eq!(type_keys(&mut m, "C", &idle()), [Did::Act(MenuAction::SetSetting { id: 201, value: 7000.0 })]);
+    assert_eq!(page(&m), (202, None));
+    // The change clashes with $110: the keypad task says so, and $201 shows again with why.
+    m.refuse(UiError::Clash { set: 201, with: 110 });
+    assert_eq!((page(&m), m.message()), ((201, None), Some(UiError::Clash { set: 201, with: 110 })));
 }
 
 #[test]
@@ -379,9 +407,9 @@ fn function_presets_and_their_domains() {
     let a = type_keys(&mut m, "B# 0# 9#", &idle());
     let root = Shape::Function { expr: crate::expr::parse("5*sqrt(x)").unwrap(), x0_mm: 0.0, x1_mm: 9.0 };
     assert_eq!(curve(&a[0]), (root, Point::ORIGIN));
-    // sqrt of negative x is refused before anything moves, and an empty interval too.
+    // sqrt of negative x is refused before anything moves, saying why, and an empty interval too.
     assert_eq!(type_keys(&mut m, "# A4# 9#", &idle()), []);
-    assert!(matches!(m.message(), Some(UiError::Drawing(DrawError::Setup(_)))), "{:?}", m.message());
+    assert_eq!(m.message(), Some(UiError::UndefinedAtStart(crate::expr::EvalError::SqrtOfNegative)));
     assert_eq!(type_keys(&mut m, "D 6 B B # 4# A9#", &idle()), []);
     assert!(
         matches!(m.message(), Some(UiError::Drawing(DrawError::Fails { .. }))),
@@ -403,23 +431,36 @@ fn home_runs_the_homing_cycle_when_homing_is_on_and_d_aborts_it() {
     let running = Status { state: RunState::Home, ..Status::default() };
     assert_eq!(m.handle(KeyEvent::Press(Key::Digit(2)), &running, &homing), MenuAction::None, "busy");
     assert_eq!(m.handle(KeyEvent::Press(Key::D), &running, &homing), MenuAction::Control(Control::Abort));
+    // Stopped in an alarm: the key that acknowledges the abort does not home again, the next does.
+    let aborted = Status { state: RunState::Alarm, ..Status::default() };
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &aborted, &homing), MenuAction::None);
+    assert_eq!((m.message(), m.selected()), (None, Mode::Home));
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &aborted, &homing), MenuAction::Home);
 }
 
 #[test]
 fn a_typed_function_is_drawn_and_its_errors_say_the_column() {
     let mut m = Menu::new();
-    // C on the function field starts from the preset (x^2/20); three B leave x^2.
-    type_keys(&mut m, "6 C B B B", &idle());
+    // C on the function field starts from the preset (x^2/20); three D leave x^2.
+    type_keys(&mut m, "6 C D D D", &idle());
     assert_eq!(form(&m).typed().map(ExprEntry::text), Some("x^2"));
     let a = type_keys(&mut m, "# 0# 10#", &idle());
     let square = Shape::Function { expr: crate::expr::parse("x^2").unwrap(), x0_mm: 0.0, x1_mm: 10.0 };
     assert_eq!(curve(&a[0]), (square, Point::ORIGIN));
     // A new form starts from the preset again; x^ does not parse: column 3, the end.
-    type_keys(&mut m, "D 6 C B B B B", &idle());
+    type_keys(&mut m, "D D 6 C D D D D", &idle());
     assert_eq!(type_keys(&mut m, "#", &idle()), []);
     let end = crate::expr::ParseError { kind: crate::expr::ParseErrorKind::UnexpectedEnd, pos: 2 };
     assert_eq!(m.message(), Some(UiError::Expression(end)));
-    // D goes back to the presets, then to the mode list.
+    // D deletes the rest; held, it stops at the empty text; pressed again it goes back to the
+    // presets, then to the mode list.
+    type_keys(&mut m, "D", &idle());
+    assert_eq!(form(&m).typed().map(ExprEntry::text), Some("x"));
+    let s = Settings::default();
+    for _ in 0..5 {
+        m.handle(KeyEvent::Repeat(Key::D), &idle(), &s);
+    }
+    assert_eq!(form(&m).typed().map(ExprEntry::text), Some(""));
     type_keys(&mut m, "D", &idle());
     assert_eq!((form(&m).typed(), form(&m).preset()), (None, FunctionPreset::Parabola));
     type_keys(&mut m, "D", &idle());
@@ -520,4 +561,54 @@ fn a_drawing_built_while_the_host_moved_the_pen_is_refused() {
     let job = built.job(Feed::MmPerMin(s.default_feed_mm_per_min)).unwrap();
     assert_eq!((job.drawing.start(), job.drawing.end()), (moved.position, moved.position), "a full circle");
     assert!(m.run().is_some_and(|r| r.plan.is_some()), "the run screen has the preview's plan");
+}
+
+/// The README's table of the forms' fields, checked against the forms: every mode with a form
+/// has its rows, one a field in order, with the field's unit, range and empty value.
+#[test]
+fn the_readme_lists_every_form_field_as_the_forms_have_it() {
+    use core::fmt::Write;
+    let readme = include_str!("../../../README.md");
+    let table = readme.split("| mode | field | unit | range | empty |\n|---|---|---|---|---|\n").nth(1).unwrap();
+    let rows: Vec<Vec<std::string::String>> = table
+        .lines()
+        .take_while(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').map(|c| c.trim().replace('−', "-")).collect())
+        .collect();
+    let mut at = 0;
+    for mode in Mode::ALL.into_iter().filter(|m| !m.fields().is_empty()) {
+        for (i, field) in mode.fields().iter().enumerate() {
+            let row = &rows[at];
+            at += 1;
+            if i == 0 {
+                let label = crate::ui::texts::Say(mode.label(), crate::language::Language::English);
+                let mut want = std::string::String::new();
+                write!(want, "{} {}", (mode.index() + 1) % 10, label).unwrap();
+                assert!(want.starts_with(&row[0]) && !row[0].is_empty(), "{row:?} for {mode:?}");
+            } else {
+                assert_eq!(row[0], "", "{row:?}: a row of {mode:?}");
+            }
+            let (unit, range, empty) = match field {
+                Field::Preset => (std::string::String::new(), std::string::String::new(), "the preset shown".into()),
+                Field::Number(spec) => {
+                    let mut range = std::string::String::new();
+                    write!(
+                        range,
+                        "{}..{}",
+                        crate::decimal::Num(*spec.range.start()),
+                        crate::decimal::Num(*spec.range.end())
+                    )
+                    .unwrap();
+                    let empty = match spec.default {
+                        None => "refused".into(),
+                        Some(v) => std::format!("{}", crate::decimal::Num(v)),
+                    };
+                    (spec.unit.symbol().into(), range, empty)
+                }
+            };
+            assert_eq!((&row[2], &row[3]), (&unit, &range), "{mode:?} field {i}: {row:?}");
+            assert!(row[4].starts_with(&empty), "{mode:?} field {i}: {row:?}");
+        }
+    }
+    assert_eq!(at, rows.len(), "no rows for fields the forms lack");
 }

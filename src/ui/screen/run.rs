@@ -15,7 +15,8 @@
 //! ```
 //!
 //! `#` shows the path over the whole screen, then machine coordinates with the keys. Once the
-//! machine is at rest the first page says DONE and gives the plot time, until a key.
+//! machine is at rest the first page says DONE (ALARM if an alarm stopped it) and gives the
+//! plot time, until a key.
 
 use core::fmt::{self, Write};
 
@@ -90,6 +91,8 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
     let language = settings.language;
     let say = |msg| Say(msg, language);
     let state = say(match status.state {
+        // Stopped by an alarm: not done, and locked until unlocked.
+        RunState::Alarm => Msg::StateAlarm,
         _ if done => Msg::Done,
         // Confirmed, waiting for the servos or the pen (short, so the name keeps its figures).
         RunState::Idle => Msg::Go,

@@ -178,12 +178,13 @@ fn mode_list_jog_and_settings_screens() {
     press(&mut m, &"B".repeat(33), &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$202 Diagonal steps", "1", "0..1 # edit"]);
     press(&mut m, "BBBB 1*5", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set *. Bdel Dback"]);
+    assert_eq!(texts(&view(&m, &idle, &s))[1..], ["$206 Input debounce", "=1.5_ ms", "#set Cnext *. Bdel Dback"]);
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Whole numbers only");
     press(&mut m, "DDBB", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], [">9 Speed presets", " 0 Language 语言"]);
-    press(&mut m, "#B", &idle);
+    // The presets open on the one in force.
+    press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[1..], ["F3000 R6000 A500", ">2 Felt tip *", " 3 Fast draft"]);
     press(&mut m, "D1", &idle);
     m.handle(KeyEvent::Press(Key::Digit(3)), &idle, &s);
@@ -327,10 +328,12 @@ fn a_typed_function_shows_its_end_the_wheel_and_its_error() {
     let s = Settings::default();
     press(&mut m, "6", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2..], ["f1 y=x^2/20", "1-5/AB pick C type # ok"]);
-    press(&mut m, "C A A", &idle);
-    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["y=x^2/20_", "A>) C put B del #"]);
+    press(&mut m, "C B B", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[2..], ["y=x^2/20_", "A<)>B C put D del"]);
+    press(&mut m, "A A A", &idle);
+    assert_eq!(texts(&view(&m, &idle, &s))[3], "A<,>B C put D del", "back past the first token");
     // A long text shows its end, where it is typed.
-    press(&mut m, "C C C C C C C C C C C C C C C C C C C C", &idle);
+    press(&mut m, "B B B C C C C C C C C C C C C C C C C C C C C", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[2], "y=0))))))))))))))))))))_");
     press(&mut m, "#", &idle);
     assert_eq!(texts(&view(&m, &idle, &s))[3], "Col 7 unmatched ( or )");
@@ -376,4 +379,75 @@ fn every_screen_speaks_chinese_when_set() {
     let stopped = Status { fault: Some(MotionFault::Curve(CurveError::DivisionByZero)), ..Status::default() };
     assert_eq!(texts(&view(&m, &stopped, &s))[3], "停止: 除以 0");
     assert_eq!(texts(&view(&m, &stopped, &Settings::default()))[3], "Stopped: division by 0");
+}
+
+#[test]
+fn homing_says_homing_and_d_aborts_it() {
+    let m = Menu::new();
+    let s = Settings { homing: true, ..Settings::default() };
+    let homing = Status { state: RunState::Home, ..Status::default() };
+    let v = texts(&view(&m, &homing, &s));
+    assert_eq!(v, ["SERVOPLOT           HOME", "X    0.000 Y    0.000", "Homing", "D abort"]);
+}
+
+#[test]
+fn a_lock_with_nothing_to_tell_says_how_to_unlock() {
+    let m = Menu::new();
+    let locked = Status { state: RunState::Alarm, ..Status::default() };
+    let homing = Settings { homing: true, ..Settings::default() };
+    let v = view(&m, &locked, &homing);
+    assert_eq!((v.lines[3].text.as_str(), v.lines[3].inverted), ("Locked: 8 home, or $X", true));
+    assert_eq!(texts(&view(&m, &locked, &Settings::default()))[3], "Locked: $X unlocks");
+    let chinese = Settings { language: crate::language::Language::Chinese, ..homing };
+    assert_eq!(texts(&view(&m, &locked, &chinese))[3], "已锁定: 8回零, 或$X");
+    // A lock with a cause says the cause.
+    let tripped = Status { fault: Some(MotionFault::Tripped(Trip::EStop)), ..locked };
+    assert_eq!(texts(&view(&m, &tripped, &homing))[3], "Stopped: E-stop");
+}
+
+#[test]
+fn a_released_jog_says_it_is_stopping_while_the_title_says_jog() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    press(&mut m, "1", &Status::default());
+    m.handle(KeyEvent::Press(Key::Digit(6)), &Status::default(), &s);
+    let jogging = Status { state: RunState::Jog, ..Status::default() };
+    assert_eq!(texts(&view(&m, &jogging, &s))[2..], ["Moving +X", "Release to stop"]);
+    m.handle(KeyEvent::Release(Key::Digit(6)), &jogging, &s);
+    let v = texts(&view(&m, &jogging, &s));
+    assert_eq!(v, [std::format!("{:<21}JOG", "JOG").as_str(), "X    0.000 Y    0.000", "Stopping", "D abort"]);
+    assert_eq!(texts(&view(&m, &Status::default(), &s))[2], "2 +Y 8 -Y 4 -X 6 +X", "at rest");
+}
+
+#[test]
+fn a_run_stopped_by_an_alarm_says_alarm_not_done() {
+    let mut m = Menu::new();
+    let s = Settings::default();
+    assert!(m.observe(&Status { state: RunState::Run, work_left: true, ..Status::default() }, 0));
+    let alarm = Status { state: RunState::Alarm, fault: Some(MotionFault::Tripped(Trip::EStop)), ..Status::default() };
+    assert!(m.observe(&alarm, 1_000));
+    let v = texts(&view(&m, &alarm, &s));
+    assert!(v[0].ends_with(" ALARM"), "{v:?}");
+    let mut done = Menu::new();
+    done.observe(&Status { state: RunState::Run, work_left: true, ..Status::default() }, 0);
+    done.observe(&Status::default(), 1_000);
+    assert!(texts(&view(&done, &Status::default(), &s))[0].ends_with(" DONE"));
+}
+
+#[test]
+fn refusals_say_why_in_either_language() {
+    let mut m = Menu::new();
+    let idle = Status::default();
+    let chinese = Settings { language: crate::language::Language::Chinese, ..Settings::default() };
+    let cases = [
+        (UiError::Clash { set: 201, with: 110 }, "Clashes with $110", "冲突: $110"),
+        (UiError::StrandsPen { set: 130 }, "Pen beyond new travel", "笔将超出行程"),
+        (UiError::UndefinedAtStart(crate::expr::EvalError::SqrtOfNegative), "x0: sqrt of a negative", "x0: 负数开方"),
+        (UiError::UndefinedAtStart(crate::expr::EvalError::DivisionByZero), "x0: division by 0", "x0: 除以 0"),
+    ];
+    for (why, english, zh) in cases {
+        m.refuse(why);
+        assert_eq!(texts(&view(&m, &idle, &Settings::default()))[3], english);
+        assert_eq!(texts(&view(&m, &idle, &chinese))[3], zh);
+    }
 }
