@@ -29,9 +29,10 @@
 //! Every line gets exactly one answer, in order, on its own link, whatever the sender does. A
 //! sender that ignores GRBL's flow control and sends more than its pipe holds while the machine
 //! is busy loses whole lines, never parts of them: from the byte that found no room up to the
-//! end of a line, the receiver drops the lines' bytes and counts their ends; once the line loop
-//! has emptied the pipe it answers each of those lines `error:11` (not processed), and only then
-//! does the receiver pass bytes on again, from the start of the next line.
+//! end of a line, the receiver drops the lines' bytes and counts their ends, after one
+//! `[MSG:Receive buffer full...]`; once the line loop has emptied the pipe it answers each of
+//! those lines `error:100` (not processed), and only then does the receiver pass bytes on again,
+//! from the start of the next line.
 //!
 //! The line loop owns the flash store: once a line has changed what a power cycle keeps
 //! (settings, G54–G59, G28/G30, startup blocks, build info), it waits for the machine to stop
@@ -321,7 +322,7 @@ async fn lines<F: NorFlash>(
                 // Lines whose bytes found no room: the partial one in the assembler is the first.
                 assembler.clear();
                 for _ in 0..n {
-                    link.send(Reply::Error(GrblError::LineOverflow)).await;
+                    link.send(Reply::Error(GrblError::ReceiveBufferFull)).await;
                 }
             }
             Intake::Bytes(n) => {

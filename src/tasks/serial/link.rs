@@ -50,7 +50,7 @@ pub type Answer = String<SERIAL_ANSWER_MAX_BYTES>;
 pub enum Intake {
     /// `n` bytes arrived, in the buffer given to [`Link::intake`].
     Bytes(usize),
-    /// Lines dropped for want of room in the pipe, to answer `error:11` each.
+    /// Lines dropped for want of room in the pipe, to answer `error:100` each.
     Dropped(u32),
 }
 
@@ -154,7 +154,10 @@ impl Link {
                 return;
             }
             d.active.set(true);
-            self.send(Reply::Message("Receive buffer full: lines dropped, each answered error:11")).await;
+            self.send(Reply::Message(
+                "Receive buffer full: lines dropped, each answered error:100; use a streaming sender",
+            ))
+            .await;
         }
         // CR and LF each end a line, as they do for the line assembler.
         if byte == b'\n' || byte == b'\r' {
