@@ -1,11 +1,13 @@
 //! The simulated host link: bytes in from a file or standard input, answers out to a buffer
 //! (and optionally standard output), through the same embedded-io traits as the UART.
 //!
-//! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next
-//! line goes out once the firmware has answered the previous one with `ok` or `error:N`. Live
-//! standard input is passed on as typed. A link can also be closed by its host at a given time,
-//! as a USB serial port is when the sender closes it: the read after the bytes sent before then
-//! reports the closing.
+//! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next line
+//! goes out once the firmware has answered the previous one with `ok` or `error:N`. Live standard
+//! input is passed on as typed. Bytes wait here until the firmware reads them, as a USB port holds
+//! back its host's writes (the most that waited is kept, [`SimSerial::most_unread`]); on the UART
+//! the firmware reads on, and drops what finds no room. A link can also be closed by its host at a
+//! given time, as a USB serial port is when the sender closes it: the read after the bytes sent
+//! before then reports the closing.
 
 use core::future::poll_fn;
 use core::task::{Poll, Waker};
@@ -27,6 +29,8 @@ struct Link {
     closings: VecDeque<u64>,
     /// The host closed the port after this many of the input bytes; not reported yet.
     closed_after: Option<usize>,
+    /// The most input bytes ever waiting to be read.
+    most_unread: usize,
     /// A reset (0x18) went out and its banner has not come back yet.
     reset_sent: bool,
     /// Answers (`ok` / `error:`) still owed for lines sent.
@@ -127,7 +131,7 @@ impl SimSerial {
                 l.closings.pop_front();
                 l.closed_after = Some(l.input.len());
             } else if let Some((_, b)) = l.timed.pop_front() {
-                l.input.push_back(b);
+                l.push_input(core::iter::once(b));
                 l.reset_sent |= b == 0x18;
             }
             sent = true;
@@ -135,6 +139,11 @@ impl SimSerial {
         if sent && let Some(w) = l.reader.take() {
             w.wake();
         }
+    }
+
+    /// The most bytes the host ever had sent that the firmware had not read yet.
+    pub fn most_unread(&self) -> usize {
+        self.link.borrow().most_unread
     }
 
     /// Also print every answer on standard output as it is written.
@@ -179,7 +188,7 @@ impl SimSerial {
         };
         match got {
             Ok(bytes) => {
-                l.input.extend(bytes);
+                l.push_input(bytes);
                 l.live = Some(rx);
                 if let Some(w) = l.reader.take() {
                     w.wake();
@@ -199,6 +208,12 @@ impl SimSerial {
 }
 
 impl Link {
+    /// The host sends `bytes`.
+    fn push_input(&mut self, bytes: impl IntoIterator<Item = u8>) {
+        self.input.extend(bytes);
+        self.most_unread = self.most_unread.max(self.input.len());
+    }
+
     /// Sends the next paced line, if no answer is owed.
     fn send_next_line(&mut self) {
         if self.owed > 0 {
@@ -209,7 +224,7 @@ impl Link {
             if line.ends_with(b"\n") {
                 self.owed += 1;
             }
-            self.input.extend(line);
+            self.push_input(line);
             if let Some(w) = self.reader.take() {
                 w.wake();
             }

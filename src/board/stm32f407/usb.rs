@@ -9,6 +9,11 @@
 //! the line the host was in the middle of sending. A host that keeps the port open but stops
 //! reading loses what is written to it after `USB_WRITE_TIMEOUT_MS` rather than stalling the
 //! other link.
+//!
+//! The port holds the host back: the driver takes one packet from the host and then answers the
+//! next with NAK until the packet has been read, and a packet is read only once the last one has
+//! been taken. A host link that reads only when it has room therefore never loses a byte: the
+//! host's writes wait meanwhile.
 
 use embassy_executor::Spawner;
 use embassy_futures::select::{Either, select};
