@@ -1,6 +1,6 @@
 //! The USB port's own flow control, on the simulated board: the port holds the host back while
 //! the plotter has no room, so a paste written all at once, without waiting for answers, runs
-//! every line.
+//! every line; and a host opening the port (DTR set) is greeted with the banner, nothing reset.
 
 use servoplot::geom::Point;
 use servoplot::sim::{self, SimConfig, SimReport, serial::SimSerial};
@@ -55,6 +55,43 @@ fn a_paste_of_100_kb_over_usb_runs_every_line() {
     }
     assert_eq!(report.position, *targets.last().unwrap());
     assert_eq!(*path.last().unwrap(), report.position);
+}
+
+#[test]
+fn a_host_opening_the_port_gets_the_banner_and_nothing_is_reset() {
+    // Relative moves: a reset would bring back G90, and the last line would go elsewhere.
+    let usb = || paste(paste(SimSerial::default(), 0, b"G91\nG1 X50 F600\n"), 2_000_000, b"G1 Y1\n");
+    let reference = run(SimSerial::default(), usb());
+    let opened = usb().with_opening_at(1_000_000);
+    let report = run(SimSerial::default(), opened.clone());
+    let banner = "Grbl 1.1h ['$' for help]";
+    let text = report.usb_answers();
+    assert_eq!(text.matches(banner).count(), 2, "power-on and opening: {text}");
+    let greeted: Vec<u64> = opened.timed_lines().into_iter().filter(|(_, l)| l == banner).map(|(t, _)| t).collect();
+    assert!((1_000_000..1_010_000).contains(&greeted[1]), "greeted when the port opened: {greeted:?}");
+    assert_eq!(line_answers(&text), ["ok"; 3], "{text}");
+    assert!(!report.answers().contains("Reset"), "the UART was told of no reset: {}", report.answers());
+    // The move under way went on, and the next line planned on from it.
+    let pulses_between =
+        |from: u64, to: u64| report.trace.pulses.iter().filter(|p| (from..to).contains(&p.t_us)).count();
+    assert!(pulses_between(900_000, 1_000_000) > 0 && pulses_between(1_000_000, 1_100_000) > 0, "moving through it");
+    assert_eq!(report.path(), reference.path());
+    assert_eq!(report.last_pulse_us(), reference.last_pulse_us());
+    assert_eq!(report.position, Point::new(5_000, 100));
+}
+
+#[test]
+fn a_host_closing_the_port_and_opening_it_again_is_greeted_again() {
+    // The line cut off by the closing is dropped; the banner comes before the next session's
+    // answers.
+    let usb = paste(SimSerial::default(), 0, b"G1 X5 F3000\nG1 Y");
+    let usb = paste(usb.with_closing_at(100_000).with_opening_at(150_000), 200_000, b"G1 X7\n");
+    let report = run(SimSerial::default(), usb);
+    let text = report.usb_answers();
+    assert_eq!(line_answers(&text), ["ok"; 2], "{text}");
+    let reopened = text.rfind("Grbl 1.1h").expect("a banner");
+    assert!(text.matches("Grbl 1.1h").count() == 2 && reopened < text.rfind("ok").unwrap(), "{text}");
+    assert_eq!(report.position, Point::new(700, 0));
 }
 
 /// `G1` lines to each of `targets`, in mm.

@@ -44,8 +44,10 @@
 //! wake it too, and are saved once the machine has stopped. At power-on the startup blocks kept
 //! there run, answered on every link.
 //!
-//! A link whose port can be closed (USB) reports each closing as a read error of kind
-//! `NotConnected`: the line the host was sending when it closed the port is dropped.
+//! A link whose port its host opens and closes (USB: DTR set and cleared) reports each change
+//! once, as a read error of kind [`PORT_OPENED`] or [`PORT_CLOSED`]. A closing drops the line the
+//! host was sending when it closed the port; an opening greets the link with the banner, as a
+//! reset does, and resets nothing: a sender that opens the port learns the version at once.
 
 mod dropped;
 mod link;
@@ -88,6 +90,11 @@ pub const SERIAL_LINKS: usize = 2;
 /// cannot hold its host back; the second its USB port, which can. The simulator's second link
 /// and the QEMU model's second UART stand for the USB port: their hosts' bytes wait until read.
 pub const LINK_FLOWS: [Flow; SERIAL_LINKS] = [Flow::Dropping, Flow::Waiting];
+/// The kind of read error a port reports once when its host closes it.
+pub const PORT_CLOSED: ErrorKind = ErrorKind::NotConnected;
+/// The kind of read error a port reports once when its host opens it: the read was interrupted
+/// by the news, and the next one reads on.
+pub const PORT_OPENED: ErrorKind = ErrorKind::Interrupted;
 /// After a read error (noise, overrun), a receiver waits this long before reading on.
 pub const SERIAL_ERROR_BACKOFF_MS: u64 = 1;
 /// How often waits for the machine to come to rest (G4, M0, M2) look again.
@@ -264,7 +271,8 @@ async fn receive<R: Read>(host: &Host<'_>, link: &Link, mut rx: R) -> ! {
     loop {
         match rx.read(&mut buf).await {
             Ok(n) => host.received(link, &buf[..n]).await,
-            Err(e) if e.kind() == ErrorKind::NotConnected => link.closed().await,
+            Err(e) if e.kind() == PORT_CLOSED => link.closed().await,
+            Err(e) if e.kind() == PORT_OPENED => link.send(Reply::Welcome(host.machine.state())).await,
             Err(_) => {
                 warn!("host link read error");
                 Timer::after(Duration::from_millis(SERIAL_ERROR_BACKOFF_MS)).await;
