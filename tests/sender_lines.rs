@@ -27,7 +27,8 @@ fn diagonal_lines(range: std::ops::RangeInclusive<u32>) -> String {
 }
 
 /// Every line pasted gets one answer, in order; a line answered `ok` is drawn, one answered
-/// `error:11` is not; a line sent afterwards is answered and drawn as usual.
+/// `error:100` (dropped: the receive buffer was full) is not; a line sent afterwards is answered
+/// and drawn as usual.
 fn check_paste(count: u32) {
     let first = "G1 X50 F1200\n";
     let pasted = diagonal_lines(10..=9 + count);
@@ -46,7 +47,7 @@ fn check_paste(count: u32) {
         let reached = path[from..].iter().position(|p| *p == target);
         match answer.as_str() {
             "ok" => from += reached.unwrap_or_else(|| panic!("line {k} was answered ok but not drawn")),
-            "error:11" => assert_eq!(reached, None, "line {k} was refused but drawn"),
+            "error:100" => assert_eq!(reached, None, "line {k} was refused but drawn"),
             other => panic!("line {k}: {other}"),
         }
     }
@@ -68,8 +69,13 @@ fn a_paste_beyond_the_receive_buffer_answers_every_line_in_order() {
     }
     let report = run(paste(SimSerial::with_input(b"G1 X50 F1200\n"), 1_000, &diagonal_lines(10..=409)));
     let got = answers(&report);
-    assert!(got.iter().any(|a| a == "error:11"), "the paste overflowed: {}", report.answers());
-    assert!(report.answers().contains("[MSG:Receive buffer full: lines dropped, each answered error:11]"));
+    assert!(got.iter().any(|a| a == "error:100"), "the paste overflowed: {}", report.answers());
+    assert!(!got.iter().any(|a| a == "error:11"), "no line was too long: {}", report.answers());
+    // Said once, before the first of them.
+    let text = report.answers();
+    let said = "[MSG:Receive buffer full: lines dropped, each answered error:100; use a streaming sender]";
+    assert_eq!(text.matches(said).count(), 1, "{text}");
+    assert!(text.find(said) < text.find("error:100"), "{text}");
 }
 
 #[test]

@@ -18,7 +18,9 @@
 //!
 //! # Error numbers
 //!
-//! Every error is a GRBL 1.1 error number, so senders show their usual text for it:
+//! Every error but one is a GRBL 1.1 error number, so senders show their usual text for it; the
+//! plotter's own (100 and up, numbers neither GRBL nor grblHAL use) come after a `[MSG:...]`
+//! saying what they mean:
 //!
 //! | N  | [`GrblError`]             | when |
 //! |----|---------------------------|------|
@@ -30,7 +32,7 @@
 //! | 5  | `SettingDisabled`         | `$H`: the plotter has no homing switches |
 //! | 8  | `NotIdle`                 | `$J=` while a program runs (a move queued or drawing), held or in alarm; a setting, `$Nn=`, `$I=`, `$SLP` while held, jogging or homing (behind a running program they wait for it); `$RST=` and `$C` unless at rest |
 //! | 9  | `Locked`                  | G-code or a curve command while in alarm (unlock with `$X`) or jogging; any line while asleep (`$SLP`, until a reset); a move still waiting for room in the job queue when an abort (keypad D, jog cancel, a curve stopped part way, a reset on the other host link) dropped what was planned |
-//! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`]; a line dropped for want of room in the receive buffer |
+//! | 11 | `LineOverflow`            | a line longer than [`LINE_MAX_BYTES`] |
 //! | 14 | `LineLengthExceeded`      | a `$Nn=` startup block longer than [`startup::STARTUP_LINE_MAX_BYTES`] |
 //! | 15 | `TravelExceeded`          | any point of a move or curve outside ±max travel (`$130`, `$131`) |
 //! | 16 | `InvalidJog`              | a `$J=` line with a word or command jogging does not allow |
@@ -54,6 +56,7 @@
 //! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |
 //! | 36 | `UnusedWords`             | a word no command in the line uses (`G0 X1 P2`, `I5` without an arc, `L2` without G10) |
 //! | 38 | `MaxValueExceeded`        | T above 255, dwell above [`gcode::DWELL_MAX_MS`] |
+//! | 100 | `ReceiveBufferFull`      | a line dropped on a link without flow control (the UART) for want of room in the receive buffer: a paste that ignored GRBL's flow control |
 //!
 //! GRBL's soft limits raise an alarm; the plotter answers `error:15` instead and moves nothing,
 //! which is safer and tells the sender which line was refused.
@@ -106,6 +109,8 @@ pub enum GrblError {
     NoOffsetsInPlane,
     UnusedWords,
     MaxValueExceeded,
+    /// A line dropped whole, unread, because the receive buffer was full when it came.
+    ReceiveBufferFull,
     /// The expression of `$F` does not parse; `column` is 1-based within the line.
     Expression {
         column: u16,
@@ -164,6 +169,7 @@ impl GrblError {
             GrblError::NoOffsetsInPlane => 35,
             GrblError::UnusedWords => 36,
             GrblError::MaxValueExceeded => 38,
+            GrblError::ReceiveBufferFull => 100,
         }
     }
 }

@@ -1,11 +1,13 @@
 //! The simulated host link: bytes in from a file or standard input, answers out to a buffer
 //! (and optionally standard output), through the same embedded-io traits as the UART.
 //!
-//! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next
-//! line goes out once the firmware has answered the previous one with `ok` or `error:N`. Live
-//! standard input is passed on as typed. A link can also be closed by its host at a given time,
-//! as a USB serial port is when the sender closes it: the read after the bytes sent before then
-//! reports the closing.
+//! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next line
+//! goes out once the firmware has answered the previous one with `ok` or `error:N`. Live standard
+//! input is passed on as typed. Bytes wait here until the firmware reads them, as a USB port holds
+//! back its host's writes (the most that waited is kept, [`SimSerial::most_unread`]); on the UART
+//! the firmware reads on, and drops what finds no room. A link can also be opened and closed by its
+//! host at given times, as a sender opens and closes a USB serial port (DTR set and cleared): the
+//! read after the bytes sent before then reports the change, as the board's USB port does.
 
 use core::future::poll_fn;
 use core::task::{Poll, Waker};
@@ -16,6 +18,17 @@ use std::rc::Rc;
 use std::sync::mpsc;
 use std::vec::Vec;
 
+use crate::tasks::serial::{PORT_CLOSED, PORT_OPENED};
+
+/// What the host did to the port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PortChange {
+    /// Opened it: DTR set.
+    Opened,
+    /// Closed it: DTR cleared.
+    Closed,
+}
+
 #[derive(Default)]
 struct Link {
     input: VecDeque<u8>,
@@ -23,10 +36,15 @@ struct Link {
     unsent: VecDeque<Vec<u8>>,
     /// Bytes sent at given virtual times, in order (a person pressing `!` mid-drawing).
     timed: VecDeque<(u64, u8)>,
-    /// Virtual times the host closes the port, in order.
-    closings: VecDeque<u64>,
-    /// The host closed the port after this many of the input bytes; not reported yet.
-    closed_after: Option<usize>,
+    /// Virtual times the host opens or closes the port, in order.
+    changes: VecDeque<(u64, PortChange)>,
+    /// Changes made, each after this many input bytes in all; not read yet.
+    changed: VecDeque<(usize, PortChange)>,
+    /// Input bytes sent in all, and read by the firmware in all.
+    sent: usize,
+    read: usize,
+    /// The most input bytes ever waiting to be read.
+    most_unread: usize,
     /// A reset (0x18) went out and its banner has not come back yet.
     reset_sent: bool,
     /// Answers (`ok` / `error:`) still owed for lines sent.
@@ -92,42 +110,55 @@ impl SimSerial {
 
     /// Also closes the port at virtual time `t_us`, after the bytes sent before then.
     pub fn with_closing_at(self, t_us: u64) -> Self {
+        self.with_change_at(t_us, PortChange::Closed)
+    }
+
+    /// Also opens the port (raises DTR) at virtual time `t_us`, after the bytes sent before then,
+    /// as a sender does when it opens the USB port. The port counts as open from the start.
+    pub fn with_opening_at(self, t_us: u64) -> Self {
+        self.with_change_at(t_us, PortChange::Opened)
+    }
+
+    fn with_change_at(self, t_us: u64, change: PortChange) -> Self {
         {
             let mut l = self.link.borrow_mut();
-            let i = l.closings.partition_point(|t| *t <= t_us);
-            l.closings.insert(i, t_us);
+            let i = l.changes.partition_point(|(t, _)| *t <= t_us);
+            l.changes.insert(i, (t_us, change));
         }
         self
     }
 
-    /// When the next timed byte or closing is due.
+    /// When the next timed byte or change of the port is due.
     pub fn next_timed_us(&self) -> Option<u64> {
         let l = self.link.borrow();
         let byte = l.timed.front().map(|(t, _)| *t);
-        let closing = l.closings.front().copied();
-        byte.into_iter().chain(closing).min()
+        let change = l.changes.front().map(|(t, _)| *t);
+        byte.into_iter().chain(change).min()
     }
 
-    /// Sends the timed bytes due by now, and closes the port if that is due; in time order.
+    /// Sends the timed bytes due by now, and opens or closes the port if that is due; in time
+    /// order.
     pub fn deliver_due(&self) {
         let now = crate::sim::clock::now_ticks();
         let mut l = self.link.borrow_mut();
         let mut sent = false;
         loop {
             let byte_at = l.timed.front().map(|(t, _)| *t).filter(|t| *t <= now);
-            let closing_at = l.closings.front().copied().filter(|t| *t <= now);
-            let closing_first = match (byte_at, closing_at) {
+            let change_at = l.changes.front().map(|(t, _)| *t).filter(|t| *t <= now);
+            let change_first = match (byte_at, change_at) {
                 (None, None) => break,
-                // Bytes sent at the time of a closing go before it.
+                // Bytes sent at the time of a change go before it.
                 (Some(tb), Some(tc)) => tc < tb,
                 (Some(_), None) => false,
                 (None, Some(_)) => true,
             };
-            if closing_first {
-                l.closings.pop_front();
-                l.closed_after = Some(l.input.len());
+            if change_first {
+                if let Some((_, change)) = l.changes.pop_front() {
+                    let after = l.sent;
+                    l.changed.push_back((after, change));
+                }
             } else if let Some((_, b)) = l.timed.pop_front() {
-                l.input.push_back(b);
+                l.push_input(core::iter::once(b));
                 l.reset_sent |= b == 0x18;
             }
             sent = true;
@@ -135,6 +166,11 @@ impl SimSerial {
         if sent && let Some(w) = l.reader.take() {
             w.wake();
         }
+    }
+
+    /// The most bytes the host ever had sent that the firmware had not read yet.
+    pub fn most_unread(&self) -> usize {
+        self.link.borrow().most_unread
     }
 
     /// Also print every answer on standard output as it is written.
@@ -159,8 +195,8 @@ impl SimSerial {
         l.input.is_empty()
             && l.unsent.is_empty()
             && l.timed.is_empty()
-            && l.closings.is_empty()
-            && l.closed_after.is_none()
+            && l.changes.is_empty()
+            && l.changed.is_empty()
             && (l.live.is_none() || l.live_ended)
     }
 
@@ -179,7 +215,7 @@ impl SimSerial {
         };
         match got {
             Ok(bytes) => {
-                l.input.extend(bytes);
+                l.push_input(bytes);
                 l.live = Some(rx);
                 if let Some(w) = l.reader.take() {
                     w.wake();
@@ -199,6 +235,14 @@ impl SimSerial {
 }
 
 impl Link {
+    /// The host sends `bytes`.
+    fn push_input(&mut self, bytes: impl IntoIterator<Item = u8>) {
+        let before = self.input.len();
+        self.input.extend(bytes);
+        self.sent += self.input.len() - before;
+        self.most_unread = self.most_unread.max(self.input.len());
+    }
+
     /// Sends the next paced line, if no answer is owed.
     fn send_next_line(&mut self) {
         if self.owed > 0 {
@@ -209,7 +253,7 @@ impl Link {
             if line.ends_with(b"\n") {
                 self.owed += 1;
             }
-            self.input.extend(line);
+            self.push_input(line);
             if let Some(w) = self.reader.take() {
                 w.wake();
             }
@@ -240,45 +284,54 @@ impl Link {
     }
 }
 
-/// The host closed the port: the one way a read of the simulated link ends without bytes.
+/// The host opened or closed the port: the one way a read of the simulated link ends without
+/// bytes, reported as the board's USB port reports it.
 #[derive(Debug)]
-pub struct PortClosed;
+pub struct PortChanged(pub PortChange);
 
-impl core::fmt::Display for PortClosed {
+impl core::fmt::Display for PortChanged {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("port closed")
+        f.write_str(match self.0 {
+            PortChange::Opened => "port opened",
+            PortChange::Closed => "port closed",
+        })
     }
 }
 
-impl core::error::Error for PortClosed {}
+impl core::error::Error for PortChanged {}
 
-impl embedded_io_async::Error for PortClosed {
+impl embedded_io_async::Error for PortChanged {
     fn kind(&self) -> embedded_io_async::ErrorKind {
-        embedded_io_async::ErrorKind::NotConnected
+        match self.0 {
+            PortChange::Opened => PORT_OPENED,
+            PortChange::Closed => PORT_CLOSED,
+        }
     }
 }
 
 impl embedded_io_async::ErrorType for SimSerial {
-    type Error = PortClosed;
+    type Error = PortChanged;
 }
 
 impl embedded_io_async::Read for SimSerial {
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
         poll_fn(|cx| {
             let mut l = self.link.borrow_mut();
-            if l.closed_after == Some(0) {
-                l.closed_after = None;
-                return Poll::Ready(Err(PortClosed));
+            let next_change = l.changed.front().copied();
+            if let Some((after, change)) = next_change
+                && after == l.read
+            {
+                l.changed.pop_front();
+                return Poll::Ready(Err(PortChanged(change)));
             }
             if l.input.is_empty() {
                 // A UART with nothing received simply waits; it never reports an end.
                 l.reader = Some(cx.waker().clone());
                 return Poll::Pending;
             }
-            let n = buf.len().min(l.input.len()).min(l.closed_after.unwrap_or(usize::MAX));
-            if let Some(before) = l.closed_after.as_mut() {
-                *before -= n;
-            }
+            let before_change = next_change.map_or(usize::MAX, |(after, _)| after - l.read);
+            let n = buf.len().min(l.input.len()).min(before_change);
+            l.read += n;
             for (dst, src) in buf.iter_mut().zip(l.input.drain(..n)) {
                 *dst = src;
             }

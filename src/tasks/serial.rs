@@ -26,12 +26,17 @@
 //! a long curve is built; the line is kept by the parser, and its jobs queued, only once its
 //! curve is built. A reset on the line's link meanwhile abandons it, unanswered.
 //!
-//! Every line gets exactly one answer, in order, on its own link, whatever the sender does. A
-//! sender that ignores GRBL's flow control and sends more than its pipe holds while the machine
-//! is busy loses whole lines, never parts of them: from the byte that found no room up to the
-//! end of a line, the receiver drops the lines' bytes and counts their ends; once the line loop
-//! has emptied the pipe it answers each of those lines `error:11` (not processed), and only then
-//! does the receiver pass bytes on again, from the start of the next line.
+//! Every line gets exactly one answer, in order, on its own link, whatever the sender does. What
+//! happens to a sender that ignores GRBL's flow control and sends more than its pipe holds while
+//! the machine is busy depends on the link's port ([`Flow`], [`LINK_FLOWS`]). The USB port holds
+//! the host back: the receiver waits for room, reads nothing meanwhile (the host's writes wait),
+//! and every line runs; a realtime byte the host sent behind such a paste acts once the bytes
+//! before it have found room. The UART cannot hold the host back, so there such a sender loses
+//! whole lines, never parts of them: from the byte that found no room up to the end of a line,
+//! the receiver drops the lines' bytes and counts their ends, after one `[MSG:Receive buffer
+//! full...]`; once the line loop has emptied the pipe it answers each of those lines `error:100`
+//! (not processed), and only then does the receiver pass bytes on again, from the start of the
+//! next line. Realtime bytes are read meanwhile.
 //!
 //! The line loop owns the flash store: once a line has changed what a power cycle keeps
 //! (settings, G54–G59, G28/G30, startup blocks, build info), it waits for the machine to stop
@@ -39,8 +44,10 @@
 //! wake it too, and are saved once the machine has stopped. At power-on the startup blocks kept
 //! there run, answered on every link.
 //!
-//! A link whose port can be closed (USB) reports each closing as a read error of kind
-//! `NotConnected`: the line the host was sending when it closed the port is dropped.
+//! A link whose port its host opens and closes (USB: DTR set and cleared) reports each change
+//! once, as a read error of kind [`PORT_OPENED`] or [`PORT_CLOSED`]. A closing drops the line the
+//! host was sending when it closed the port; an opening greets the link with the banner, as a
+//! reset does, and resets nothing: a sender that opens the port learns the version at once.
 
 mod dropped;
 mod link;
@@ -73,12 +80,21 @@ use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
 use link::{CLOSED_MARK, Intake, Link, RESET_MARK, write_answers};
 pub use link::{
-    SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
+    Flow, SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
     SERIAL_RX_WINDOW_BYTES,
 };
 
 /// Host links served: the board's UART and USB port, the simulator's two serial links.
 pub const SERIAL_LINKS: usize = 2;
+/// What each link's receiver does when its pipe is full: the first link is the board's UART, which
+/// cannot hold its host back; the second its USB port, which can. The simulator's second link
+/// and the QEMU model's second UART stand for the USB port: their hosts' bytes wait until read.
+pub const LINK_FLOWS: [Flow; SERIAL_LINKS] = [Flow::Dropping, Flow::Waiting];
+/// The kind of read error a port reports once when its host closes it.
+pub const PORT_CLOSED: ErrorKind = ErrorKind::NotConnected;
+/// The kind of read error a port reports once when its host opens it: the read was interrupted
+/// by the news, and the next one reads on.
+pub const PORT_OPENED: ErrorKind = ErrorKind::Interrupted;
 /// After a read error (noise, overrun), a receiver waits this long before reading on.
 pub const SERIAL_ERROR_BACKOFF_MS: u64 = 1;
 /// How often waits for the machine to come to rest (G4, M0, M2) look again.
@@ -109,7 +125,7 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
         machine,
         refresh: RefCell::new(Refresh::new()),
         startup: RefCell::new(store.kept().startup.clone()),
-        links: [Link::new(), Link::new()],
+        links: [Link::new(LINK_FLOWS[0]), Link::new(LINK_FLOWS[1])],
     };
     for link in &host.links {
         // The writers are not running yet: each outbox has room for this first answer.
@@ -257,7 +273,8 @@ async fn receive<R: Read>(host: &Host<'_>, link: &Link, mut rx: R) -> ! {
     loop {
         match rx.read(&mut buf).await {
             Ok(n) => host.received(link, &buf[..n]).await,
-            Err(e) if e.kind() == ErrorKind::NotConnected => link.closed().await,
+            Err(e) if e.kind() == PORT_CLOSED => link.closed().await,
+            Err(e) if e.kind() == PORT_OPENED => link.send(Reply::Welcome(host.machine.state())).await,
             Err(_) => {
                 warn!("host link read error");
                 Timer::after(Duration::from_millis(SERIAL_ERROR_BACKOFF_MS)).await;
@@ -323,7 +340,7 @@ async fn lines<F: NorFlash>(
                 // Lines whose bytes found no room: the partial one in the assembler is the first.
                 assembler.clear();
                 for _ in 0..n {
-                    link.send(Reply::Error(GrblError::LineOverflow)).await;
+                    link.send(Reply::Error(GrblError::ReceiveBufferFull)).await;
                 }
             }
             Intake::Bytes(n) => {

@@ -5,10 +5,15 @@
 //! The port is open while the host holds DTR set, as serial programs do from opening a port to
 //! closing it. While it is closed (or the cable is out) reads wait for the next opening and
 //! answers go nowhere, as a UART's do with no cable: a closed port never holds up the host link.
-//! Each closing is read once as a [`UsbSerialError::Closed`] error, so the host link can drop
-//! the line the host was in the middle of sending. A host that keeps the port open but stops
-//! reading loses what is written to it after `USB_WRITE_TIMEOUT_MS` rather than stalling the
-//! other link.
+//! Each opening is read once as a [`UsbSerialError::Opened`] error, so the host link can greet
+//! the host, and each closing once as a [`UsbSerialError::Closed`] error, so it can drop the line
+//! the host was in the middle of sending. A host that keeps the port open but stops reading
+//! loses what is written to it after `USB_WRITE_TIMEOUT_MS` rather than stalling the other link.
+//!
+//! The port holds the host back: the driver takes one packet from the host and then answers the
+//! next with NAK until the packet has been read, and a packet is read only once the last one has
+//! been taken. A host link that reads only when it has room therefore never loses a byte: the
+//! host's writes wait meanwhile.
 
 use embassy_executor::Spawner;
 use embassy_futures::select::{Either, select};
@@ -23,6 +28,7 @@ use embassy_usb::{Builder, UsbDevice};
 use static_cell::StaticCell;
 
 use crate::firmware::polls;
+use servoplot::tasks::serial::{PORT_CLOSED, PORT_OPENED};
 
 /// pid.codes' vendor ID for open hardware, and its test product ID (1209:0001).
 const USB_VID: u16 = 0x1209;
@@ -108,6 +114,8 @@ pub fn start(
 /// Why a read or write on the port did not happen.
 #[derive(Debug, defmt::Format)]
 pub enum UsbSerialError {
+    /// The host opened the port (set DTR) since the last read.
+    Opened,
     /// The host closed the port (or the cable was pulled) since the last read.
     Closed,
     /// The host kept the port open but did not take a packet in time.
@@ -117,6 +125,7 @@ pub enum UsbSerialError {
 impl core::fmt::Display for UsbSerialError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
+            UsbSerialError::Opened => "port opened",
             UsbSerialError::Closed => "port closed",
             UsbSerialError::TimedOut => "host not reading",
         })
@@ -128,7 +137,8 @@ impl core::error::Error for UsbSerialError {}
 impl embedded_io_async::Error for UsbSerialError {
     fn kind(&self) -> embedded_io_async::ErrorKind {
         match self {
-            UsbSerialError::Closed => embedded_io_async::ErrorKind::NotConnected,
+            UsbSerialError::Opened => PORT_OPENED,
+            UsbSerialError::Closed => PORT_CLOSED,
             UsbSerialError::TimedOut => embedded_io_async::ErrorKind::TimedOut,
         }
     }
@@ -171,6 +181,7 @@ impl embedded_io_async::Read for UsbRx {
         if !self.open {
             self.opened().await;
             self.open = true;
+            return Err(UsbSerialError::Opened);
         }
         if self.start == self.end {
             match select(self.rx.read_packet(&mut self.packet), closed(&self.control)).await {

@@ -1,5 +1,5 @@
 //! One link's count of lines dropped for want of room in its pipe: the receiver counts them,
-//! the line loop answers each `error:11` once it has taken every byte that came before them.
+//! the line loop answers each `error:100` once it has taken every byte that came before them.
 
 use core::cell::Cell;
 

@@ -1,7 +1,8 @@
 //! One host link as the serial task sees it: the pipe of line bytes from its receiver to the line
-//! loop, its outbox of whole answers to its writer, and what a reset or a closing of the port
-//! leaves for the line loop to do. Nothing here knows the link's port: only [`write_answers`]
-//! touches it, and the receiver's reads live with the protocol.
+//! loop, what the receiver does when the pipe is full (its [`Flow`]), its outbox of whole answers
+//! to its writer, and what a reset or a closing of the port leaves for the line loop to do.
+//! Nothing here knows the link's port: only [`write_answers`] touches it, and the receiver's
+//! reads live with the protocol.
 
 use core::cell::Cell;
 
@@ -21,7 +22,7 @@ use crate::protocol::report::{self, Reply};
 
 /// Bytes between a link's receiver and the line loop. GRBL senders keep at most 128 unanswered
 /// bytes in flight, so this never fills for them; it also holds a terminal paste of about 50
-/// lines beyond what the machine has room for. Beyond that, see the serial task's documentation.
+/// lines beyond what the machine has room for. Beyond that, see [`Flow`].
 pub const SERIAL_PIPE_BYTES: usize = 1024;
 /// What a sender may assume it can have in flight (reported by `$I` and `Bf:`).
 pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
@@ -29,8 +30,9 @@ pub const SERIAL_RX_WINDOW_BYTES: usize = 128;
 pub const SERIAL_ANSWER_MAX_BYTES: usize = 512;
 /// Whole answers waiting for a link's writer, beyond the one it is writing.
 pub const SERIAL_OUTBOX_ANSWERS: usize = 1;
-/// How long a byte may wait for room in the pipe before it is dropped: the line loop drains
-/// the pipe far faster unless it is waiting for the machine.
+/// On a link whose port does not hold its host back ([`Flow::Dropping`]), how long a byte may
+/// wait for room in the pipe before it is dropped: the line loop drains the pipe far faster
+/// unless it is waiting for the machine.
 pub const SERIAL_PIPE_WAIT_MS: u64 = 20;
 /// Bytes taken from a port, or from a pipe, at a time.
 pub const SERIAL_CHUNK_BYTES: usize = 32;
@@ -46,17 +48,31 @@ pub const CLOSED_MARK: u8 = 0x84;
 /// One answer, written to its link as a whole.
 pub type Answer = String<SERIAL_ANSWER_MAX_BYTES>;
 
+/// What a link's receiver does with a line byte that finds the pipe full.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Flow {
+    /// The port has no flow control (a UART without handshake lines): the host's bytes keep
+    /// arriving, so after `SERIAL_PIPE_WAIT_MS` the byte is dropped, and its line with it, rather
+    /// than holding up the realtime bytes behind it; see the serial task's documentation.
+    Dropping,
+    /// The port holds the host back while the receiver does not read (USB CDC-ACM: the device
+    /// takes the next packet only once the last is read, and the host's write waits): the
+    /// receiver waits for room, and no byte is ever dropped.
+    Waiting,
+}
+
 /// What the line loop has to do next on a link.
 pub enum Intake {
     /// `n` bytes arrived, in the buffer given to [`Link::intake`].
     Bytes(usize),
-    /// Lines dropped for want of room in the pipe, to answer `error:11` each.
+    /// Lines dropped for want of room in the pipe, to answer `error:100` each.
     Dropped(u32),
 }
 
 /// One host link's state, shared by its receiver, its writer and the line loop; all run on one
 /// executor, so plain cells do.
 pub struct Link {
+    flow: Flow,
     outbox: Channel<NoopRawMutex, Answer, SERIAL_OUTBOX_ANSWERS>,
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
     /// Lines dropped for want of room in the pipe; see the serial task's documentation.
@@ -68,8 +84,9 @@ pub struct Link {
 }
 
 impl Link {
-    pub fn new() -> Self {
+    pub fn new(flow: Flow) -> Self {
         Link {
+            flow,
             outbox: Channel::new(),
             bytes: Pipe::new(),
             dropped: Dropped::default(),
@@ -142,11 +159,17 @@ impl Link {
         SERIAL_RX_WINDOW_BYTES.saturating_sub(self.bytes.len())
     }
 
-    /// Passes a byte of a line to the line loop. When the pipe stays full for
-    /// `SERIAL_PIPE_WAIT_MS` (a sender ignoring GRBL's flow control while the line loop waits
-    /// for the machine) the byte is dropped rather than waited for, so realtime bytes behind it
-    /// are still read, and its line with it; see the serial task's documentation.
+    /// Passes a byte of a line to the line loop, once the pipe has room for it. On a link
+    /// [`Flow::Dropping`], when the pipe stays full for `SERIAL_PIPE_WAIT_MS` (a sender ignoring
+    /// GRBL's flow control while the line loop waits for the machine) the byte is dropped rather
+    /// than waited for, so realtime bytes behind it are still read, and its line with it; see the
+    /// serial task's documentation.
     pub async fn line_byte(&self, byte: u8) {
+        if self.flow == Flow::Waiting {
+            // Meanwhile the port takes nothing more from the host.
+            self.bytes.write_all(&[byte]).await;
+            return;
+        }
         let d = &self.dropped;
         if !d.active.get() {
             let wait = Timer::after(Duration::from_millis(SERIAL_PIPE_WAIT_MS));
@@ -154,7 +177,10 @@ impl Link {
                 return;
             }
             d.active.set(true);
-            self.send(Reply::Message("Receive buffer full: lines dropped, each answered error:11")).await;
+            self.send(Reply::Message(
+                "Receive buffer full: lines dropped, each answered error:100; use a streaming sender",
+            ))
+            .await;
         }
         // CR and LF each end a line, as they do for the line assembler.
         if byte == b'\n' || byte == b'\r' {
