@@ -379,7 +379,7 @@ fn write_texts(out: &Path) {
     .expect("writing to a String");
     write!(
         src,
-        "/// u8g2's `boutique_bitmap_7x7` glyph of each character in [`HANZI`], written by build.rs:\n\
+        "/// u8g2's `boutique_bitmap_7x7` glyph of each Chinese character (glyph order), written by build.rs:\n\
          /// 49 bits per glyph, bit `49 * k + 7 * x + y` set where the pixel x from the left, y from the\n\
          /// top of glyph k's 7x7 cell is lit.\n\
          pub const GLYPHS_7X7: [u8; {}] = [\n",

@@ -4,7 +4,7 @@
 //! host: geometry, interpolators, the expression language, the speed planner, the serial
 //! protocol, keypad decoding, the menu and its screen, settings and machine state. The async
 //! loops in [`tasks`] only wait and move values between the core and the pins. The STM32 board
-//! lives in the firmware binary; the simulated board and its command line ([`sim`], host only)
+//! lives in the firmware binary; the simulated board and its command line (`sim`, host only)
 //! live here so tests and benchmarks can drive it.
 #![no_std]
 

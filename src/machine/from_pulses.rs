@@ -1,8 +1,8 @@
 //! What the pulse interrupt writes into the machine, and how its news reaches the tasks. The
 //! interrupt runs above every critical section (they mask every interrupt but it, see
-//! [`crate::critical`]), so it takes no lock and wakes no task itself: it leaves its news in the
+//! `critical`, on the chip), so it takes no lock and wakes no task itself: it leaves its news in the
 //! machine's pulse news (atomics only), and the board then pends an interrupt below it whose
-//! handler hands the news on ([`Machine::deliver_pulse_news`]): the trip to the motion task, the
+//! handler hands the news on ([`Machine::deliver_pulse_news`](crate::machine::Machine::deliver_pulse_news)): the trip to the motion task, the
 //! stop to those waiting for it, the warnings to the log.
 
 use core::sync::atomic::Ordering;

@@ -29,7 +29,7 @@ pub const CHUNK_RING_LEN: usize = STEP_RING_LEN / CHUNK_STEPS;
 pub const CHUNK_STEPS: usize = 32;
 
 /// Steps per chunk on a straight line
-/// ([`Interpolator::is_straight`](crate::interp::Interpolator::is_straight)): its steps all have
+/// ([`Interpolator::straight_steps_left`](crate::interp::Interpolator::straight_steps_left)): its steps all have
 /// the same length and caps.
 pub const STRAIGHT_CHUNK_STEPS: usize = 256;
 

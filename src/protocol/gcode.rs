@@ -21,7 +21,7 @@
 //! - G0, G1 (X Y, F), G2/G3 with I J centre offsets or an R radius (negative R: the arc longer
 //!   than half a circle), full circles when the end equals the start (`G91 G2 X0 Y0 I10`; as in
 //!   GRBL the end must be written, `G2 I10` alone is error 26); radii up to
-//!   [`CURVE_RADIUS_MAX_MM`];
+//!   [`CURVE_RADIUS_MAX_MM`](crate::drawing::CURVE_RADIUS_MAX_MM);
 //! - G4 P dwell (seconds), G17 (G18/G19 refused), G20/G21, G90/G91, G91.1, G80, and the header
 //!   no-ops G40, G49, G61, G94;
 //! - work coordinates, below: G54–G59, G10 L2 / L20, G28 / G30, G28.1 / G30.1, G92 / G92.1, G53;

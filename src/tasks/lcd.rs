@@ -7,7 +7,7 @@
 //! in the [`Panel`] the keypad task changes: only while a frame is worked out and drawn into the
 //! picture, never while the task waits or sends.
 //! While a run is under way the task reads the pen's position every `PREVIEW_SAMPLE_MS` into
-//! the run's [`Trail`]: the path of the steps emitted, read from the position the pulse engine
+//! the run's [`Trail`](crate::ui::trail::Trail): the path of the steps emitted, read from the position the pulse engine
 //! counts, which costs the motion and the pulses nothing.
 
 pub mod st7920;
