@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::string::{String, ToString};
+use std::string::String;
 use std::vec::Vec;
 use std::{eprintln, format};
 
@@ -14,6 +14,17 @@ use crate::store::STORE_SECTORS;
 /// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
 const DEMO_GCODE: &str = include_str!("../../demo/demo.gcode");
 const DEMO_KEYS: &str = include_str!("../../demo/demo.keys");
+
+/// The built-in demo, as `servoplot` with no input runs it: the PC's drawing streamed over the
+/// serial link, then the keypad script, once that drawing is done.
+pub fn demo() -> Result<SimConfig, String> {
+    Ok(SimConfig {
+        serial: SimSerial::with_input(DEMO_GCODE.as_bytes()),
+        keys: KeyScript::parse(DEMO_KEYS).map_err(|e| format!("demo/demo.keys: {e}"))?,
+        keys_start: KeysStart::AfterSerial,
+        ..SimConfig::default()
+    })
+}
 
 /// At most this many LCD frames are written as PNG files (the last frame always is).
 const LCD_PNG_MAX_FRAMES: usize = 300;
@@ -28,7 +39,8 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
 
   --serial FILE   host-link input, as a GRBL sender would send it (`-` = standard input)
   --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
-                  with --serial it starts once the serial drawing is done
+                  with --serial FILE it starts once the file's last line is answered
+                  and the pen rests (the first key then puts the DONE screen away)
   --keys-text S   the keypad script given inline
   --cpu f407      let the firmware's work take the time it takes on the STM32F407 (as counted
                   on a Cortex-M4F); the summary then tells whether the pulses ever had to wait
@@ -149,35 +161,13 @@ pub fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let demo = args.serial.is_none() && args.keys.is_none();
-    let has_serial = demo || args.serial.is_some();
-    let serial = match args.serial.as_deref() {
-        Some("-") => SimSerial::from_stdin(),
-        Some(path) => match std::fs::read(path) {
-            Ok(bytes) => SimSerial::with_input(&bytes),
-            Err(e) => {
-                eprintln!("error: {path}: {e}");
-                return ExitCode::from(2);
-            }
-        },
-        None if demo => SimSerial::with_input(DEMO_GCODE.as_bytes()),
-        None => SimSerial::default(),
-    };
-    let key_text = if demo { Some(DEMO_KEYS.to_string()) } else { args.keys };
-    let keys = match key_text.as_deref().map(KeyScript::parse).transpose() {
-        Ok(k) => k.unwrap_or_default(),
+    let (serial, keys, keys_start) = match inputs(&args) {
+        Ok(inputs) => inputs,
         Err(e) => {
-            eprintln!("error: keypad script: {e}");
+            eprintln!("error: {e}");
             return ExitCode::from(2);
         }
     };
-    if demo {
-        eprintln!("servoplot simulator: no input given, drawing the built-in demo");
-    }
-    // A keypad script given with a serial file starts once the file's drawing is done; with a
-    // person at the terminal, at once.
-    let keys_start =
-        if has_serial && args.serial.as_deref() != Some("-") { KeysStart::AfterSerial } else { KeysStart::AtOnce };
     let flash = match &args.flash {
         Some(path) => match SimFlash::in_file(path, STORE_SECTORS) {
             Ok(flash) => flash,
@@ -220,6 +210,28 @@ pub fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
+}
+
+/// The host link and the keypad script the command line asks for: the built-in demo if it asks
+/// for neither.
+fn inputs(args: &Args) -> Result<(SimSerial, KeyScript, KeysStart), String> {
+    if args.serial.is_none() && args.keys.is_none() {
+        eprintln!("servoplot simulator: no input given, drawing the built-in demo");
+        let demo = demo()?;
+        return Ok((demo.serial, demo.keys, demo.keys_start));
+    }
+    let keys = args.keys.as_deref().map(KeyScript::parse).transpose().map_err(|e| format!("keypad script: {e}"))?;
+    let (serial, keys_start) = match args.serial.as_deref() {
+        // A person at the terminal: the keys start at once.
+        Some("-") => (SimSerial::from_stdin(), KeysStart::AtOnce),
+        // A file: the keys start once its drawing is done.
+        Some(path) => {
+            let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+            (SimSerial::with_input(&bytes), KeysStart::AfterSerial)
+        }
+        None => (SimSerial::default(), KeysStart::AtOnce),
+    };
+    Ok((serial, keys.unwrap_or_default(), keys_start))
 }
 
 fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {

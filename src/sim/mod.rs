@@ -68,8 +68,8 @@ pub enum KeysStart {
     /// At power-on, alongside the serial input.
     #[default]
     AtOnce,
-    /// Once the serial input is used up and the machine rests (a person steps up to the
-    /// machine after the PC's drawing is done).
+    /// Once every line of the serial input has had its answer and the motion has ended (a
+    /// person steps up to the machine after the PC's drawing is done).
     AfterSerial,
 }
 

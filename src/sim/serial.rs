@@ -126,6 +126,8 @@ impl SimSerial {
             if closing_first {
                 l.closings.pop_front();
                 l.closed_after = Some(l.input.len());
+                // The sender is gone: it waits for no answer any more.
+                l.owed = 0;
             } else if let Some((_, b)) = l.timed.pop_front() {
                 l.input.push_back(b);
                 l.reset_sent |= b == 0x18;
@@ -153,11 +155,13 @@ impl SimSerial {
         self.link.borrow().lines.clone()
     }
 
-    /// True when no input is waiting and none can come any more.
+    /// True when no input is waiting, none can come any more, and every paced line has had its
+    /// answer (a last `G4` answers only once its dwell is over).
     pub fn input_done(&self) -> bool {
         let l = self.link.borrow();
         l.input.is_empty()
             && l.unsent.is_empty()
+            && l.owed == 0
             && l.timed.is_empty()
             && l.closings.is_empty()
             && l.closed_after.is_none()
