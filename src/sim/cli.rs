@@ -1,11 +1,12 @@
 //! The simulator's command line: feeds the simulated board from files, standard input or the
 //! built-in demo, prints the serial answers, and writes the plot and the LCD frames.
 
+use std::format;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::string::String;
 use std::vec::Vec;
-use std::{eprintln, format};
 
 use crate::sim::inputs::{InputScript, Switches};
 use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, serial::SimSerial};
@@ -58,6 +59,14 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
 
+/// A line on standard error; a closed standard error (`servoplot 2>&1 | head`) loses it, and
+/// nothing else.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        let _ = std::writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// Firmware log lines on standard error, stamped with virtual time; the level comes from the
 /// `SERVOPLOT_LOG` variable (`error`, `warn`, `info`, `debug`, `trace`), off when it is unset.
 struct StderrLog;
@@ -69,7 +78,7 @@ impl log::Log for StderrLog {
 
     fn log(&self, record: &log::Record) {
         let t_s = sim::clock::now_ticks() as f64 / 1e6;
-        eprintln!("{t_s:10.6} {:<5} {}", record.level(), record.args());
+        note!("{t_s:10.6} {:<5} {}", record.level(), record.args());
     }
 
     fn flush(&self) {}
@@ -152,19 +161,20 @@ pub fn main() -> ExitCode {
         Ok(a) => a,
         // `--help` asked for the usage: it goes to standard output and is no error.
         Err(e) if e.is_empty() => {
-            std::println!("{USAGE}");
+            // `servoplot --help | head` closes the pipe early: what is cut is no error.
+            let _ = std::writeln!(std::io::stdout(), "{USAGE}");
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            eprintln!("{USAGE}");
+            note!("error: {e}");
+            note!("{USAGE}");
             return ExitCode::from(2);
         }
     };
     let (serial, keys, keys_start) = match inputs(&args) {
         Ok(inputs) => inputs,
         Err(e) => {
-            eprintln!("error: {e}");
+            note!("error: {e}");
             return ExitCode::from(2);
         }
     };
@@ -172,7 +182,7 @@ pub fn main() -> ExitCode {
         Some(path) => match SimFlash::in_file(path, STORE_SECTORS) {
             Ok(flash) => flash,
             Err(e) => {
-                eprintln!("error: --flash {}: {e}", path.display());
+                note!("error: --flash {}: {e}", path.display());
                 return ExitCode::from(2);
             }
         },
@@ -190,20 +200,20 @@ pub fn main() -> ExitCode {
         ..SimConfig::default()
     });
     if with_cpu {
-        eprintln!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
+        note!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
     }
     if report.missed_updates > 0 {
-        eprintln!("missed step timer updates: {}", report.missed_updates);
+        note!("missed step timer updates: {}", report.missed_updates);
     }
     match write_pictures(&report, &args.out) {
         Ok(()) => {}
         Err(e) => {
-            eprintln!("error: writing pictures to {}: {e}", args.out.display());
+            note!("error: writing pictures to {}: {e}", args.out.display());
             return ExitCode::FAILURE;
         }
     }
     if report.timed_out {
-        eprintln!(
+        note!(
             "error: the machine did not come to rest within {} s of virtual time",
             sim::SIM_MAX_VIRTUAL_US / 1_000_000
         );
@@ -216,7 +226,7 @@ pub fn main() -> ExitCode {
 /// for neither.
 fn inputs(args: &Args) -> Result<(SimSerial, KeyScript, KeysStart), String> {
     if args.serial.is_none() && args.keys.is_none() {
-        eprintln!("servoplot simulator: no input given, drawing the built-in demo");
+        note!("servoplot simulator: no input given, drawing the built-in demo");
         let demo = demo()?;
         return Ok((demo.serial, demo.keys, demo.keys_start));
     }
@@ -265,23 +275,23 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
     picture::write_session_gif(&session, &out.join("session.gif"))?;
     let [xf, xb, yf, yb] = report.trace.counts();
     let mm = |axis: usize, steps: i32| steps as f32 / report.settings.steps_per_mm[axis];
-    eprintln!();
-    eprintln!("pulses: X {xf} forward, {xb} back; Y {yf} forward, {yb} back");
-    eprintln!(
+    note!("");
+    note!("pulses: X {xf} forward, {xb} back; Y {yf} forward, {yb} back");
+    note!(
         "final position: X {:.3} mm, Y {:.3} mm; last pulse at {:.3} s of virtual time",
         mm(0, report.position.x),
         mm(1, report.position.y),
         report.last_pulse_us() as f64 / 1e6
     );
-    eprintln!("plot (rebuilt from the pulses): {}", svg_path.display());
-    eprintln!(
+    note!("plot (rebuilt from the pulses): {}", svg_path.display());
+    note!(
         "LCD frames: {} sent, {} distinct, {written} written to {}{}",
         report.frames.len(),
         distinct.len(),
         lcd_dir.display(),
         if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
     );
-    eprintln!("final LCD frame: {}", out.join("lcd-final.png").display());
-    eprintln!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
+    note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    note!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
     Ok(())
 }
