@@ -9,7 +9,7 @@ use std::string::String;
 use std::vec::Vec;
 
 use crate::sim::inputs::{InputScript, Switches};
-use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, serial::SimSerial};
+use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, pty::Pty, serial::SimSerial};
 use crate::store::STORE_SECTORS;
 
 /// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
@@ -31,7 +31,7 @@ pub fn demo() -> Result<SimConfig, String> {
 const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
-usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
+usage: servoplot [--serial FILE|- | --pty] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
                  [--switches MM] [--events FILE] [--out DIR]
 
 Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
@@ -39,6 +39,9 @@ built-in demo. Serial answers go to standard output; the pen path (rebuilt from 
 pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults to `out`).
 
   --serial FILE   host-link input, as a GRBL sender would send it (`-` = standard input)
+  --pty           serve the host link on a pseudo-terminal: its path is printed, for a sender
+                  or a terminal to open as a serial port; time passes as on the wall clock,
+                  and Ctrl-C ends the session
   --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
                   with --serial FILE it starts once the file's last line is answered
                   and the pen rests (the first key then puts the DONE screen away)
@@ -101,6 +104,7 @@ fn init_log() {
 
 struct Args {
     serial: Option<String>,
+    pty: bool,
     keys: Option<String>,
     cpu: Option<sim::cpu::CpuModel>,
     flash: Option<PathBuf>,
@@ -112,6 +116,7 @@ struct Args {
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
         serial: None,
+        pty: false,
         keys: None,
         cpu: None,
         flash: None,
@@ -124,6 +129,7 @@ fn parse_args() -> Result<Args, String> {
         let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
         match a.as_str() {
             "--serial" => args.serial = Some(value()?),
+            "--pty" => args.pty = true,
             "--keys" => {
                 let path = value()?;
                 args.keys = Some(std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?);
@@ -150,6 +156,9 @@ fn parse_args() -> Result<Args, String> {
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
         }
+    }
+    if args.pty && args.serial.is_some() {
+        return Err("--pty and --serial both feed the host link: give one of them".into());
     }
     Ok(args)
 }
@@ -189,6 +198,7 @@ pub fn main() -> ExitCode {
         None => SimFlash::default(),
     };
     let with_cpu = args.cpu.is_some();
+    let live = serial.is_live();
     let report = sim::run(SimConfig {
         flash,
         serial: serial.echo_to_stdout(),
@@ -197,8 +207,17 @@ pub fn main() -> ExitCode {
         cpu: args.cpu,
         switches: args.switches,
         events: args.events,
+        stop: live.then(sim::stop::on_ctrl_c),
         ..SimConfig::default()
     });
+    if let Some((wall_us, virtual_us)) = report.live_kept_us {
+        // How well the virtual clock kept to the wall clock while the session was live.
+        let (wall_s, virtual_s) = (wall_us as f64 / 1e6, virtual_us as f64 / 1e6);
+        note!(
+            "live session: {wall_s:.3} s of wall time, {virtual_s:.3} s of virtual time ({:.3}x)",
+            virtual_s / wall_s.max(f64::MIN_POSITIVE)
+        );
+    }
     if with_cpu {
         note!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
     }
@@ -225,12 +244,21 @@ pub fn main() -> ExitCode {
 /// The host link and the keypad script the command line asks for: the built-in demo if it asks
 /// for neither.
 fn inputs(args: &Args) -> Result<(SimSerial, KeyScript, KeysStart), String> {
+    let keys = args.keys.as_deref().map(KeyScript::parse).transpose().map_err(|e| format!("keypad script: {e}"))?;
+    if args.pty {
+        let pty = Pty::open().map_err(|e| format!("--pty: {e}"))?;
+        note!(
+            "servoplot simulator: host link on {} (connect a sender or a terminal to it; Ctrl-C ends)",
+            pty.path().display()
+        );
+        let serial = SimSerial::from_pty(pty).map_err(|e| format!("--pty: {e}"))?;
+        return Ok((serial, keys.unwrap_or_default(), KeysStart::AtOnce));
+    }
     if args.serial.is_none() && args.keys.is_none() {
         note!("servoplot simulator: no input given, drawing the built-in demo");
         let demo = demo()?;
         return Ok((demo.serial, demo.keys, demo.keys_start));
     }
-    let keys = args.keys.as_deref().map(KeyScript::parse).transpose().map_err(|e| format!("keypad script: {e}"))?;
     let (serial, keys_start) = match args.serial.as_deref() {
         // A person at the terminal: the keys start at once.
         Some("-") => (SimSerial::from_stdin(), KeysStart::AtOnce),

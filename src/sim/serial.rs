@@ -3,9 +3,10 @@
 //!
 //! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next
 //! line goes out once the firmware has answered the previous one with `ok` or `error:N`. Live
-//! standard input is passed on as typed. A link can also be closed by its host at a given time,
-//! as a USB serial port is when the sender closes it: the read after the bytes sent before then
-//! reports the closing.
+//! standard input is passed on as typed, and so is what a sender writes to the pseudo-terminal
+//! of [`SimSerial::from_pty`], which gets the answers back. A link can also be closed by its
+//! host at a given time, as a USB serial port is when the sender closes it: the read after the
+//! bytes sent before then reports the closing.
 
 use core::future::poll_fn;
 use core::task::{Poll, Waker};
@@ -15,6 +16,11 @@ use std::io::Write as _;
 use std::rc::Rc;
 use std::sync::mpsc;
 use std::vec::Vec;
+
+use crate::sim::pty::Pty;
+
+/// Most bytes taken from a live source at once.
+const LIVE_READ_BYTES: usize = 256;
 
 #[derive(Default)]
 struct Link {
@@ -35,8 +41,11 @@ struct Link {
     partial: Vec<u8>,
     /// Every whole line of output (without its line end), with the virtual time it ended.
     lines: Vec<(u64, std::string::String)>,
-    /// Standard input read by a helper thread, when the simulator is driven live.
+    /// Standard input or the pseudo-terminal, read by a thread of its own, when the simulator is
+    /// driven live.
     live: Option<mpsc::Receiver<Vec<u8>>>,
+    /// The pseudo-terminal the answers go to, when a sender drives the link through one.
+    port: Option<Pty>,
     live_ended: bool,
     reader: Option<Waker>,
     output: Vec<u8>,
@@ -64,12 +73,23 @@ impl SimSerial {
 
     /// A link fed live from standard input.
     pub fn from_stdin() -> Self {
+        Self::live(std::io::stdin())
+    }
+
+    /// A link fed live by whatever sender opens the pseudo-terminal's port, and answering it
+    /// there.
+    pub fn from_pty(pty: Pty) -> std::io::Result<Self> {
+        let s = Self::live(pty.reader()?);
+        s.link.borrow_mut().port = Some(pty);
+        Ok(s)
+    }
+
+    /// A link fed live from `source`, read as it sends, until it ends.
+    fn live(mut source: impl std::io::Read + Send + 'static) -> Self {
         let (tx, rx) = mpsc::channel();
         std::thread::spawn(move || {
-            use std::io::Read;
-            let mut buf = [0u8; 256];
-            let mut stdin = std::io::stdin().lock();
-            while let Ok(n @ 1..) = stdin.read(&mut buf) {
+            let mut buf = [0u8; LIVE_READ_BYTES];
+            while let Ok(n @ 1..) = source.read(&mut buf) {
                 if tx.send(buf[..n].to_vec()).is_err() {
                     break;
                 }
@@ -297,6 +317,9 @@ impl embedded_io_async::Write for SimSerial {
         let mut l = self.link.borrow_mut();
         l.output.extend_from_slice(buf);
         l.heard(buf);
+        if let Some(port) = l.port.as_mut() {
+            port.send(buf);
+        }
         if l.echo_stdout {
             let mut out = std::io::stdout().lock();
             let _ = out.write_all(buf);
