@@ -31,12 +31,14 @@ pub fn demo() -> Result<SimConfig, String> {
 const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
-usage: servoplot [--serial FILE|- | --pty] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
-                 [--switches MM] [--events FILE] [--out DIR]
+usage: servoplot [--serial FILE|- | --pty] [--keys FILE] [--keys-text SCRIPT] [--cpu f407]
+                 [--flash FILE] [--switches MM] [--events FILE] [--out DIR]
 
-Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
+Runs the plotter firmware on a simulated board. With no --serial, --pty or --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
-pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults to `out`).
+pulses) goes to DIR/plot.svg, the first 300 LCD frames that differ from the one before to
+DIR/lcd/*.png, the last to DIR/lcd-final.png, and all of them to DIR/session.gif (DIR
+defaults to `out`).
 
   --serial FILE   host-link input, as a GRBL sender would send it (`-` = standard input)
   --pty           serve the host link on a pseudo-terminal: its path is printed, for a sender
