@@ -2,10 +2,12 @@
 //!
 //! The pulse, motion, keypad, serial and LCD loops are the same code as on target; only their
 //! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
-//! pressed by a script, the two host links (the board's UART and USB port) read transcripts or
-//! standard input, and the LCD is a model of the ST7920 fed by the real driver. A run ends when every input is used up and the
-//! machine has come to rest. [`cli`] is the simulator's command line: what the firmware binary
-//! runs when built for the host.
+//! pressed by a script, the two host links (the board's UART and USB port) read transcripts,
+//! standard input or a sender on a pseudo-terminal, and the LCD is a model of the ST7920 fed by
+//! the real driver. A run ends when every input is used up and the machine has come to rest. In
+//! a live session (standard input, a pseudo-terminal) virtual time keeps to the wall clock.
+//! [`cli`] is the simulator's command line: what the firmware binary runs when built for the
+//! host.
 //!
 //! As on the board, the tasks run at two levels: the step timer and the motion task at
 //! interrupt level, polled whenever they are woken; the others in thread mode, polled only
