@@ -1,34 +1,52 @@
 //! The simulator's command line: feeds the simulated board from files, standard input or the
 //! built-in demo, prints the serial answers, and writes the plot and the LCD frames.
 
+use std::format;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::string::{String, ToString};
+use std::string::String;
 use std::vec::Vec;
-use std::{eprintln, format};
 
 use crate::sim::inputs::{InputScript, Switches};
-use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, serial::SimSerial};
+use crate::sim::{self, KeysStart, SimConfig, flash::SimFlash, keys::KeyScript, picture, pty::Pty, serial::SimSerial};
 use crate::store::STORE_SECTORS;
 
 /// The built-in demo: a drawing streamed over the serial link, then one drawn from the keypad.
 const DEMO_GCODE: &str = include_str!("../../demo/demo.gcode");
 const DEMO_KEYS: &str = include_str!("../../demo/demo.keys");
 
+/// The built-in demo, as `servoplot` with no input runs it: the PC's drawing streamed over the
+/// serial link, then the keypad script, once that drawing is done.
+pub fn demo() -> Result<SimConfig, String> {
+    Ok(SimConfig {
+        serial: SimSerial::with_input(DEMO_GCODE.as_bytes()),
+        keys: KeyScript::parse(DEMO_KEYS).map_err(|e| format!("demo/demo.keys: {e}"))?,
+        keys_start: KeysStart::AfterSerial,
+        ..SimConfig::default()
+    })
+}
+
 /// At most this many LCD frames are written as PNG files (the last frame always is).
 const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
-usage: servoplot [--serial FILE|-] [--keys FILE] [--keys-text SCRIPT] [--cpu f407] [--flash FILE]
-                 [--switches MM] [--events FILE] [--out DIR]
+usage: servoplot [--serial FILE|- | --pty] [--keys FILE] [--keys-text SCRIPT] [--cpu f407]
+                 [--flash FILE] [--switches MM] [--events FILE] [--out DIR]
 
-Runs the plotter firmware on a simulated board. With no --serial and no --keys it draws the
+Runs the plotter firmware on a simulated board. With no --serial, --pty or --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
-pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults to `out`).
+pulses) goes to DIR/plot.svg, the first 300 LCD frames that differ from the one before to
+DIR/lcd/*.png, the last to DIR/lcd-final.png, and all of them to DIR/session.gif (DIR
+defaults to `out`).
 
   --serial FILE   host-link input, as a GRBL sender would send it (`-` = standard input)
+  --pty           serve the host link on a pseudo-terminal: its path is printed, for a sender
+                  or a terminal to open as a serial port; time passes as on the wall clock,
+                  and Ctrl-C ends the session
   --keys FILE     keypad script: keys like `1 # A`, `8:1500` holds 8 for 1.5 s, `wait:500`;
-                  with --serial it starts once the serial drawing is done
+                  with --serial FILE it starts once the file's last line is answered
+                  and the pen rests (the first key then puts the DONE screen away)
   --keys-text S   the keypad script given inline
   --cpu f407      let the firmware's work take the time it takes on the STM32F407 (as counted
                   on a Cortex-M4F); the summary then tells whether the pulses ever had to wait
@@ -46,6 +64,14 @@ pulses) goes to DIR/plot.svg and the LCD frames to DIR/lcd/*.png (DIR defaults t
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
 
+/// A line on standard error; a closed standard error (`servoplot 2>&1 | head`) loses it, and
+/// nothing else.
+macro_rules! note {
+    ($($arg:tt)*) => {{
+        let _ = std::writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 /// Firmware log lines on standard error, stamped with virtual time; the level comes from the
 /// `SERVOPLOT_LOG` variable (`error`, `warn`, `info`, `debug`, `trace`), off when it is unset.
 struct StderrLog;
@@ -57,7 +83,7 @@ impl log::Log for StderrLog {
 
     fn log(&self, record: &log::Record) {
         let t_s = sim::clock::now_ticks() as f64 / 1e6;
-        eprintln!("{t_s:10.6} {:<5} {}", record.level(), record.args());
+        note!("{t_s:10.6} {:<5} {}", record.level(), record.args());
     }
 
     fn flush(&self) {}
@@ -80,6 +106,7 @@ fn init_log() {
 
 struct Args {
     serial: Option<String>,
+    pty: bool,
     keys: Option<String>,
     cpu: Option<sim::cpu::CpuModel>,
     flash: Option<PathBuf>,
@@ -91,6 +118,7 @@ struct Args {
 fn parse_args() -> Result<Args, String> {
     let mut args = Args {
         serial: None,
+        pty: false,
         keys: None,
         cpu: None,
         flash: None,
@@ -103,6 +131,7 @@ fn parse_args() -> Result<Args, String> {
         let mut value = || it.next().ok_or_else(|| format!("{a} needs a value"));
         match a.as_str() {
             "--serial" => args.serial = Some(value()?),
+            "--pty" => args.pty = true,
             "--keys" => {
                 let path = value()?;
                 args.keys = Some(std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?);
@@ -130,6 +159,9 @@ fn parse_args() -> Result<Args, String> {
             other => return Err(format!("unknown argument `{other}`")),
         }
     }
+    if args.pty && args.serial.is_some() {
+        return Err("--pty and --serial both feed the host link: give one of them".into());
+    }
     Ok(args)
 }
 
@@ -140,55 +172,35 @@ pub fn main() -> ExitCode {
         Ok(a) => a,
         // `--help` asked for the usage: it goes to standard output and is no error.
         Err(e) if e.is_empty() => {
-            std::println!("{USAGE}");
+            // `servoplot --help | head` closes the pipe early: what is cut is no error.
+            let _ = std::writeln!(std::io::stdout(), "{USAGE}");
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            eprintln!("{USAGE}");
+            note!("error: {e}");
+            note!("{USAGE}");
             return ExitCode::from(2);
         }
     };
-    let demo = args.serial.is_none() && args.keys.is_none();
-    let has_serial = demo || args.serial.is_some();
-    let serial = match args.serial.as_deref() {
-        Some("-") => SimSerial::from_stdin(),
-        Some(path) => match std::fs::read(path) {
-            Ok(bytes) => SimSerial::with_input(&bytes),
-            Err(e) => {
-                eprintln!("error: {path}: {e}");
-                return ExitCode::from(2);
-            }
-        },
-        None if demo => SimSerial::with_input(DEMO_GCODE.as_bytes()),
-        None => SimSerial::default(),
-    };
-    let key_text = if demo { Some(DEMO_KEYS.to_string()) } else { args.keys };
-    let keys = match key_text.as_deref().map(KeyScript::parse).transpose() {
-        Ok(k) => k.unwrap_or_default(),
+    let (serial, keys, keys_start) = match inputs(&args) {
+        Ok(inputs) => inputs,
         Err(e) => {
-            eprintln!("error: keypad script: {e}");
+            note!("error: {e}");
             return ExitCode::from(2);
         }
     };
-    if demo {
-        eprintln!("servoplot simulator: no input given, drawing the built-in demo");
-    }
-    // A keypad script given with a serial file starts once the file's drawing is done; with a
-    // person at the terminal, at once.
-    let keys_start =
-        if has_serial && args.serial.as_deref() != Some("-") { KeysStart::AfterSerial } else { KeysStart::AtOnce };
     let flash = match &args.flash {
         Some(path) => match SimFlash::in_file(path, STORE_SECTORS) {
             Ok(flash) => flash,
             Err(e) => {
-                eprintln!("error: --flash {}: {e}", path.display());
+                note!("error: --flash {}: {e}", path.display());
                 return ExitCode::from(2);
             }
         },
         None => SimFlash::default(),
     };
     let with_cpu = args.cpu.is_some();
+    let live = serial.is_live();
     let report = sim::run(SimConfig {
         flash,
         serial: serial.echo_to_stdout(),
@@ -197,29 +209,69 @@ pub fn main() -> ExitCode {
         cpu: args.cpu,
         switches: args.switches,
         events: args.events,
+        stop: live.then(sim::stop::on_ctrl_c),
         ..SimConfig::default()
     });
+    if let Some((wall_us, virtual_us)) = report.live_kept_us {
+        // How well the virtual clock kept to the wall clock while the session was live.
+        let (wall_s, virtual_s) = (wall_us as f64 / 1e6, virtual_us as f64 / 1e6);
+        note!(
+            "live session: {wall_s:.3} s of wall time, {virtual_s:.3} s of virtual time ({:.3}x)",
+            virtual_s / wall_s.max(f64::MIN_POSITIVE)
+        );
+    }
     if with_cpu {
-        eprintln!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
+        note!("step-queue underruns on the modelled STM32F407: {}", report.underruns);
     }
     if report.missed_updates > 0 {
-        eprintln!("missed step timer updates: {}", report.missed_updates);
+        note!("missed step timer updates: {}", report.missed_updates);
     }
     match write_pictures(&report, &args.out) {
         Ok(()) => {}
         Err(e) => {
-            eprintln!("error: writing pictures to {}: {e}", args.out.display());
+            note!("error: writing pictures to {}: {e}", args.out.display());
             return ExitCode::FAILURE;
         }
     }
     if report.timed_out {
-        eprintln!(
+        note!(
             "error: the machine did not come to rest within {} s of virtual time",
             sim::SIM_MAX_VIRTUAL_US / 1_000_000
         );
         return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
+}
+
+/// The host link and the keypad script the command line asks for: the built-in demo if it asks
+/// for neither.
+fn inputs(args: &Args) -> Result<(SimSerial, KeyScript, KeysStart), String> {
+    let keys = args.keys.as_deref().map(KeyScript::parse).transpose().map_err(|e| format!("keypad script: {e}"))?;
+    if args.pty {
+        let pty = Pty::open().map_err(|e| format!("--pty: {e}"))?;
+        note!(
+            "servoplot simulator: host link on {} (connect a sender or a terminal to it; Ctrl-C ends)",
+            pty.path().display()
+        );
+        let serial = SimSerial::from_pty(pty).map_err(|e| format!("--pty: {e}"))?;
+        return Ok((serial, keys.unwrap_or_default(), KeysStart::AtOnce));
+    }
+    if args.serial.is_none() && args.keys.is_none() {
+        note!("servoplot simulator: no input given, drawing the built-in demo");
+        let demo = demo()?;
+        return Ok((demo.serial, demo.keys, demo.keys_start));
+    }
+    let (serial, keys_start) = match args.serial.as_deref() {
+        // A person at the terminal: the keys start at once.
+        Some("-") => (SimSerial::from_stdin(), KeysStart::AtOnce),
+        // A file: the keys start once its drawing is done.
+        Some(path) => {
+            let bytes = std::fs::read(path).map_err(|e| format!("{path}: {e}"))?;
+            (SimSerial::with_input(&bytes), KeysStart::AfterSerial)
+        }
+        None => (SimSerial::default(), KeysStart::AtOnce),
+    };
+    Ok((serial, keys.unwrap_or_default(), keys_start))
 }
 
 fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
@@ -253,23 +305,23 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
     picture::write_session_gif(&session, &out.join("session.gif"))?;
     let [xf, xb, yf, yb] = report.trace.counts();
     let mm = |axis: usize, steps: i32| steps as f32 / report.settings.steps_per_mm[axis];
-    eprintln!();
-    eprintln!("pulses: X {xf} forward, {xb} back; Y {yf} forward, {yb} back");
-    eprintln!(
+    note!("");
+    note!("pulses: X {xf} forward, {xb} back; Y {yf} forward, {yb} back");
+    note!(
         "final position: X {:.3} mm, Y {:.3} mm; last pulse at {:.3} s of virtual time",
         mm(0, report.position.x),
         mm(1, report.position.y),
         report.last_pulse_us() as f64 / 1e6
     );
-    eprintln!("plot (rebuilt from the pulses): {}", svg_path.display());
-    eprintln!(
+    note!("plot (rebuilt from the pulses): {}", svg_path.display());
+    note!(
         "LCD frames: {} sent, {} distinct, {written} written to {}{}",
         report.frames.len(),
         distinct.len(),
         lcd_dir.display(),
         if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
     );
-    eprintln!("final LCD frame: {}", out.join("lcd-final.png").display());
-    eprintln!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
+    note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    note!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
     Ok(())
 }

@@ -2,10 +2,12 @@
 //!
 //! The pulse, motion, keypad, serial and LCD loops are the same code as on target; only their
 //! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
-//! pressed by a script, the two host links (the board's UART and USB port) read transcripts or
-//! standard input, and the LCD is a model of the ST7920 fed by the real driver. A run ends when every input is used up and the
-//! machine has come to rest. [`cli`] is the simulator's command line: what the firmware binary
-//! runs when built for the host.
+//! pressed by a script, the two host links (the board's UART and USB port) read transcripts,
+//! standard input or a sender on a pseudo-terminal, and the LCD is a model of the ST7920 fed by
+//! the real driver. A run ends when every input is used up and the machine has come to rest. In
+//! a live session (standard input, a pseudo-terminal) virtual time keeps to the wall clock.
+//! [`cli`] is the simulator's command line: what the firmware binary runs when built for the
+//! host.
 //!
 //! As on the board, the tasks run at two levels: the step timer and the motion task at
 //! interrupt level, polled whenever they are woken; the others in thread mode, polled only
@@ -20,8 +22,10 @@ pub mod keys;
 pub mod lcd;
 pub mod picture;
 pub mod pins;
+pub mod pty;
 pub mod serial;
 pub mod step_timer;
+pub mod stop;
 
 use core::future::Future;
 use core::pin::pin;
@@ -68,8 +72,8 @@ pub enum KeysStart {
     /// At power-on, alongside the serial input.
     #[default]
     AtOnce,
-    /// Once the serial input is used up and the machine rests (a person steps up to the
-    /// machine after the PC's drawing is done).
+    /// Once every line of the serial input has had its answer and the motion has ended (a
+    /// person steps up to the machine after the PC's drawing is done).
     AfterSerial,
 }
 
@@ -94,6 +98,8 @@ pub struct SimConfig {
     pub events: InputScript,
     /// A step timer interrupt that comes late (none by default).
     pub late_interrupt: Option<LateInterrupt>,
+    /// Once set, the run ends at the next instant every task waits (Ctrl-C in a live session).
+    pub stop: Option<&'static AtomicBool>,
 }
 
 /// What a simulation produced.
@@ -135,6 +141,9 @@ pub struct SimReport {
     /// The longest the watchdog went unfed, µs: beyond `WATCHDOG_TIMEOUT_MS` the board would
     /// have been reset.
     pub watchdog_unfed_us: u64,
+    /// In a live session, the wall time and the virtual time, µs, that passed while the run held
+    /// the one to the other (until the live input ended).
+    pub live_kept_us: Option<(u64, u64)>,
 }
 
 impl SimReport {
@@ -223,6 +232,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let usb = config.usb;
     let links = [&serial, &usb];
     let cpu = config.cpu;
+    let stop = config.stop;
     let spi = SimSpi::default();
     let lcd =
         St7920Lcd::new(spi.clone(), LcdPin::Reset, LcdPin::ChipSelect(spi.model.clone()), spi.delay(), SIM_LCD_SPI_HZ);
@@ -261,6 +271,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let (irq_waker, thread_waker) = (Waker::from(irq_flag.clone()), Waker::from(thread_flag.clone()));
     let (mut irq_cx, mut thread_cx) = (Context::from_waker(&irq_waker), Context::from_waker(&thread_waker));
     let mut rest_since: Option<u64> = None;
+    let mut wall_pace: Option<clock::WallPace> = None;
+    let mut live_kept_us = None;
     let mut timed_out = false;
     loop {
         // The interrupts first, whenever they are woken, as their priority has them on the board.
@@ -284,6 +296,9 @@ pub fn run(config: SimConfig) -> SimReport {
         if runnable() {
             continue;
         }
+        if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+            break;
+        }
         let now = clock::now_ticks();
         // Thread mode taken: nothing there is at rest, and it takes its tasks up again once free.
         let thread_free_at = thread.busy().then(|| thread.busy_until_us());
@@ -306,11 +321,17 @@ pub fn run(config: SimConfig) -> SimReport {
             (d, free) => d.or(free),
         };
         if serial.is_live() {
-            // A person is at the terminal: let time pass as it does for them (so a `!` typed
-            // mid-move lands mid-move), waiting for their input up to the next deadline.
-            let wait_us = next_deadline.map_or(u64::MAX, |d| d.saturating_sub(now));
-            serial.pump_live(std::time::Duration::from_micros(wait_us));
+            // A person or a sender is at the link: let time pass as it does for them (so a `!`
+            // typed mid-move lands mid-move), waiting for their input until the wall clock
+            // reaches the next deadline.
+            let pace = wall_pace.get_or_insert_with(clock::WallPace::start);
+            if let Some(wait) = next_deadline.map_or(Some(std::time::Duration::MAX), |d| pace.wait_for(d)) {
+                serial.pump_live(wait);
+            }
+            live_kept_us = Some(pace.kept_us());
             if runnable() {
+                // Input came: it arrives at the wall clock's time, never past the next deadline.
+                clock::jump_to(next_deadline.map_or(pace.wall_us(), |d| d.min(pace.wall_us())));
                 continue;
             }
         } else if now >= SIM_MAX_VIRTUAL_US {
@@ -361,6 +382,7 @@ pub fn run(config: SimConfig) -> SimReport {
         pen: pen.changes(),
         led: led.changes(),
         buzzer: buzzer.changes(),
+        live_kept_us,
     }
 }
 

@@ -3,11 +3,13 @@
 //!
 //! Input known in advance is streamed the way GRBL senders stream ("send-response"): the next line
 //! goes out once the firmware has answered the previous one with `ok` or `error:N`. Live standard
-//! input is passed on as typed. Bytes wait here until the firmware reads them, as a USB port holds
-//! back its host's writes (the most that waited is kept, [`SimSerial::most_unread`]); on the UART
-//! the firmware reads on, and drops what finds no room. A link can also be opened and closed by its
-//! host at given times, as a sender opens and closes a USB serial port (DTR set and cleared): the
-//! read after the bytes sent before then reports the change, as the board's USB port does.
+//! input is passed on as typed, and so is what a sender writes to the pseudo-terminal of
+//! [`SimSerial::from_pty`], which gets the answers back. Bytes wait here until the firmware reads
+//! them, as a USB port holds back its host's writes (the most that waited is kept,
+//! [`SimSerial::most_unread`]); on the UART the firmware reads on, and drops what finds no room.
+//! A link can also be opened and closed by its host at given times, as a sender opens and closes
+//! a USB serial port (DTR set and cleared): the read after the bytes sent before then reports the
+//! change, as the board's USB port does.
 
 use core::future::poll_fn;
 use core::task::{Poll, Waker};
@@ -28,6 +30,10 @@ pub enum PortChange {
     /// Closed it: DTR cleared.
     Closed,
 }
+use crate::sim::pty::Pty;
+
+/// Most bytes taken from a live source at once.
+const LIVE_READ_BYTES: usize = 256;
 
 #[derive(Default)]
 struct Link {
@@ -53,8 +59,11 @@ struct Link {
     partial: Vec<u8>,
     /// Every whole line of output (without its line end), with the virtual time it ended.
     lines: Vec<(u64, std::string::String)>,
-    /// Standard input read by a helper thread, when the simulator is driven live.
+    /// Standard input or the pseudo-terminal, read by a thread of its own, when the simulator is
+    /// driven live.
     live: Option<mpsc::Receiver<Vec<u8>>>,
+    /// The pseudo-terminal the answers go to, when a sender drives the link through one.
+    port: Option<Pty>,
     live_ended: bool,
     reader: Option<Waker>,
     output: Vec<u8>,
@@ -82,12 +91,23 @@ impl SimSerial {
 
     /// A link fed live from standard input.
     pub fn from_stdin() -> Self {
+        Self::live(std::io::stdin())
+    }
+
+    /// A link fed live by whatever sender opens the pseudo-terminal's port, and answering it
+    /// there.
+    pub fn from_pty(pty: Pty) -> std::io::Result<Self> {
+        let s = Self::live(pty.reader()?);
+        s.link.borrow_mut().port = Some(pty);
+        Ok(s)
+    }
+
+    /// A link fed live from `source`, read as it sends, until it ends.
+    fn live(mut source: impl std::io::Read + Send + 'static) -> Self {
         let (tx, rx) = mpsc::channel();
         std::thread::spawn(move || {
-            use std::io::Read;
-            let mut buf = [0u8; 256];
-            let mut stdin = std::io::stdin().lock();
-            while let Ok(n @ 1..) = stdin.read(&mut buf) {
+            let mut buf = [0u8; LIVE_READ_BYTES];
+            while let Ok(n @ 1..) = source.read(&mut buf) {
                 if tx.send(buf[..n].to_vec()).is_err() {
                     break;
                 }
@@ -156,6 +176,10 @@ impl SimSerial {
                 if let Some((_, change)) = l.changes.pop_front() {
                     let after = l.sent;
                     l.changed.push_back((after, change));
+                    if change == PortChange::Closed {
+                        // The sender is gone: it waits for no answer any more.
+                        l.owed = 0;
+                    }
                 }
             } else if let Some((_, b)) = l.timed.pop_front() {
                 l.push_input(core::iter::once(b));
@@ -189,11 +213,13 @@ impl SimSerial {
         self.link.borrow().lines.clone()
     }
 
-    /// True when no input is waiting and none can come any more.
+    /// True when no input is waiting, none can come any more, and every paced line has had its
+    /// answer (a last `G4` answers only once its dwell is over).
     pub fn input_done(&self) -> bool {
         let l = self.link.borrow();
         l.input.is_empty()
             && l.unsent.is_empty()
+            && l.owed == 0
             && l.timed.is_empty()
             && l.changes.is_empty()
             && l.changed.is_empty()
@@ -346,6 +372,9 @@ impl embedded_io_async::Write for SimSerial {
         let mut l = self.link.borrow_mut();
         l.output.extend_from_slice(buf);
         l.heard(buf);
+        if let Some(port) = l.port.as_mut() {
+            port.send(buf);
+        }
         if l.echo_stdout {
             let mut out = std::io::stdout().lock();
             let _ = out.write_all(buf);
