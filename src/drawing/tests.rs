@@ -105,6 +105,19 @@ fn a_function_that_changes_faster_than_its_steps_is_refused() {
 }
 
 #[test]
+fn a_function_defined_up_to_its_ends_is_checked_only_within_them() {
+    // sqrt(x1 - x) is undefined just past x1: the points evaluated inside the X steps stay
+    // within the range, however they round (past 131,072 X steps, here without soft limits,
+    // the last one can round to x0 + (x1 - x0), which need not be x1).
+    let s = Settings { soft_limits: false, ..settings() };
+    for (x0, x1) in [(-0.1f32, 1400.3f32), (0.2, 1500.7), (-3.3, 1313.37), (1400.3, -0.1), (1313.37, -3.3)] {
+        let toward_x1 = if x1 > x0 { std::format!("{x1}-x") } else { std::format!("x-{x1}") };
+        let f = function(&std::format!("sqrt({toward_x1})"), x0, x1);
+        assert!(build(&f, Point::ORIGIN, &s).unwrap().is_some(), "x from {x0} to {x1}");
+    }
+}
+
+#[test]
 fn a_function_too_far_from_zero_for_single_precision_is_refused() {
     let s = settings();
     // At x = 10,000,000 mm f32 numbers are 1 mm apart: 100 steps.

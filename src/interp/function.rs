@@ -117,10 +117,14 @@ impl CurveFn for ExprFn {
         self.y_steps_per_mm
     }
 
-    /// At `x0 + (x1 - x0)·((k + fraction)/n)`, as a column is, strictly between the columns.
+    /// At `x0 + (x1 - x0)·((k + fraction)/n)`, as a column is, between the columns; kept within
+    /// the range, which the last chord's rounding can pass by a unit in the last place past
+    /// 131,072 columns (`(k + fraction)/n` rounds to 1 there, and `x0 + (x1 - x0)` need not be
+    /// x1): out of `sqrt(x1 - x)`'s domain, say.
     fn y_between(&self, column: i32, fraction: f32) -> Option<Result<f32, CurveError>> {
         let x = self.x0_mm + self.span_mm * ((column as f32 + fraction) / self.columns_f32);
-        Some(self.expr.eval(x).map_err(CurveError::from))
+        let (low, high) = (math::min(self.x0_mm, self.x1_mm), math::max(self.x0_mm, self.x1_mm));
+        Some(self.expr.eval(math::max(math::min(x, high), low)).map_err(CurveError::from))
     }
 }
 
