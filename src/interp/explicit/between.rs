@@ -22,10 +22,11 @@
 //!   times the stray. Sampled anywhere in its chords, a sine of three steps per wave or more
 //!   bends at least 4.6 times its stray, whatever its amplitude and phase. Those draw, as `$S`
 //!   draws them at eight or more.
-//! * A wave the columns miss (one of a step or less, or up to 1.7 waves a step) leaves them
+//! * A wave of 2.25 steps or fewer, which the columns miss or see as a slower one, leaves them
 //!   bending little from chord to chord, while the curve between them strays by up to its
-//!   whole height: somewhere the bend is under 2.6 times the stray (none at all for a whole
-//!   number of waves a step), and it is refused there, as soon as it strays more than a step.
+//!   whole height: somewhere the bend is under 2.4 times the stray (none at all for a whole
+//!   number of waves a step, or two steps a wave), and it is refused there, as soon as it
+//!   strays more than a step. Between 2.25 and 3 steps a wave it depends on the amplitude.
 //! * A staircase (`floor`) does not stray at all.
 //!
 //! The sample point moves from chord to chord along the golden-ratio sequence, so no wave can
@@ -43,14 +44,14 @@ mod tests;
 use crate::interp::interpolator::CurveError;
 use crate::math;
 
-/// How far the curve may stray from a chord between two columns whatever the columns show, in
-/// steps at right angles to the chord: the drawn path stays within one step of the curve there.
+/// How far the curve may stray beyond the rows of a chord between its two columns whatever the
+/// columns show, in steps: the drawn path stays within about a step of the curve there.
 pub const STRAY_MAX_STEPS: f32 = 1.0;
 
 /// How many times a chord's stray the columns around it must bend (their change of rise, rows
 /// per column) to show it, beyond [`STRAY_MAX_STEPS`]. A smooth curve bends sixteen times its
-/// stray, a sine of three steps per wave or more at least 4.6, a wave the columns miss 2.6 or
-/// less somewhere along it.
+/// stray, a kink four, a sine of three steps per wave or more at least 4.6, a wave of 2.25
+/// steps or fewer under 2.4 somewhere along it.
 pub const STRAY_SHOWN_RATIO: f32 = 3.0;
 
 /// The golden ratio's fractional part, 0.618..., in 32-bit fixed point: the step of the

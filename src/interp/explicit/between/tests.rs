@@ -66,9 +66,10 @@ fn a_wave_the_columns_miss_is_refused_at_once() {
     let aliased = |t: f32| 300.0 * (per_step * t).sin();
     let refused_at = check(aliased, 500).expect_err("refused");
     assert!(refused_at <= 3, "refused only at chord {refused_at}");
-    // Two, three waves per step, and the waves between one and 1.7 a step, which the columns
-    // see as slower waves, of any height.
-    for steps_per_wave in [0.5, 1.0 / 3.0, 0.6, 2.0 / 3.0, 0.75, 0.8, 0.9, 0.95, 0.99] {
+    // Two, three waves per step, the waves between one and three a step, and waves of up to
+    // 2.25 steps, which the columns see as slower waves or alternating, of any height.
+    for steps_per_wave in [0.5, 1.0 / 3.0, 0.6, 2.0 / 3.0, 0.75, 0.8, 0.9, 0.95, 0.99, 1.1, 1.25, 1.5, 1.75, 2.0, 2.25]
+    {
         for amplitude in [30.0, 300.0, 30_000.0] {
             for phase in [0.0, 0.2, 1.0] {
                 let wave = sine(amplitude, steps_per_wave, phase);
