@@ -4,10 +4,13 @@
 //! misses draw. The keypad's function mode shows the same refusal on the LCD.
 
 use servoplot::geom::Point;
+use servoplot::keypad::Key;
 use servoplot::protocol::{Command, GcodeState};
 use servoplot::settings::Settings;
 use servoplot::sim;
 use servoplot::status::RunState;
+use servoplot::ui::FunctionPreset;
+use servoplot::ui::expr_entry::{EXPR_TOKENS, ExprEntry};
 
 mod support;
 
@@ -84,22 +87,66 @@ fn the_near_misses_draw() {
     assert!(f.iter().zip(&s).all(|(a, b)| (a.x - b.x).abs() + (a.y - b.y).abs() <= 2), "within a step or two");
 }
 
+/// The keys that type `tokens` on the keypad's function editor once it holds `preset`: the
+/// keys that clear it, then digits and `*` (the decimal point) as themselves and every other
+/// token from the wheel, turned on from where it stands and put with C. Which key deletes and
+/// which turns the wheel on are the editor's own, found by pressing them on it.
+fn typing_keys(preset: &str, tokens: &[&str]) -> String {
+    let key_name = |k: Key| match k {
+        Key::A => "A",
+        Key::B => "B",
+        _ => "D",
+    };
+    let deletes = [Key::B, Key::D]
+        .into_iter()
+        .find(|&k| {
+            let mut e = ExprEntry::new("x");
+            e.press(k).is_ok() && e.text().is_empty()
+        })
+        .expect("a key deletes");
+    let turns_on = [Key::A, Key::B]
+        .into_iter()
+        .find(|&k| {
+            let mut e = ExprEntry::new("");
+            e.press(k).is_ok() && e.token() == EXPR_TOKENS[1]
+        })
+        .expect("a key turns the wheel on");
+    let mut entry = ExprEntry::new(preset);
+    let mut keys = String::new();
+    while !entry.text().is_empty() {
+        entry.press(deletes).unwrap();
+        keys += key_name(deletes);
+        keys += " ";
+    }
+    for token in tokens {
+        if token.chars().all(|c| c.is_ascii_digit() || c == '.') {
+            for c in token.chars() {
+                let key = if c == '.' { Key::Star } else { Key::Digit(c as u8 - b'0') };
+                entry.press(key).unwrap();
+                keys.push(if c == '.' { '*' } else { c });
+                keys += " ";
+            }
+            continue;
+        }
+        while entry.token() != *token {
+            entry.press(turns_on).unwrap();
+            keys += key_name(turns_on);
+            keys += " ";
+        }
+        entry.press(Key::C).unwrap();
+        keys += "C ";
+    }
+    assert_eq!(entry.text(), tokens.concat(), "typed as asked");
+    keys
+}
+
 #[test]
 fn the_keypad_shows_the_refusal_and_moves_nothing() {
-    // Function mode (6), C to type from the first preset (x^2/20), six B to clear it, then
-    // sin(x*628.3)*3 from the wheel (A turns it, C puts its token; it stays where it was put)
-    // and the digits (* is the decimal point), from x0 = 0 to x1 = 5 mm.
-    let a = |n: usize| "A ".repeat(n);
-    let typing = format!(
-        "6 C {clear}{sin}C {x}C {times}C 6 2 8 * 3 {close}C {times2}C 3 # 0 # 5 #",
-        clear = "B ".repeat(6),
-        sin = a(8),
-        x = a(17),
-        times = a(5),
-        close = a(22),
-        times2 = a(3),
-    );
-    let report = sim::run_keys(&format!("{typing} wait:500")).unwrap();
+    // Function mode (6), C to type from the first preset, then sin(x*628.3)*3, from x0 = 0 to
+    // x1 = 5 mm: the last # builds it for the preview, and it is refused.
+    let preset = FunctionPreset::ALL[0].expression();
+    let typing = typing_keys(preset, &["sin(", "x", "*", "628.3", ")", "*", "3"]);
+    let report = sim::run_keys(&format!("6 C {typing}# 0 # 5 # wait:500")).unwrap();
     let frame = &report.frames.last().expect("the LCD was drawn").1;
     assert_eq!(support::text(frame, 3, 21), "Finer than a step");
     assert!(report.trace.pulses.is_empty());
