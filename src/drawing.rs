@@ -15,8 +15,11 @@
 //! - a function that fails part way (undefined, or jumping more than `$204`) is refused with the
 //!   x where it fails, instead of stopping the pen part way;
 //! - a request finer than the lattice can draw (an ellipse axis under a step, a sine with fewer
-//!   than [`SINE_MIN_STEPS_PER_WAVE`] steps per wave, a path that strays from its ideal box) is
-//!   refused rather than drawn as something else.
+//!   than [`SINE_MIN_STEPS_PER_WAVE`] steps per wave, a path that strays from its ideal box, a
+//!   function that strays between its X steps further than they show, see
+//!   [`crate::interp::explicit::between`]) is refused rather than drawn as something else;
+//! - a function too far from zero for single precision to place its points within
+//!   [`F32_ERROR_MAX_STEPS`] of the curve is refused.
 //!
 //! Geometry, relative to the pen, X to the right and Y up:
 //!
@@ -38,6 +41,7 @@ pub use builder::{BUILD_SLICE_STEPS, Builder, Slice, build, from_shape};
 
 use crate::expr::Expr;
 use crate::geom::{Axis, Point, Rotation};
+use crate::interp::function::{F32_ERROR_MAX_STEPS, f32_error_steps};
 use crate::interp::sine::{fits_jump_limit, sin_range};
 use crate::interp::{Curve, CurveError, CurveSetupError, Shape, ShapeKind};
 use crate::settings::Settings;
@@ -190,6 +194,9 @@ pub enum DrawError {
     TooSteep,
     /// Finer than the step lattice can draw.
     TooFine,
+    /// A function too far from zero for single precision to place its points within
+    /// [`F32_ERROR_MAX_STEPS`] of its curve.
+    Imprecise,
     /// The function fails part way, after `x_mm` (undefined there, or jumping).
     Fails { x_mm: f32, error: CurveError },
 }
@@ -416,9 +423,23 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
             if !ideal_x.within(settings.travel_steps(), LATTICE_SLACK_STEPS) {
                 return Err(DrawError::Travel);
             }
+            if !precise_enough(expr, *x0_mm, *x1_mm, settings) {
+                return Err(DrawError::Imprecise);
+            }
             Some((Shape::Function { expr: expr.clone(), x0_mm: *x0_mm, x1_mm: *x1_mm }, None))
         }
     })
+}
+
+/// True when single precision places every column's point of `expr` over x from `x0_mm` to
+/// `x1_mm` within [`F32_ERROR_MAX_STEPS`] of its curve. Its values are f(x0) give or take the
+/// machine's Y travel (`$131`) either way: a path that goes further does not draw. An f not
+/// defined at x0 passes: the curve's setup says why it is not drawn.
+fn precise_enough(expr: &Expr, x0_mm: f32, x1_mm: f32, settings: &Settings) -> bool {
+    let Ok(start_mm) = expr.eval(x0_mm) else { return true };
+    let largest_mm = start_mm.abs() + 2.0 * settings.max_travel_mm[1];
+    // False for NaN as well.
+    f32_error_steps(x0_mm, x1_mm, largest_mm, settings.steps_per_mm).iter().all(|e| *e <= F32_ERROR_MAX_STEPS)
 }
 
 /// sin and cos of an angle in degrees, exact at multiples of 90.

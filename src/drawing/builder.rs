@@ -7,9 +7,12 @@
 //! at a time and let the other tasks run between slices, so the watchdog is fed and the host link
 //! and the keypad stay live while a drawing is built. A slice is measured in steps' worth of
 //! work: a step is worth one, and an X step of a sine or a function, where the curve is
-//! evaluated, is worth as much more as the evaluation costs (see [`Builder::advance`]), so a
+//! evaluated, is worth as much more as the evaluations cost (see [`Builder::advance`]), so a
 //! slice takes about the same time whatever it walks. Nothing here waits: a builder is plain
 //! data, and what it walked ([`Slice`]) says how much work each slice was.
+//!
+//! The walk checks a function between its X steps too ([`Curve::check_between_columns`]), which
+//! the motion's curve does not: that is its second evaluation per X step.
 //!
 //! A straight line is not walked: its path ends on its target, stays within the box of its two
 //! ends, and takes as many steps as its method gives from the ends alone (`|dx| + |dy|` one axis
@@ -29,6 +32,10 @@ pub const BUILD_SLICE_STEPS: u32 = 2048;
 
 /// Steps' worth of work an X step of a sine adds: it evaluates a sine, about four steps' walk.
 const SINE_EVALUATION_STEPS: u32 = 4;
+
+/// Evaluations of a function's expression per X step of the walk: at the column, and between
+/// it and the next for the check between columns ([`Curve::check_between_columns`]).
+pub(super) const FUNCTION_EVALUATIONS_PER_X_STEP: u32 = 2;
 
 /// Steps the builder takes from its curve at a time, within a slice.
 const TRACE_BATCH_STEPS: usize = 64;
@@ -58,8 +65,9 @@ pub struct Slice {
     pub expr_ops: u8,
     /// Steps walked.
     pub steps: u32,
-    /// How far X moved: for a sine or a function, whose X moves one way, its X steps; it
-    /// evaluates its curve once per X step (a column, see [`crate::interp::explicit`]).
+    /// How far X moved: for a sine or a function, whose X moves one way, its X steps; the walk
+    /// evaluates a sine once per X step (a column, see [`crate::interp::explicit`]), a function
+    /// [`FUNCTION_EVALUATIONS_PER_X_STEP`] times.
     pub x_steps: u32,
     /// The walk is over: [`Builder::finish`] has the drawing, or why it is refused.
     pub done: bool,
@@ -108,7 +116,7 @@ impl Builder {
         start: Point,
         settings: &Settings,
     ) -> Result<Builder, DrawError> {
-        let copy = Curve::new(&shape, start, settings)?;
+        let copy = Curve::new(&shape, start, settings)?.check_between_columns();
         let mut builder = Builder {
             shape,
             start,
@@ -157,8 +165,9 @@ impl Builder {
 
     /// Walks at most `max_steps` steps' worth more of the curve: a step is worth one, and an X
     /// step of a sine or a function, where the curve is evaluated, is worth as many more as the
-    /// evaluation costs: [`SINE_EVALUATION_STEPS`] for a sine, one per operation of a
-    /// function's expression. At least one step, whatever it is worth.
+    /// evaluations cost: [`SINE_EVALUATION_STEPS`] for a sine, one per operation of a
+    /// function's expression and evaluation ([`FUNCTION_EVALUATIONS_PER_X_STEP`]). At least one
+    /// step, whatever it is worth.
     pub fn advance(&mut self, max_steps: u32) -> Slice {
         self.walk(max_steps, None)
     }
@@ -174,7 +183,7 @@ impl Builder {
         let (expr_ops, evaluation) = match &self.shape {
             Shape::Function { expr, .. } => {
                 let ops = u8::try_from(expr.op_count()).unwrap_or(u8::MAX);
-                (ops, u32::from(ops))
+                (ops, u32::from(ops) * FUNCTION_EVALUATIONS_PER_X_STEP)
             }
             Shape::Sine { .. } => (0, SINE_EVALUATION_STEPS),
             _ => (0, 0),
@@ -255,6 +264,8 @@ impl Builder {
                 // the curve.
                 CurveError::Travel if self.ideal.is_some_and(|i| i.within(travel, 0.0)) => DrawError::TooFine,
                 CurveError::Travel => DrawError::Travel,
+                // Between two X steps the function strays further than they show.
+                CurveError::Aliased => DrawError::TooFine,
                 _ => {
                     // Where a function's x starts, for the x where it fails.
                     let x0_mm = match &self.shape {

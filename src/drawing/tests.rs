@@ -88,6 +88,53 @@ fn what_the_lattice_cannot_draw_is_refused() {
 }
 
 #[test]
+fn a_function_that_changes_faster_than_its_steps_is_refused() {
+    let s = settings();
+    // A wave of 0.01 mm, one step: its columns are nearly flat, the curve between them is not.
+    assert_eq!(build(&function("sin(x*628.3)*3", 0.0, 5.0), Point::ORIGIN, &s), Err(DrawError::TooFine));
+    // Two waves a step, and one wave in 0.8 of a step (its columns show a wave four times
+    // longer); a wave on a slope, whose columns rise evenly.
+    for text in ["sin(x*1256.6)*3", "sin(x*785.4)*3", "x*10+sin(x*628.3)*3"] {
+        assert_eq!(build(&function(text, 0.0, 5.0), Point::ORIGIN, &s), Err(DrawError::TooFine), "{text}");
+    }
+    // Ten and three steps per wave draw, as `$S` draws them (at eight and more), and a
+    // wiggle of under a step draws flat.
+    for text in ["sin(x*62.83)*3", "sin(x*209.4)*0.3", "x+sin(x*628.3)*0.004"] {
+        assert!(build(&function(text, 0.0, 5.0), Point::ORIGIN, &s).unwrap().is_some(), "{text}");
+    }
+}
+
+#[test]
+fn a_function_defined_up_to_its_ends_is_checked_only_within_them() {
+    // sqrt(x1 - x) is undefined just past x1: the points evaluated inside the X steps stay
+    // within the range, however they round (past 131,072 X steps, here without soft limits,
+    // the last one can round to x0 + (x1 - x0), which need not be x1).
+    let s = Settings { soft_limits: false, ..settings() };
+    for (x0, x1) in [(-0.1f32, 1400.3f32), (0.2, 1500.7), (-3.3, 1313.37), (1400.3, -0.1), (1313.37, -3.3)] {
+        let toward_x1 = if x1 > x0 { std::format!("{x1}-x") } else { std::format!("x-{x1}") };
+        let f = function(&std::format!("sqrt({toward_x1})"), x0, x1);
+        assert!(build(&f, Point::ORIGIN, &s).unwrap().is_some(), "x from {x0} to {x1}");
+    }
+}
+
+#[test]
+fn a_function_too_far_from_zero_for_single_precision_is_refused() {
+    let s = settings();
+    // At x = 10,000,000 mm f32 numbers are 1 mm apart: 100 steps.
+    let far = function("(x-10000000)*4", 10_000_000.0, 10_000_020.0);
+    assert_eq!(build(&far, Point::ORIGIN, &s), Err(DrawError::Imprecise));
+    // A value of 10,000,000 mm is as coarse.
+    assert_eq!(build(&function("10000000+sin(x)", 0.0, 5.0), Point::ORIGIN, &s), Err(DrawError::Imprecise));
+    // At x = 1000 mm they are 0.00006 mm apart: it draws, the line of slope 4 it is.
+    let near = build(&function("(x-1000)*4", 1000.0, 1020.0), Point::ORIGIN, &s).unwrap().unwrap();
+    assert_eq!(near.end(), Point::new(2000, 8000));
+    assert_eq!(build(&function("1000+sin(x)", 0.0, 5.0), Point::ORIGIN, &s).map(|d| d.is_some()), Ok(true));
+    // The limit: x to 20,971 mm at 100 steps/mm, a quarter step of f32 spacing.
+    assert!(build(&function("x-20000", 20_000.0, 20_010.0), Point::ORIGIN, &s).unwrap().is_some());
+    assert_eq!(build(&function("x-22000", 22_000.0, 22_010.0), Point::ORIGIN, &s), Err(DrawError::Imprecise));
+}
+
+#[test]
 fn a_function_that_fails_part_way_is_refused_with_where() {
     let s = settings();
     match build(&function("sqrt(1-x)", 0.0, 2.0), Point::ORIGIN, &s) {
@@ -235,21 +282,21 @@ fn slices_build_what_one_go_builds() {
 #[test]
 fn a_slice_does_about_as_much_work_whatever_it_walks() {
     // A step is worth one; an X step of a function one more per operation of its expression
-    // (as compiled: 6 and 4 here), of a sine four more: a slice of 2,048 steps' worth walks many
-    // steps of a steep curve and few of a flat one.
+    // (as compiled: 6 and 4 here) and evaluation (at the column and between columns), of a sine
+    // four more: a slice of 2,048 steps' worth walks many steps of a steep curve and few of a
+    // flat one.
+    let per_op = builder::FUNCTION_EVALUATIONS_PER_X_STEP;
     let cases = [
-        (function("20*exp(-x^2/200)", -30.0, 30.0), 6),
-        (function("sin(x/2)*100", -30.0, 30.0), 4),
-        (sine(10.0, 0.3, 60.0), 4),
-        (ellipse(30.0, 15.0, 0.0, 360.0), 0),
+        (function("20*exp(-x^2/200)", -30.0, 30.0), 6, 6 * per_op),
+        (function("sin(x/2)*100", -30.0, 30.0), 4, 4 * per_op),
+        (sine(10.0, 0.3, 60.0), 0, 4),
+        (ellipse(30.0, 15.0, 0.0, 360.0), 0, 0),
     ];
-    for (request, evaluation) in cases {
+    for (request, ops, evaluation) in cases {
         let mut slices = 0;
         sliced(&request, Point::ORIGIN, BUILD_SLICE_STEPS, |s, _| {
             slices += 1;
-            if s.kind == ShapeKind::Function {
-                assert_eq!(u32::from(s.expr_ops), evaluation, "{request:?}");
-            }
+            assert_eq!(u32::from(s.expr_ops), ops, "{request:?}");
             let work = s.steps + s.x_steps * evaluation;
             // The last batch of a slice may reach one step's worth past it.
             assert!(work <= BUILD_SLICE_STEPS + 1 + evaluation, "{request:?}: {s:?}");

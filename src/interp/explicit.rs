@@ -44,6 +44,13 @@
 //! drawing builder refuses a curve whose lattice path leaves it, and the guard of
 //! [`crate::interp::Curve`] stops one at the edge.
 //!
+//! The drawing builder's copy of a curve is also checked between its columns
+//! ([`ExplicitCurve::check_between_columns`], see [`between`]): one more evaluation of g per
+//! column, at a point inside the chord, and the curve ends with [`CurveError::Aliased`] one
+//! column after a chord that strays there further than its columns show (at the end, for the
+//! last chord), or with g's own error where g cannot be evaluated there. The steps are the
+//! same either way; the curve the motion steps is not checked.
+//!
 //! [`Interpolator::tangent`] is the direction of the current chord, `(1, h(k+1) - h(k))`
 //! normalised and pointing in the direction of travel (the derivative by finite difference). It
 //! changes only where the pen reaches a column, so that is the only place a curve can kink
@@ -86,11 +93,13 @@
 //!   an integer, so all of the above stays in the exact range, and all step arithmetic is `i32`.
 
 use crate::geom::{Point, Step};
+use crate::interp::explicit::between::{BetweenColumns, sample_fraction};
 use crate::interp::interpolator::{CurveError, Filled, Interpolator, KINK_CHORD, Tangent};
 use crate::interp::setup::CurveSetupError;
 use crate::math;
 use crate::method::Method;
 
+pub mod between;
 #[cfg(test)]
 pub(crate) mod test_support;
 #[cfg(test)]
@@ -119,6 +128,12 @@ pub trait CurveFn {
     /// Steps per unit of [`CurveFn::y`]; any finite number (negative mirrors the curve).
     fn y_steps_per_unit(&self) -> f32 {
         1.0
+    }
+
+    /// The ideal y a `fraction` (between 0 and 1) of the way from `column` to the next one, for
+    /// the check between columns ([`between`]); `None` for a curve that is not checked there.
+    fn y_between(&self, _column: i32, _fraction: f32) -> Option<Result<f32, CurveError>> {
+        None
     }
 }
 
@@ -223,6 +238,8 @@ struct Walk {
     /// Number of columns to travel (|length|).
     columns: i32,
     max_jump_steps: i32,
+    /// The check between columns, where the walk makes it (the drawing builder's copy).
+    between: Option<BetweenColumns>,
     /// g(0), in g's unit: the curve is translated by it so that it starts at the pen.
     origin: f32,
     /// Steps per unit of g.
@@ -247,6 +264,21 @@ impl<G: CurveFn> ExplicitCurve<G> {
     pub fn new(g: G, length_steps: i32, max_jump_steps: i32, method: Method) -> Result<Self, CurveSetupError> {
         let walk = Walk::new(&g, length_steps, max_jump_steps, method)?;
         Ok(ExplicitCurve { g, walk })
+    }
+
+    /// The same curve, checked between its columns as it is walked (see [`between`]): the
+    /// drawing builder walks such a copy, so a curve that changes faster than its steps sample
+    /// it ends with [`CurveError::Aliased`]. Costs one more evaluation of g per column.
+    pub fn check_between_columns(mut self) -> Self {
+        self.walk.between = Some(BetweenColumns::default());
+        // The first chord was loaded unchecked: load it again.
+        if self.walk.columns > 0 {
+            self.walk.phase = match self.walk.start(&self.g) {
+                Ok(()) => Phase::Running,
+                Err(e) => Phase::Failed(e),
+            };
+        }
+        self
     }
 
     /// The curve's g.
@@ -293,6 +325,7 @@ impl Walk {
             dir,
             columns: length_steps.abs(),
             max_jump_steps,
+            between: None,
             origin,
             steps_per_unit,
             // Before column 0: the pen stands at the end of no chord.
@@ -375,9 +408,33 @@ impl Walk {
         Chord { vertical, middle, after_middle, middle_at, total, done: 0 }
     }
 
+    /// Checks the chord from column `chord` (value `h0`) to the next (value `h1`) between its
+    /// columns (see [`between`]), when the walk does; an error where the curve cannot be
+    /// evaluated there or a chord strays further than its columns show.
+    #[inline(never)]
+    fn check_between<G: CurveFn + ?Sized>(&mut self, g: &G, chord: i32, h0: f32, h1: f32) -> Result<(), CurveError> {
+        let Some(mut check) = self.between else { return Ok(()) };
+        let fraction = sample_fraction(chord);
+        let Some(y) = g.y_between(chord, fraction) else {
+            // The curve does not say: nothing to check.
+            self.between = None;
+            return Ok(());
+        };
+        let at = (y? - self.origin) * self.steps_per_unit;
+        let judged = check.chord(h0, h1, at);
+        self.between = Some(check);
+        judged
+    }
+
+    /// Judges the last chord between its columns, when the walk checks there.
+    fn check_between_end(&self) -> Result<(), CurveError> {
+        self.between.map_or(Ok(()), |check| check.end())
+    }
+
     /// Makes the chord from column 0 to column 1 current, or tells why it cannot be drawn.
     fn start(&mut self, g: &dyn CurveFn) -> Result<(), CurveError> {
         let (h1, r1) = self.column(g, 1, 0)?;
+        self.check_between(g, 0, 0.0, h1)?;
         self.chord = self.chord(0.0, 0, h1, r1);
         self.seg = 0;
         self.h1 = h1;
@@ -440,12 +497,20 @@ impl Walk {
             let (mut seg, mut r0, mut h1, mut r1, mut slope) = (self.seg, self.r0, self.h1, self.r1, self.slope);
             let ended = loop {
                 if seg + 1 == self.columns {
-                    break Phase::Done;
+                    break match self.check_between_end() {
+                        Ok(()) => Phase::Done,
+                        Err(e) => Phase::Failed(e),
+                    };
                 }
                 let (h, r) = match self.column(g, seg + 2, r1) {
                     Ok(v) => v,
                     Err(e) => break Phase::Failed(e),
                 };
+                if self.between.is_some()
+                    && let Err(e) = self.check_between(g, seg + 1, h1, h)
+                {
+                    break Phase::Failed(e);
+                }
                 let (h0, before) = (h1, slope);
                 (seg, r0, h1, r1, slope) = (seg + 1, r1, h, r, h - h1);
                 // Unit tangents whose slopes differ by at most the kink chord differ by less

@@ -21,6 +21,16 @@
 //! (a few units in the last place of |f|: 2⁻²³·1000 mm is 0.01 step at 80 steps/mm). An
 //! evaluation error (domain, division by zero, overflow) ends the curve at the column before;
 //! at x0 it is a setup error and nothing moves.
+//!
+//! # Precision
+//!
+//! Both errors above grow with the numbers, not with the steps: far enough from zero, `f32`
+//! cannot tell one step from the next (at x = 10,000,000 mm its numbers are 1 mm apart, 100
+//! steps at 100 steps/mm, and `(x-10000000)*4` comes out as 4 mm stairs). [`f32_error_steps`]
+//! bounds how far they can move a column's point from the curve, in steps on each axis: x's
+//! error moves it along X (the point `(x, f(x))` computed is on the curve, drawn at the ideal x),
+//! f's along Y. A curve whose bound is over [`F32_ERROR_MAX_STEPS`] on either axis is refused
+//! before anything moves (the drawing builder asks).
 
 use crate::expr::{EvalError, Expr};
 use crate::geom::{Point, Step};
@@ -32,6 +42,28 @@ use crate::method::Method;
 
 #[cfg(test)]
 mod tests;
+
+/// The most single precision may move a column's point from the curve on either axis, in
+/// steps: with the √2/2 step the path keeps from its chords, it stays within a step of the
+/// curve.
+pub const F32_ERROR_MAX_STEPS: f32 = 0.25;
+
+/// A column's x is within this much of its ideal, relative to `|x1 - x0| + max(|x0|, |x1|)`
+/// (2⁻²³: see the module documentation).
+const X_RELATIVE_ERROR: f32 = 1.0 / 8_388_608.0;
+
+/// f's values carry a few units in their last place of error: within 2⁻²¹ of |f| (see
+/// [`crate::interp::explicit`]'s Arithmetic).
+const VALUE_RELATIVE_ERROR: f32 = 1.0 / 2_097_152.0;
+
+/// How far single precision may move a column's point from the curve of f over x from `x0_mm`
+/// to `x1_mm`, in steps along X and along Y, for values of f up to `largest_value_mm` in size,
+/// at `steps_per_mm` (X, Y). See the module documentation; compare with
+/// [`F32_ERROR_MAX_STEPS`]. Not finite for inputs that are not.
+pub fn f32_error_steps(x0_mm: f32, x1_mm: f32, largest_value_mm: f32, steps_per_mm: [f32; 2]) -> [f32; 2] {
+    let x_size_mm = (x1_mm - x0_mm).abs() + math::max(x0_mm.abs(), x1_mm.abs());
+    [x_size_mm * X_RELATIVE_ERROR * steps_per_mm[0], largest_value_mm.abs() * VALUE_RELATIVE_ERROR * steps_per_mm[1]]
+}
 
 impl From<EvalError> for CurveError {
     fn from(e: EvalError) -> Self {
@@ -84,6 +116,16 @@ impl CurveFn for ExprFn {
     fn y_steps_per_unit(&self) -> f32 {
         self.y_steps_per_mm
     }
+
+    /// At `x0 + (x1 - x0)·((k + fraction)/n)`, as a column is, between the columns; kept within
+    /// the range, which the last chord's rounding can pass by a unit in the last place past
+    /// 131,072 columns (`(k + fraction)/n` rounds to 1 there, and `x0 + (x1 - x0)` need not be
+    /// x1): out of `sqrt(x1 - x)`'s domain, say.
+    fn y_between(&self, column: i32, fraction: f32) -> Option<Result<f32, CurveError>> {
+        let x = self.x0_mm + self.span_mm * ((column as f32 + fraction) / self.columns_f32);
+        let (low, high) = (math::min(self.x0_mm, self.x1_mm), math::max(self.x0_mm, self.x1_mm));
+        Some(self.expr.eval(math::max(math::min(x, high), low)).map_err(CurveError::from))
+    }
 }
 
 /// The curve y = f(x) for x from `x0_mm` to `x1_mm`, drawn from the pen: see the module
@@ -135,6 +177,12 @@ impl FunctionInterp {
             y_steps_per_mm: y_spm,
         };
         Ok(FunctionInterp { curve: ExplicitCurve::new(g, length_steps, max_jump_steps, method)? })
+    }
+
+    /// The same curve, checked between its columns as it is walked: see
+    /// [`ExplicitCurve::check_between_columns`].
+    pub fn check_between_columns(self) -> Self {
+        FunctionInterp { curve: self.curve.check_between_columns() }
     }
 
     /// Where the steps handed out so far have taken the pen, relative to the start.

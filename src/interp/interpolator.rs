@@ -16,6 +16,9 @@ pub enum CurveError {
     Overflow,
     /// The curve jumps by more than the allowed distance between two points.
     Jump,
+    /// Between two columns the curve strays from its chord further than the columns show: it
+    /// changes faster than the steps sample it (see `crate::interp::explicit::between`).
+    Aliased,
     /// The curve would leave the machine's travel area (`$130`, `$131`): it ends at the last
     /// point inside, before any step toward the first point outside.
     Travel,

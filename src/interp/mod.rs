@@ -158,6 +158,17 @@ impl Curve {
         Ok(Curve { kind, at: start, limit, ended: false })
     }
 
+    /// The same curve, checked as it is walked between the columns where a function is
+    /// evaluated (see [`explicit::between`]): the drawing builder walks such a copy, so a
+    /// function that changes faster than its X steps sample it ends with
+    /// [`CurveError::Aliased`] before anything moves. Other curves are the same as before.
+    pub fn check_between_columns(mut self) -> Curve {
+        if let CurveKind::Function(f) = self.kind {
+            self.kind = CurveKind::Function(f.check_between_columns());
+        }
+        self
+    }
+
     /// The same curve, guarded by the travel `limit` (± steps on each axis) instead of the one
     /// of the settings it was set up with: the motion task guards every curve by the travel of
     /// the settings it runs under, should they have changed since the curve was built.

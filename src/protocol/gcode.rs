@@ -100,7 +100,8 @@
 //! Every move and curve is built by the drawing builder ([`crate::drawing`]) from the planned
 //! position, exactly as it will be drawn: what would leave the travel limits is error 15, what
 //! cannot be drawn as asked (a curve finer than the step lattice, a sine steeper than the jump
-//! limit `$204`, a function undefined or jumping part way) is error 33 with a message, and
+//! limit `$204`, a function undefined or jumping part way, changing faster than its X steps or
+//! too far from zero for single precision) is error 33 with a message, and
 //! nothing moves. The planned position afterwards is the curve's last lattice point (for a G-code
 //! target that rounds to it, the target in millimetres). A curve that ends on its own start step
 //! is a full turn if it sweeps at least half a turn, and draws nothing otherwise.

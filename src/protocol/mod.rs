@@ -50,7 +50,7 @@
 //! | 31 | `AxisWordsExist`          | axis words while G80 is the motion mode (G10's, G28's, G30's and G92's too) |
 //! | 32 | `NoAxisWordsInPlane`      | G2/G3 with only a Z word |
 //! | 33 | `InvalidTarget`           | arc end not on its circle, R arc to its own start, sweep above 360° |
-//! | 33 | `Drawing`                 | the drawing cannot be drawn as asked: finer than the step lattice (an axis under a step, a sine of fewer than 8 steps per wave), a sine steeper than the max function jump (`$204`), a function undefined or jumping part way (an info line says which and where); as `Drawing(Travel)`: error 15 |
+//! | 33 | `Drawing`                 | the drawing cannot be drawn as asked: finer than the step lattice (an axis under a step, a sine of fewer than 8 steps per wave, a function changing faster than its X steps), a sine steeper than the max function jump (`$204`), a function undefined or jumping part way (an info line says which and where), a function too far from 0 for single precision; as `Drawing(Travel)`: error 15 |
 //! | 33 | `FunctionUndefined`       | the `$F` function cannot be evaluated on its range (an info line gives x) |
 //! | 34 | `ArcRadius`               | R arc whose radius is shorter than half the chord |
 //! | 35 | `NoOffsetsInPlane`        | G2/G3 without R, I or J |

@@ -118,6 +118,7 @@ fn drawing_refused(out: &mut impl Write, e: DrawError) -> fmt::Result {
         DrawError::Setup(_) => out.write_str("Curve cannot start at the pen")?,
         DrawError::TooSteep => out.write_str("Sine steeper than the max function jump ($204)")?,
         DrawError::TooFine => out.write_str("Curve finer than the step lattice can draw")?,
+        DrawError::Imprecise => out.write_str("Function too far from 0 for single precision")?,
         DrawError::Fails { x_mm, error } => {
             let why = Text(match error {
                 CurveError::Jump => "jumps more than $204",
@@ -182,6 +183,7 @@ fn curve_stopped(e: CurveError) -> AlarmText {
         CurveError::DivisionByZero => "division by zero",
         CurveError::Overflow => "value too large",
         CurveError::Jump => "jump over $204",
+        CurveError::Aliased => "finer than the steps",
         CurveError::Travel => "travel limit",
     };
     (code, ["Curve stopped: ", why, "; queued lines dropped. '$X' to unlock", ""])

@@ -321,6 +321,7 @@ impl fmt::Display for ErrorText {
             UiError::Drawing(DrawError::Travel) => Msg::ErrTravel,
             UiError::Drawing(DrawError::TooSteep) => Msg::ErrSteep,
             UiError::Drawing(DrawError::TooFine) => Msg::ErrFine,
+            UiError::Drawing(DrawError::Imprecise) => Msg::ErrImprecise,
             UiError::Drawing(DrawError::BadParameter) => Msg::ErrParameter,
             UiError::Drawing(DrawError::Setup(_)) => Msg::ErrStart,
             UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => Msg::ErrJumps,
@@ -362,6 +363,7 @@ impl fmt::Display for FaultText {
             MotionFault::Curve(CurveError::DivisionByZero) => Msg::FaultDivision,
             MotionFault::Curve(CurveError::Overflow) => Msg::FaultOverflow,
             MotionFault::Curve(CurveError::Jump) => Msg::FaultJump,
+            MotionFault::Curve(CurveError::Aliased) => Msg::ErrFine,
             MotionFault::Curve(CurveError::Travel) => Msg::FaultTravel,
         };
         write!(f, "{}: {}", say(Msg::FaultStopped), say(why))

@@ -313,6 +313,52 @@ fn errors_end_a_batch_where_next_step_meets_them() {
     }
 }
 
+#[test]
+fn checked_between_columns_a_function_takes_the_same_steps() {
+    for (src, x0, x1) in BATCH_EXPRESSIONS {
+        for method in METHODS {
+            let interp = FunctionInterp::new(parse(src).unwrap(), x0, x1, [20.0, 20.0], 500, method).unwrap();
+            let plain = walk(&mut interp.clone(), method, 1_000_000);
+            let checked = walk(&mut interp.check_between_columns(), method, 1_000_000);
+            assert_eq!((&checked.path, checked.end), (&plain.path, plain.end), "{src}");
+        }
+    }
+}
+
+#[test]
+fn checked_between_columns_a_wave_of_a_step_ends_at_once() {
+    // sin(x*628.3)*3 at 100 steps/mm: a wave every step, 300 steps high.
+    for method in METHODS {
+        let interp = FunctionInterp::new(parse("sin(x*628.3)*3").unwrap(), 0.0, 5.0, [100.0, 100.0], 500, method);
+        let plain = walk(&mut interp.clone().unwrap(), method, 1_000_000);
+        assert_eq!((plain.end, plain.last().x), (Ok(()), 500), "unchecked, drawn nearly flat");
+        assert!(plain.path.iter().all(|p| p.y.abs() <= 30));
+        let checked = walk(&mut interp.unwrap().check_between_columns(), method, 1_000_000);
+        assert_eq!(checked.end, Err(CurveError::Aliased));
+        assert!(checked.last().x <= 3, "ends within a few columns: {:?}", checked.last());
+    }
+}
+
+#[test]
+fn single_precision_error_grows_with_the_numbers_not_the_range() {
+    let spm = [100.0, 100.0];
+    // 20 mm at x = 10,000,000 mm: 2⁻²³ of it is 1.2 mm, 119 steps.
+    let [x, _] = f32_error_steps(10_000_000.0, 10_000_020.0, 0.0, spm);
+    assert!((x - 119.2).abs() < 0.1, "{x}");
+    // The same range at x = 1000 mm: 0.012 step; from 0, 0.0002.
+    let [x, y] = f32_error_steps(1000.0, 1020.0, 80.0, spm);
+    assert!(x < 0.013 && x > 0.012 && y < 0.004, "{x} {y}");
+    let [x, _] = f32_error_steps(0.0, 20.0, 0.0, spm);
+    assert!(x < 0.0005, "{x}");
+    // Values of 10,000,000 mm are 2⁻²¹ of it apart at worst: 477 steps.
+    let [_, y] = f32_error_steps(0.0, 5.0, 10_000_000.0, spm);
+    assert!((y - 476.8).abs() < 0.1, "{y}");
+    assert!(
+        f32_error_steps(0.0, f32::INFINITY, 0.0, spm)[0].is_nan()
+            || f32_error_steps(0.0, f32::INFINITY, 0.0, spm)[0] > F32_ERROR_MAX_STEPS
+    );
+}
+
 /// Expressions of every kind for the batch property.
 const BATCH_EXPRESSIONS: [(&str, f32, f32); 6] = [
     ("20*exp(-x^2/200)", -30.0, 30.0),
