@@ -125,8 +125,11 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
         machine,
         refresh: RefCell::new(Refresh::new()),
         startup: RefCell::new(store.kept().startup.clone()),
-        links: [Link::new(LINK_FLOWS[0]), Link::new(LINK_FLOWS[1])],
+        links: [Link::new(), Link::new()],
     };
+    for (link, flow) in host.links.iter().zip(LINK_FLOWS) {
+        link.set_flow(flow);
+    }
     for link in &host.links {
         // The writers are not running yet: each outbox has room for this first answer.
         link.send(Reply::Welcome(machine.state())).await;

@@ -72,7 +72,7 @@ pub enum Intake {
 /// One host link's state, shared by its receiver, its writer and the line loop; all run on one
 /// executor, so plain cells do.
 pub struct Link {
-    flow: Flow,
+    flow: Cell<Flow>,
     outbox: Channel<NoopRawMutex, Answer, SERIAL_OUTBOX_ANSWERS>,
     bytes: Pipe<NoopRawMutex, SERIAL_PIPE_BYTES>,
     /// Lines dropped for want of room in the pipe; see the serial task's documentation.
@@ -84,15 +84,23 @@ pub struct Link {
 }
 
 impl Link {
-    pub fn new(flow: Flow) -> Self {
+    /// A link whose receiver drops what finds no room ([`Flow::Dropping`]) until
+    /// [`set_flow`](Self::set_flow) says otherwise. (Built without arguments, the two links of
+    /// the host link are built straight into its future, not on the stack and moved.)
+    pub fn new() -> Self {
         Link {
-            flow,
+            flow: Cell::new(Flow::Dropping),
             outbox: Channel::new(),
             bytes: Pipe::new(),
             dropped: Dropped::default(),
             resets_pending: Cell::new(0),
             reset: Signal::new(),
         }
+    }
+
+    /// What the receiver does when the pipe is full: what the link's port allows.
+    pub fn set_flow(&self, flow: Flow) {
+        self.flow.set(flow);
     }
 
     /// Sends `reply` as one whole answer, once the outbox has room.
@@ -165,7 +173,7 @@ impl Link {
     /// than waited for, so realtime bytes behind it are still read, and its line with it; see the
     /// serial task's documentation.
     pub async fn line_byte(&self, byte: u8) {
-        if self.flow == Flow::Waiting {
+        if self.flow.get() == Flow::Waiting {
             // Meanwhile the port takes nothing more from the host.
             self.bytes.write_all(&[byte]).await;
             return;
