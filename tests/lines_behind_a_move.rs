@@ -57,3 +57,28 @@ fn in_the_power_on_lock_a_setting_and_sleep_are_answered_at_once() {
     assert_eq!(answers(&locked), ["[MSG:'$H'|'$X' to unlock]", "ok", "[MSG:Sleeping]", "ok"]);
     assert_eq!(locked.settings.steps_per_mm[0], 150.0);
 }
+
+#[test]
+fn a_queued_move_reports_run_before_its_first_pulse() {
+    // The servos off at rest (`$1=0`): a move waits `$209` ms for them after it is queued.
+    // Polled every 5 ms: no report between the move's `ok` and its last pulse says Idle, or a
+    // sender would take the job as done.
+    let polls = (900..1_300)
+        .step_by(5)
+        .fold(SimSerial::with_input(b"$1=0\nG4 P0.9\nG1 X10 F1000\n"), |s, ms| s.with_byte_at(ms * 1_000, b'?'));
+    let report = sim::run(SimConfig { serial: polls, ..SimConfig::default() });
+    assert!(!report.timed_out);
+    let lines = &report.serial_lines;
+    let ok_us = lines.iter().filter(|(_, l)| l == "ok").nth(2).expect("the move's ok").0;
+    let first_pulse_us = report.trace.pulses.first().expect("the move pulsed").t_us;
+    let last_pulse_us = report.trace.pulses.last().unwrap().t_us;
+    let waiting: Vec<&String> =
+        lines.iter().filter(|(t, l)| l.starts_with('<') && *t > ok_us && *t < first_pulse_us).map(|(_, l)| l).collect();
+    assert!(
+        !waiting.is_empty(),
+        "a report falls between the ok at {ok_us} µs and the first pulse at {first_pulse_us} µs"
+    );
+    for (t, l) in lines.iter().filter(|(t, l)| l.starts_with('<') && *t > ok_us && *t < last_pulse_us) {
+        assert!(l.starts_with("<Run|"), "at {t} µs: {l}");
+    }
+}

@@ -75,7 +75,7 @@ use crate::protocol::report::{Reply, StatusFields};
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
 use crate::protocol::{Command, GcodeState, GrblError, Report};
 use crate::settings::{SettingError, Settings};
-use crate::status::RunState;
+use crate::status::{RunState, Status};
 use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
 use link::{CLOSED_MARK, Intake, Link, RESET_MARK, write_answers};
@@ -146,7 +146,9 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
 impl Host<'_> {
     async fn status_report(&self, link: &Link) {
         let machine = self.machine;
-        let status = machine.status();
+        // `Run` from the moment a move is queued, as GRBL reports it: a sender that sees `Idle`
+        // after its last `ok` takes the job as done.
+        let status = Status { state: machine.line_state(), ..machine.status() };
         let settings = machine.settings();
         let work_offset_mm = machine.work_offset_mm();
         let busy = status.state.moving();
