@@ -106,7 +106,7 @@ impl Machine {
                 Command::CheckMode { on: false } => self.reset(),
                 Command::Unlock | Command::Home => self.mode = None,
                 Command::Report(kind) => self.report(kind, line),
-                Command::Dwell { .. } | Command::Pause | Command::ProgramEnd | Command::Pen(_) => {}
+                Command::Dwell { .. } | Command::Pause | Command::ProgramEnd | Command::Pen(..) => {}
             }
         }
         if self.mode != Some(RunState::Check) {
