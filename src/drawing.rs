@@ -417,8 +417,9 @@ fn shape(request: &Request, start: Point, settings: &Settings) -> Result<Option<
             if (x1_mm - x0_mm).abs() * spm[0] < 1.0 {
                 return Ok(None);
             }
+            // A span past the step range saturates (and is far outside the travel).
             let dx = settings.mm_to_steps(Axis::X, x1_mm - x0_mm);
-            let x = [start.x as f32, (start.x + dx) as f32];
+            let x = [start.x as f32, start.x.saturating_add(dx) as f32];
             let ideal_x = IdealBox { min: [x[0].min(x[1]), start.y as f32], max: [x[0].max(x[1]), start.y as f32] };
             if !ideal_x.within(settings.travel_steps(), LATTICE_SLACK_STEPS) {
                 return Err(DrawError::Travel);
