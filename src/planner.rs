@@ -7,10 +7,12 @@
 //! task [`push`](Planner::push)es one interpolator per job (a segment) and hands what
 //! [`next_cmd`](Planner::next_cmd) returns to the pulse engine.
 //!
-//! The work is split as in GRBL (`planner.c` / `stepper.c`): the look-ahead ([`scan`]) decides
-//! speed caps and exit speeds per *block* of steps, with floating point once per chunk of steps;
-//! the step generator ([`stepgen`]) runs the steps out a *run* at a time, cruising steps with an
-//! integer addition each, ramps with the acceleration rule worked out once per run.
+//! The work is split as in GRBL (`planner.c` / `stepper.c`): the look-ahead ([`lookahead`],
+//! filled and planned by its scan) decides speed caps and exit speeds per *block* of steps, with
+//! floating point once per chunk of steps; the step generator ([`stepgen`]) takes them from the
+//! look-ahead's front through a narrow interface, as GRBL's stepper takes its blocks, and runs
+//! the steps out a *run* at a time, cruising steps with an integer addition each, ramps with the
+//! acceleration rule worked out once per run.
 //!
 //! # Speed along the ideal curve
 //!
@@ -108,11 +110,10 @@
 
 mod block;
 mod limits;
-mod overriding;
+mod lookahead;
 mod ring;
 mod run;
 mod scaling;
-mod scan;
 mod segment;
 mod sizes;
 mod state;
@@ -121,7 +122,7 @@ mod stepgen;
 mod tests;
 
 pub use limits::{CENTRIPETAL_SHARE, Limits, LimitsError, MIN_FEED_MM_PER_MIN, plot_time_lower_bound};
-pub use scan::BLOCK_MARGIN;
+pub use lookahead::BLOCK_MARGIN;
 pub use sizes::{
     CHUNK_RING_LEN, CHUNK_STEPS, LEAD_SHARE, PLANNER_BLOCKS, PLANNER_SEGMENTS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL,
     SCAN_STEPS_PER_PUSH, STEP_RING_LEN, STRAIGHT_CHUNK_STEPS,
@@ -131,10 +132,11 @@ pub use stepgen::Emitted;
 
 use crate::interp::{Interpolator, Method};
 use crate::job::Feed;
-use ring::{CopyRing, Ring, StepRing};
+use crate::overrides::Overrides;
+use lookahead::Lookahead;
 use run::Run;
 use scaling::{Factors, Scale};
-use segment::{ScanPoint, Segment};
+use segment::Segment;
 use state::{Request, ScanPace};
 
 /// The planner holds as many segments as it can ([`Planner::is_full`]); try again after the next
@@ -173,12 +175,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             addr_of_mut!((*p).limits).write(limits);
             addr_of_mut!((*p).factors).write(Factors::NONE);
             addr_of_mut!((*p).pending_limits).write(None);
-            Ring::init_in_place(addr_of_mut!((*p).segments));
-            addr_of_mut!((*p).held).write(0);
-            addr_of_mut!((*p).scan).write(ScanPoint::new());
-            CopyRing::init_in_place(addr_of_mut!((*p).steps));
-            CopyRing::init_in_place(addr_of_mut!((*p).chunks));
-            CopyRing::init_in_place(addr_of_mut!((*p).blocks));
+            Lookahead::init_in_place(addr_of_mut!((*p).ahead));
             addr_of_mut!((*p).request).write(Request::Run);
             addr_of_mut!((*p).speed).write(None);
             addr_of_mut!((*p).run).write(Run::EMPTY);
@@ -196,12 +193,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             limits: _,
             factors: _,
             pending_limits: _,
-            segments: _,
-            held: _,
-            scan: _,
-            steps: _,
-            chunks: _,
-            blocks: _,
+            ahead: _,
             request: _,
             speed: _,
             run: _,
@@ -216,12 +208,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             limits,
             factors: Factors::NONE,
             pending_limits: None,
-            segments: Ring::new(),
-            held: 0,
-            scan: ScanPoint::new(),
-            steps: StepRing::new(),
-            chunks: CopyRing::new(),
-            blocks: CopyRing::new(),
+            ahead: Lookahead::new(),
             request: Request::Run,
             speed: None,
             run: Run::EMPTY,
@@ -246,17 +233,17 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// True when [`push`](Self::push) would refuse: the planner holds `N` segments, or an abort
     /// is braking.
     pub fn is_full(&self) -> bool {
-        self.held >= N || self.request == Request::Abort
+        self.ahead.held() >= N || self.request == Request::Abort
     }
 
     /// Segments [`push`](Self::push) would still take.
     pub fn free_segments(&self) -> usize {
-        if self.request == Request::Abort { 0 } else { N.saturating_sub(self.held) }
+        if self.request == Request::Abort { 0 } else { N.saturating_sub(self.ahead.held()) }
     }
 
     /// True when nothing is left to emit and the machine is at rest.
     pub fn is_idle(&self) -> bool {
-        self.held == 0 && self.speed.is_none()
+        self.ahead.held() == 0 && self.speed.is_none()
     }
 
     /// What the planner is doing.
@@ -294,10 +281,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         }
         let requested_mm_per_s = self.limits.requested_speed_mm_per_s(feed);
         let segment = Segment { curve, method, requested_mm_per_s, scale };
-        if self.segments.push_back(segment).is_err() {
+        if self.ahead.push(segment).is_err() {
             return Err(PlannerFull);
         }
-        self.held += 1;
         self.scan(SCAN_STEPS_PER_PUSH);
         Ok(())
     }
@@ -336,17 +322,43 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         self.rest();
     }
 
+    /// Applies the feed and rapid overrides (GRBL's, percent) to the queued segments and to
+    /// those pushed from now on; see [`crate::overrides`] and the look-ahead's `overriding`. The
+    /// next run of steps the step generator starts runs at the new speeds; the steps it
+    /// returned already keep theirs.
+    pub fn set_overrides(&mut self, overrides: Overrides) {
+        let factors = Factors::from_overrides(overrides);
+        if factors == self.factors {
+            return;
+        }
+        self.factors = factors;
+        // Book the steps emitted so far, so that the front block's progress is the motion's.
+        self.run.cut();
+        self.retire_run();
+        self.ahead.apply_factors(&self.limits, factors, self.speed);
+    }
+
+    /// Scans up to about `budget` more steps ahead, under the limits and overrides in force.
+    fn scan(&mut self, budget: usize) {
+        self.ahead.scan(&self.limits, self.factors, budget);
+    }
+
+    /// Scans one chunk ahead; see `Lookahead::scan_chunk`.
+    fn scan_chunk(&mut self) -> Option<usize> {
+        self.ahead.scan_chunk(&self.limits, self.factors)
+    }
+
+    /// Plans the blocks' exit speeds again.
+    fn replan(&mut self) {
+        self.ahead.replan(&self.limits);
+    }
+
     /// The machine is at rest: finishes an abort, applies pending limits.
     fn rest(&mut self) {
         self.speed = None;
         self.run = Run::EMPTY;
         if self.request == Request::Abort {
-            self.segments.clear();
-            self.held = 0;
-            self.scan = ScanPoint::new();
-            self.steps.clear();
-            self.chunks.clear();
-            self.blocks.clear();
+            self.ahead.clear();
             self.request = Request::Run;
         }
         self.apply_pending_if_idle();

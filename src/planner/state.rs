@@ -1,15 +1,13 @@
-//! The planner's state: the [`Planner`] struct, whose fields its parts share, and the request
-//! it runs under. Its methods live with the part they belong to: the queue and its controls in
-//! [`crate::planner`], the scan in `scan`, the step generator in `stepgen`.
+//! The planner's state: the [`Planner`] struct and the request it runs under. The look-ahead is
+//! the scan's ([`Lookahead`]); the rest is the step generator's and the controls'. Its methods
+//! live with the part they belong to: the queue and its controls in [`crate::planner`], the step
+//! generator in `stepgen`.
 
 use crate::interp::Interpolator;
-use crate::planner::block::{Block, Chunk};
 use crate::planner::limits::Limits;
-use crate::planner::ring::{CopyRing, Ring, StepRing};
+use crate::planner::lookahead::Lookahead;
 use crate::planner::run::Run;
 use crate::planner::scaling::Factors;
-use crate::planner::segment::{ScanPoint, Segment};
-use crate::planner::sizes::{CHUNK_RING_LEN, PLANNER_BLOCKS};
 
 /// What the user last asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,18 +27,8 @@ pub struct Planner<C: Interpolator, const N: usize> {
     pub(super) factors: Factors,
     /// Limits to apply once the planner is idle.
     pub(super) pending_limits: Option<Limits>,
-    /// Pushed segments not yet fully scanned, in order; the scan works on the front one.
-    pub(super) segments: Ring<Segment<C>, N>,
-    /// Segments pushed and not yet fully emitted (scanned or not).
-    pub(super) held: usize,
-    /// Where the scan stands on the front segment.
-    pub(super) scan: ScanPoint,
-    /// Steps scanned and not yet emitted.
-    pub(super) steps: StepRing,
-    /// The scanned steps, cut into chunks with one length per step.
-    pub(super) chunks: CopyRing<Chunk, CHUNK_RING_LEN>,
-    /// The scanned steps, cut into blocks with one cap each.
-    pub(super) blocks: CopyRing<Block, PLANNER_BLOCKS>,
+    /// The segments queued, the steps scanned from them and their blocks: the scan's.
+    pub(super) ahead: Lookahead<C, N>,
     pub(super) request: Request,
     /// Speed of the last step while moving, mm/s; `None` at rest.
     pub(super) speed: Option<f32>,

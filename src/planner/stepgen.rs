@@ -101,7 +101,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 }
             }
             let room = out.len() - written;
-            let steps = self.steps.front_slice((self.run.left as usize).min(room));
+            let steps = self.ahead.front_steps((self.run.left as usize).min(room));
             let mut carry = self.carry;
             let mut taken = 0;
             // A ramp that reaches the cap goes on as a cruise; braking ends at `start2`.
@@ -178,7 +178,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             } else if self.run.step_mm != step_mm {
                 (step_mm_before, step_mm_from, step_mm) = (step_mm, written, self.run.step_mm);
             }
-            self.steps.drop_front(taken);
+            self.ahead.drop_steps(taken);
             self.pace.emitted += taken;
             self.run.left -= taken as u32;
             if ends_early {
@@ -193,7 +193,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     }
 
     /// Keeps the scan ahead: twice what was emitted since it last ran, and a chunk more, while
-    /// the scan's front may still cap the motion ([`Self::lead_short`]); once it cannot, as much
+    /// the scan's front may still cap the motion (`Lookahead::lead_short`); once it cannot, as much
     /// as was emitted, and a chunk more. At most [`SCAN_STEPS_PER_CALL`] at once; what is left
     /// waits for the next call. The steps are counted as they are emitted, not as their run ends:
     /// a cruise along a long line is one run, and its steps scanned again all at once at its end
@@ -203,35 +203,19 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// grows: at a function's top rate the processor has no room for that, so the look-ahead
     /// grows only as far as braking from the caps scanned needs.
     fn keep_scanning(&mut self) {
-        if self.steps.free() < CHUNK_STEPS {
+        if self.ahead.steps_free() < CHUNK_STEPS {
             return;
         }
         self.pace.since_check += self.pace.emitted;
         if self.pace.since_check >= SCAN_EVERY_STEPS || self.speed.is_none() {
             // Worked out now and then: it reads every block.
             self.pace.since_check = 0;
-            self.pace.rate = if self.lead_short() { 2 } else { 1 };
+            self.pace.rate = if self.ahead.lead_short(LEAD_SHARE) { 2 } else { 1 };
         }
         let ScanPace { emitted, rate, .. } = self.pace;
         let budget = (rate * emitted + CHUNK_STEPS).min(SCAN_STEPS_PER_CALL);
         self.scan(budget);
         self.pace.emitted = emitted.saturating_sub(budget / rate);
-    }
-
-    /// True while the scan's front may cap the motion: what is scanned ahead of it (with a
-    /// straight line's known rest) is shorter than [`LEAD_SHARE`] times the distance to brake
-    /// from the highest cap scanned at the lowest acceleration scanned.
-    fn lead_short(&self) -> bool {
-        let (mut lead_nm, mut top_mm_per_s, mut accel_mm_per_s2) = (0u64, 0.0f32, f32::INFINITY);
-        for i in 0..self.blocks.len() {
-            if let Some(block) = self.blocks.get(i) {
-                lead_nm += u64::from(block.end_nm().saturating_sub(block.done_nm));
-                top_mm_per_s = math::max(top_mm_per_s, block.caps.speed_mm_per_s);
-                accel_mm_per_s2 = math::min(accel_mm_per_s2, block.caps.accel_mm_per_s2);
-            }
-        }
-        let brake_nm = top_mm_per_s * top_mm_per_s / (2.0 * accel_mm_per_s2) * NM_PER_MM;
-        (lead_nm as f32) < LEAD_SHARE * brake_nm
     }
 
     /// Plans the next run.
@@ -247,7 +231,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         // Every pass returns, drops a finished block, or scans where the motion has caught up
         // with the scan; the bound only guards against the unforeseen.
         for _ in 0..(N + PLANNER_BLOCKS + 8) {
-            let Some(block) = self.blocks.front() else {
+            let Some(block) = self.ahead.front_block() else {
                 // Nothing scanned: scan on (at rest or at the start rate), unless nothing is left.
                 if self.scan_chunk().is_some() {
                     self.replan();
@@ -257,7 +241,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 return RunStart::Empty;
             };
             if let Some(e) = block.error {
-                self.finish_block();
+                self.ahead.finish_block();
                 self.rest();
                 return RunStart::Failed(e);
             }
@@ -272,7 +256,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                     self.rest();
                     return RunStart::Empty;
                 }
-                self.finish_block();
+                self.ahead.finish_block();
                 continue;
             }
             let start = math::min(self.limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
@@ -281,7 +265,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 return RunStart::Empty;
             }
             let ahead = block.ahead();
-            let Some(chunk) = self.chunks.front().copied() else {
+            let Some(chunk) = self.ahead.front_chunk() else {
                 // Every scanned step is in a chunk; only a bug gets here.
                 self.rest();
                 return RunStart::Empty;
@@ -356,30 +340,11 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         if emitted == 0 {
             return;
         }
-        let Some(chunk) = self.chunks.front_mut() else { return };
-        let emitted_nm = chunk.nm(emitted);
-        chunk.left = chunk.left.saturating_sub(emitted);
-        if chunk.left == 0 {
-            self.chunks.pop_front();
-        }
-        let Some(block) = self.blocks.front_mut() else { return };
-        block.done_steps = block.done_steps.saturating_add(emitted);
-        block.done_nm = block.done_nm.saturating_add(emitted_nm);
-        let start = math::min(self.limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
-        if block.done_steps >= block.steps && !block.open {
-            self.finish_block();
-        }
+        let Some(cap_mm_per_s) = self.ahead.book(emitted) else { return };
+        let start = math::min(self.limits.start_speed_mm_per_s, cap_mm_per_s);
         let stopped = self.request != Request::Run && self.speed.is_some_and(|w| w <= start);
-        if self.held == 0 || stopped {
+        if self.ahead.held() == 0 || stopped {
             self.rest();
         }
-    }
-
-    /// Drops the front block, emitted to its end (or a failure block, reported).
-    fn finish_block(&mut self) {
-        if self.blocks.front().is_some_and(|b| b.ends_segment) {
-            self.held = self.held.saturating_sub(1);
-        }
-        self.blocks.drop_front(1);
     }
 }

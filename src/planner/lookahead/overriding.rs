@@ -17,41 +17,31 @@
 //!   the caps they had: braking needs the acceleration it was planned with. The blocks beyond
 //!   take the new caps at once.
 
+use super::Lookahead;
 use crate::interp::Interpolator;
 use crate::math;
-use crate::overrides::Overrides;
-use crate::planner::limits::Caps;
+use crate::planner::limits::{Caps, Limits};
 use crate::planner::scaling::Factors;
 use crate::planner::sizes::PLANNER_BLOCKS;
-use crate::planner::state::Planner;
 
 /// Braking from a speed up to this factor above the brake limit counts as in time (float noise).
 const BRAKE_TOLERANCE: f32 = 1.0 + 1.0e-4;
 
-impl<C: Interpolator, const N: usize> Planner<C, N> {
-    /// Applies the feed and rapid overrides (GRBL's, percent) to the queued segments and to
-    /// those pushed from now on; see [`crate::overrides`]. The next run of steps the step
-    /// generator starts runs at the new speeds; the steps it returned already keep theirs.
-    pub fn set_overrides(&mut self, overrides: Overrides) {
-        let factors = Factors::from_overrides(overrides);
-        if factors == self.factors {
-            return;
-        }
-        self.factors = factors;
-        // Book the steps emitted so far, so that the front block's progress is the motion's.
-        self.run.cut();
-        self.retire_run();
+impl<C: Interpolator, const N: usize> Lookahead<C, N> {
+    /// The overrides are now `factors`, the motion at `speed` (mm/s; `None` at rest), its steps
+    /// so far booked: every queued block takes its new caps, and the plan is worked out again.
+    pub fn apply_factors(&mut self, limits: &Limits, factors: Factors, speed: Option<f32>) {
         let mut before = [Caps::default(); PLANNER_BLOCKS];
         for (i, caps) in before.iter_mut().enumerate().take(self.blocks.len()) {
             *caps = self.blocks.get_mut(i).map_or(Caps::default(), |b| b.caps);
         }
-        self.recap(&before, false);
-        self.replan();
-        if let (Some(speed), Some(front)) = (self.speed, self.blocks.front())
+        self.recap(limits, factors, speed, &before, false);
+        self.replan(limits);
+        if let (Some(speed), Some(front)) = (speed, self.blocks.front())
             && speed > front.brake_limit(front.done_nm) * BRAKE_TOLERANCE
         {
-            self.recap(&before, true);
-            self.replan();
+            self.recap(limits, factors, Some(speed), &before, true);
+            self.replan(limits);
         }
         // The scan may add steps to the last block: they are compared with its caps in force.
         if let Some(back) = self.blocks.back_mut()
@@ -64,12 +54,10 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// Gives every queued block its caps at the factors in force, and its exit floor. With
     /// `keep_braking`, a block the motion may be braking through keeps its caps from `before`
     /// where the new ones would take acceleration away.
-    fn recap(&mut self, before: &[Caps], keep_braking: bool) {
-        let limits = self.limits;
+    fn recap(&mut self, limits: &Limits, factors: Factors, speed: Option<f32>, before: &[Caps], keep_braking: bool) {
         let start = limits.start_speed_mm_per_s;
-        let factors = self.factors;
         // The least speed², braking from the speed now, at the end of each block in turn.
-        let mut least2 = self.speed.map_or(0.0, |v| v * v);
+        let mut least2 = speed.map_or(0.0, |v| v * v);
         for i in 0..self.blocks.len() {
             let Some(block) = self.blocks.get_mut(i) else { break };
             block.dirty = true;
@@ -83,7 +71,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let speed = block.basis.speed(factors);
             block.caps = Caps {
                 speed_mm_per_s: speed,
-                accel_mm_per_s2: block.basis.accel_at(&limits, math::max(speed, carried)),
+                accel_mm_per_s2: block.basis.accel_at(limits, math::max(speed, carried)),
             };
             if let Some(&old) = before.get(i)
                 && keep_braking

@@ -1,22 +1,19 @@
-//! The scan: steps each queued curve once, ahead of the motion, into the ring of steps; cuts
-//! the steps into chunks (one step length each) and blocks (one cap each); plans the blocks'
-//! exit speeds (the backward pass). Floating point here runs once per chunk, not per step.
+//! The scan: steps each queued curve once, ahead of the motion, into the look-ahead's ring of
+//! steps; cuts the steps into chunks (one step length each) and blocks (one cap each); plans the
+//! blocks' exit speeds (the backward pass). Floating point here runs once per chunk, not per
+//! step. It runs under the planner's limits and overrides, given with each call.
 
+use super::{BLOCK_MARGIN, Lookahead, ScanPoint};
 use crate::interp::{CurveError, Interpolator, Tangent};
 use crate::math;
 use crate::planner::block::{Block, Chunk};
-use crate::planner::limits::{Bend, Caps, StepGeometry, UnitDir};
-use crate::planner::scaling::{CapBasis, ChunkCaps, Scale};
-use crate::planner::segment::ScanPoint;
+use crate::planner::limits::{Bend, Caps, Limits, StepGeometry, UnitDir};
+use crate::planner::scaling::{CapBasis, ChunkCaps, Factors, Scale};
 use crate::planner::sizes::{CHUNK_STEPS, STRAIGHT_CHUNK_STEPS};
-use crate::planner::state::Planner;
 
 /// Caps of a segment's first block sit this far below those of its first chunk: only float
 /// noise, so a straight line runs at its own caps.
 const FIRST_BLOCK_MARGIN: f32 = 1e-4;
-
-/// Caps of a curve's later blocks sit this far (relative) below those of their first chunk.
-pub const BLOCK_MARGIN: f32 = 0.02;
 
 /// A chunk allowing this much (relative) more speed than its block starts a new block.
 const BLOCK_SPLIT_GAIN: f32 = 0.1;
@@ -39,14 +36,14 @@ fn turn_rad(from: [f32; 2], to: [f32; 2]) -> f32 {
     math::atan2(cross.abs(), dot)
 }
 
-impl<C: Interpolator, const N: usize> Planner<C, N> {
+impl<C: Interpolator, const N: usize> Lookahead<C, N> {
     /// Scans up to about `budget` steps of the queued segments, as far as there is room, then
     /// plans the blocks' exit speeds again.
-    pub(crate) fn scan(&mut self, budget: usize) {
+    pub fn scan(&mut self, limits: &Limits, factors: Factors, budget: usize) {
         let mut scanned = 0;
         let mut changed = false;
         while scanned < budget {
-            match self.scan_chunk() {
+            match self.scan_chunk(limits, factors) {
                 Some(steps) => {
                     scanned += steps.max(1);
                     changed = true;
@@ -55,14 +52,13 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             }
         }
         if changed {
-            self.replan();
+            self.replan(limits);
         }
     }
 
     /// Scans one chunk of the front segment (or finishes it); the number of steps scanned, or
     /// `None` when nothing could be done (no segment, or no room).
-    pub(crate) fn scan_chunk(&mut self) -> Option<usize> {
-        let limits = self.limits;
+    pub fn scan_chunk(&mut self, limits: &Limits, factors: Factors) -> Option<usize> {
         // Room for a chunk and two blocks (a new one and, should the curve fail, its error).
         if self.chunks.is_full() || self.blocks.free() < 2 {
             return None;
@@ -95,7 +91,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             let end_tangent = filled.kink.unwrap_or(after);
             let (sx, sy) = last_step.map_or((0, 0), |s| (s.x, s.y));
             let end = limits.step_geometry(method, UnitDir::from_tangent(end_tangent, sx, sy));
-            self.take_chunk(n as u32, end, end_tangent, requested, scale);
+            self.take_chunk(limits, factors, n as u32, end, end_tangent, requested, scale);
             if let Some(left) = straight_left {
                 self.see_ahead(left);
             }
@@ -113,7 +109,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             None if n == 0 => None,
             None => Some(n),
             Some(end) => {
-                self.end_segment(end);
+                self.end_segment(limits, end);
                 Some(n)
             }
         }
@@ -121,9 +117,17 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Files `n` scanned steps that end where a step has geometry `end` (tangent `end_tangent`)
     /// into the chunks and blocks; the feed asked for is `requested_mm_per_s`, scaled by `scale`.
-    fn take_chunk(&mut self, n: u32, end: StepGeometry, end_tangent: Tangent, requested_mm_per_s: f32, scale: Scale) {
-        let limits = self.limits;
-        let factors = self.factors;
+    #[allow(clippy::too_many_arguments)]
+    fn take_chunk(
+        &mut self,
+        limits: &Limits,
+        factors: Factors,
+        n: u32,
+        end: StepGeometry,
+        end_tangent: Tangent,
+        requested_mm_per_s: f32,
+        scale: Scale,
+    ) {
         let start = self.scan.at;
         let fresh = self.scan.fresh;
         let kink_from = self.scan.kink_from_mm.take();
@@ -144,7 +148,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             None if straight => Bend::Straight,
             None => Bend::Curve { curvature_per_mm: turn_rad(start.dir_mm, end.dir_mm) / (n as f32 * step_mm) },
         };
-        let caps = ChunkCaps::new(&limits, &limits.step_limit(&g, bend), scale, requested_mm_per_s, factors);
+        let caps = ChunkCaps::new(limits, &limits.step_limit(&g, bend), scale, requested_mm_per_s, factors);
         let chunk = Chunk::new(n, step_mm);
         // The open block, if any, is this segment's: the last block in the queue.
         if !fresh && let Some(back) = self.blocks.back_mut() {
@@ -226,8 +230,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     }
 
     /// The front segment is scanned to its end (`Ok`) or to the point where it fails.
-    fn end_segment(&mut self, end: Result<(), CurveError>) {
-        let limits = self.limits;
+    fn end_segment(&mut self, limits: &Limits, end: Result<(), CurveError>) {
         let fresh = self.scan.fresh;
         let exit_dir_mm = self.scan.at.dir_mm;
         if !fresh && let Some(back) = self.blocks.back_mut() {
@@ -266,8 +269,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// Backward pass: each block's exit speed, from a stop at the end of the plan, and never
     /// below its floor (see [`Block::exit_floor_mm_per_s`]). Stops early where nothing changes
     /// any more (the scan only changes the last blocks).
-    pub(crate) fn replan(&mut self) {
-        let limits = self.limits;
+    pub fn replan(&mut self, limits: &Limits) {
         let start = limits.start_speed_mm_per_s;
         let len = self.blocks.len();
         // (entry direction, caps, highest speed it can be entered at) of the next block.
