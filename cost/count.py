@@ -309,7 +309,7 @@ BUILD_KINDS = {
 }
 # The front ends' slice (src/drawing/builder.rs, BUILD_SLICE_STEPS), and the longest a slice may
 # take on the board.
-BUILD_SLICE_STEPS = 2048
+BUILD_SLICE_STEPS = 1536
 BUILD_SLICE_BUDGET_MS = 2.0
 
 

@@ -24,11 +24,10 @@ use crate::interp::{Curve, CurveError, Filled, Interpolator, Method, Shape, Shap
 use crate::settings::Settings;
 
 /// Steps' worth of work one slice of a build does at most (see [`Builder::advance`]). Counted on
-/// the board (`cost/`): a step's walk costs 52 to 72 instructions, an evaluation 30 to 100 per
-/// step it is worth; a slice of 2,048 steps' worth takes 0.6 to 1.7 ms of the F407 (the longest
-/// counted: a function of general powers), under the 2 ms `cost/count.py --check-budgets` allows
-/// and well within the 10 ms any task may hold the processor.
-pub const BUILD_SLICE_STEPS: u32 = 2048;
+/// the board (`cost/`, `--check-budgets` allows 2 ms): a slice of this many steps' worth takes
+/// about 0.5 to 1.5 ms of the F407, the longest a function of general powers, which costs three
+/// times what its operations weigh here; well within the 10 ms any task may hold the processor.
+pub const BUILD_SLICE_STEPS: u32 = 1536;
 
 /// Steps' worth of work an X step of a sine adds: it evaluates a sine, about four steps' walk.
 const SINE_EVALUATION_STEPS: u32 = 4;

@@ -283,8 +283,8 @@ fn slices_build_what_one_go_builds() {
 fn a_slice_does_about_as_much_work_whatever_it_walks() {
     // A step is worth one; an X step of a function one more per operation of its expression
     // (as compiled: 6 and 4 here) and evaluation (at the column and between columns), of a sine
-    // four more: a slice of 2,048 steps' worth walks many steps of a steep curve and few of a
-    // flat one.
+    // four more: a slice of `BUILD_SLICE_STEPS` steps' worth walks many steps of a steep curve
+    // and few of a flat one.
     let per_op = builder::FUNCTION_EVALUATIONS_PER_X_STEP;
     let cases = [
         (function("20*exp(-x^2/200)", -30.0, 30.0), 6, 6 * per_op),
