@@ -6,7 +6,7 @@
 
 use crate::drawing::{self, DrawError, Drawing, Request};
 use crate::geom::{Axis, Point, Step};
-use crate::pen::{Pen, PenLift};
+use crate::pen::{self, Pen};
 use crate::settings::Settings;
 
 /// Feed of a jog from the keypad.
@@ -90,7 +90,7 @@ impl Job {
         let unchecked = Settings { soft_limits: false, ..*settings };
         let drawing = drawing::build(&Request::Straight { to }, from, &unchecked).ok()??;
         // Homing never draws: with a pen lift, the pen is up.
-        let pen = (PenLift::of(settings) != PenLift::None).then_some(Pen::Up);
+        let pen = pen::for_homing(settings);
         Some(Job { drawing, feed: Feed::MmPerMin(feed_mm_per_min), kind: JobKind::Home, pen, raise_after: false })
     }
 

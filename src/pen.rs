@@ -170,6 +170,41 @@ pub fn pulse_us(settings: &Settings, order: PenOrder) -> u32 {
     }
 }
 
+/// Where a keypad drawing needs the pen: down, and raised again once it is drawn; `None` when
+/// nothing lifts the pen.
+pub fn for_keypad_drawing(settings: &Settings) -> Option<Pen> {
+    (PenLift::of(settings) != PenLift::None).then_some(Pen::Down)
+}
+
+/// Where a homing move needs the pen: up, homing never draws; `None` when nothing lifts it.
+pub fn for_homing(settings: &Settings) -> Option<Pen> {
+    (PenLift::of(settings) != PenLift::None).then_some(Pen::Up)
+}
+
+/// Where a program's end (M2/M30, which turn the spindle off) leaves the pen: up; `None` when
+/// nothing lifts it.
+pub fn at_program_end(settings: &Settings) -> Option<Pen> {
+    for_homing(settings)
+}
+
+/// Where a line's spindle words send the pen, at rest: M3/M4 down (as deep as the S word in
+/// force says), M5 up, and a new S word under M3/M4 to its new depth. `spindle_on` is the
+/// spindle after the line, `spindle_word` and `s_word` whether the line has an M3/M4/M5 and an
+/// S word; `None` when the line leaves the pen where it is, or nothing lifts it.
+pub fn for_spindle_words(
+    settings: &Settings,
+    spindle_on: bool,
+    spindle_word: bool,
+    s_word: bool,
+    spindle_speed: Option<f32>,
+) -> Option<(Pen, PenDepth)> {
+    if PenLift::of(settings) == PenLift::None || !(spindle_word || (s_word && spindle_on)) {
+        return None;
+    }
+    let depth = PenDepth::of_spindle_speed(settings, spindle_speed);
+    Some((if spindle_on { Pen::Down } else { Pen::Up }, depth))
+}
+
 /// Where a move needs the pen, a rapid (`G0`) or not, with the spindle (`M3`/`M4`) on or not;
 /// `None` when nothing lifts the pen.
 pub fn for_move(settings: &Settings, rapid: bool, spindle_on: bool) -> Option<Pen> {
@@ -186,6 +221,23 @@ pub fn for_move(settings: &Settings, rapid: bool, spindle_on: bool) -> Option<Pe
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_front_ends_ask_one_policy() {
+        let (none, lift) = (Settings::default(), Settings { pen_lift: 1, ..Settings::default() });
+        assert_eq!((for_keypad_drawing(&none), for_homing(&none), at_program_end(&none)), (None, None, None));
+        assert_eq!(
+            (for_keypad_drawing(&lift), for_homing(&lift), at_program_end(&lift)),
+            (Some(Pen::Down), Some(Pen::Up), Some(Pen::Up))
+        );
+        let half = PenDepth::of_spindle_speed(&lift, Some(500.0));
+        assert_eq!(for_spindle_words(&lift, true, true, false, None), Some((Pen::Down, PenDepth::FULL)), "M3");
+        assert_eq!(for_spindle_words(&lift, false, true, false, None), Some((Pen::Up, PenDepth::FULL)), "M5");
+        assert_eq!(for_spindle_words(&lift, true, false, true, Some(500.0)), Some((Pen::Down, half)), "S under M3");
+        assert_eq!(for_spindle_words(&lift, false, false, true, Some(500.0)), None, "S with the spindle off");
+        assert_eq!(for_spindle_words(&lift, true, false, false, Some(500.0)), None, "neither word");
+        assert_eq!(for_spindle_words(&none, true, true, true, None), None, "no pen lift");
+    }
 
     #[test]
     fn each_mode_puts_the_pen_where_a_move_needs_it() {

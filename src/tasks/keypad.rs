@@ -12,7 +12,7 @@ use crate::drawing::BUILD_SLICE_STEPS;
 use crate::job::{Control, Job};
 use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
 use crate::machine::Machine;
-use crate::pen::{Pen, PenLift};
+use crate::pen;
 use crate::tasks::panel::Panel;
 use crate::tasks::slices::BetweenSlices;
 use crate::ui::MenuAction;
@@ -111,8 +111,8 @@ fn act(machine: &Machine, panel: &Panel, action: MenuAction, building: &mut Opti
         MenuAction::Start(feed) => {
             if let Some(mut job) = building.as_mut().and_then(|b| b.job(feed)) {
                 // A pen lift lowers the pen for a keypad drawing and raises it once it is drawn.
-                if PenLift::of(&machine.settings()) != PenLift::None {
-                    job.pen = Some(Pen::Down);
+                if let Some(pen) = pen::for_keypad_drawing(&machine.settings()) {
+                    job.pen = Some(pen);
                     job.raise_after = true;
                 }
                 queue(machine, panel, job);

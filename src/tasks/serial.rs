@@ -66,7 +66,7 @@ use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
 use crate::overrides::Overrides;
-use crate::pen::{Pen, PenDepth, PenLift};
+use crate::pen::{self, Pen, PenDepth};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::gcode::{Offsets, Pending};
@@ -565,8 +565,11 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Command::Dwell { ms } => Some(host.dwell(ms)),
             Command::Pen(pen, depth) => Some(host.pen_to(pen, depth)),
             // M2/M30 turn the spindle off: a pen lift raises the pen.
-            Command::ProgramEnd if PenLift::of(settings) != PenLift::None => Some(host.pen_to(Pen::Up, PenDepth::FULL)),
-            Command::Pause | Command::ProgramEnd => Some(host.machine_at_rest()),
+            Command::ProgramEnd => match pen::at_program_end(settings) {
+                Some(pen) => Some(host.pen_to(pen, PenDepth::FULL)),
+                None => Some(host.machine_at_rest()),
+            },
+            Command::Pause => Some(host.machine_at_rest()),
             // A setting applies to the motion after it, never under a move: the planner takes
             // new limits at rest (see `Planner::set_limits`), so the lines before it end first.
             // What a power cycle keeps changes only at rest: a reset meanwhile drops the line.

@@ -12,7 +12,7 @@ use super::{
 use crate::drawing::{self, EllipseParams, Request};
 use crate::geom::Rotation;
 use crate::job::{Feed, JobKind};
-use crate::pen::{Pen, PenDepth, PenLift};
+use crate::pen;
 use crate::protocol::GrblError;
 use crate::settings::Settings;
 
@@ -59,10 +59,8 @@ impl GcodeState {
         // M3/M4/M5, or a new S word under M3/M4 (how deep the pen goes), moves the pen, as
         // GRBL's spindle changes with them once the motion before has ended.
         let spindle_on = self.spindle != Spindle::Off;
-        if PenLift::of(settings) != PenLift::None && (block.spindle.is_some() || (speed.is_some() && spindle_on)) {
-            let depth = PenDepth::of_spindle_speed(settings, self.spindle_speed);
-            out.pen = Some((if spindle_on { Pen::Down } else { Pen::Up }, depth));
-        }
+        out.pen =
+            pen::for_spindle_words(settings, spindle_on, block.spindle.is_some(), speed.is_some(), self.spindle_speed);
         if block.non_modal == Some(NonModal::Dwell) {
             let p = words.take(b'P').ok_or(GrblError::ValueWordMissing)?;
             let ms = crate::math::round(p * 1000.0);
