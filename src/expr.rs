@@ -28,9 +28,12 @@
 //! error at the `x`). Angles are in radians. This module owns only the language; the curve that
 //! steps along a function lives in `crate::interp::function`.
 
+mod program;
+
 use crate::decimal::{self, DecimalError, Syntax};
 use crate::math;
 use heapless::Vec;
+use program::{Arith, BinOp, Func1, Op};
 
 const _: () = assert!(EXPR_MAX_CONSTS <= u8::MAX as usize, "constant indices are u8");
 
@@ -143,101 +146,6 @@ impl EvalError {
             EvalError::TanPole => "tan at its pole",
             EvalError::DivisionByZero => "division by zero",
             EvalError::Overflow => "value too large",
-        }
-    }
-}
-
-/// Functions of one argument.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-enum Func1 {
-    Sin,
-    Cos,
-    Tan,
-    Asin,
-    Acos,
-    Atan,
-    Sqrt,
-    Abs,
-    Exp,
-    Ln,
-    Log10,
-    Floor,
-    Ceil,
-}
-
-/// Operations on the two topmost values: `a op b` with `b` on top.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-enum BinOp {
-    Add,
-    Sub,
-    Mul,
-    Div,
-    Pow,
-    Min,
-    Max,
-}
-
-/// The operators of `expr` and `term`, as the parser fuses them with a constant operand.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Arith {
-    Add,
-    Sub,
-    Mul,
-    Div,
-}
-
-/// One operation of the reverse-Polish program.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-enum Op {
-    /// Push the number at this index of the constants.
-    Num(u8),
-    /// Push the argument `x`.
-    X,
-    /// The program's first operand, the number at this index or `x`: nothing is under it to
-    /// push.
-    FirstNum(u8),
-    FirstX,
-    /// The top with the number at this index as the right operand: `top + c`, `top - c`,
-    /// `top * c`, `top / c`; where the source had a number there, one operation instead of two
-    /// and nothing pushed.
-    AddConst(u8),
-    SubConst(u8),
-    MulConst(u8),
-    DivConst(u8),
-    /// The number at this index with the top as the right operand: `c - top`, `c / top` (for
-    /// `+` and `*` the order makes no difference: [`Op::AddConst`], [`Op::MulConst`]).
-    ConstSub(u8),
-    ConstDiv(u8),
-    /// Negate the top.
-    Neg,
-    /// Apply a one-argument function to the top.
-    Call(Func1),
-    /// Replace the two topmost values by their combination.
-    Bin(BinOp),
-    /// Raise the top to this integer power, of at most
-    /// [`EXPR_POW_BY_MULTIPLICATION_MAX_EXPONENT`] in magnitude: `^` with a literal exponent
-    /// such as `x^2`, one operation instead of two.
-    PowInt(i8),
-}
-
-impl Op {
-    /// How the operation changes the stack's depth.
-    const fn stack_effect(self) -> isize {
-        match self {
-            Op::Num(_) | Op::X | Op::FirstNum(_) | Op::FirstX => 1,
-            Op::Neg
-            | Op::Call(_)
-            | Op::PowInt(_)
-            | Op::AddConst(_)
-            | Op::SubConst(_)
-            | Op::MulConst(_)
-            | Op::DivConst(_)
-            | Op::ConstSub(_)
-            | Op::ConstDiv(_) => 0,
-            Op::Bin(_) => -1,
         }
     }
 }
