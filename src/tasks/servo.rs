@@ -26,6 +26,7 @@ use crate::geom::TICKS_PER_US;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::Machine;
 use crate::pen::{PEN_SERVO_PERIOD_US, PenServo};
+use crate::settings::Settings;
 use crate::signals::Signals;
 use crate::son::ServoEnable;
 use crate::watchdog::{Look, Progress};
@@ -53,30 +54,11 @@ pub async fn run<P: OutputPin>(
     let mut progress = Progress::default();
     let mut stalled = false;
     loop {
-        let now = levels();
-        machine.set_input_levels(now);
         let settings = machine.settings();
-        let setup = InputSetup::from_settings(&settings);
-        let active = setup.stops_active(now);
-        // The debounce clock in step ticks, wrapping as it allows.
-        let ticks = (Instant::now().as_micros() as u32).wrapping_mul(TICKS_PER_US);
-        if let Some(trip) = debounce.sample(active, ticks, setup.debounce_ticks) {
-            machine.trip(trip);
-            debounce.clear();
-        }
+        watch_inputs(machine, levels(), &settings, &mut debounce);
         // The clock of the timings below, wrapping as it allows.
         let ms = super::now_ms();
-        let mut idle_off = enable.idle_off(ms, machine.at_standstill(), &settings);
-        if idle_off && enable.is_on() {
-            // Going off for standing still: first no longer ready, then still standing still?
-            // The motion task queues its steps before it looks whether the servos are ready, so
-            // one of the two sees the other.
-            machine.set_servos_ready(false);
-            fence(Ordering::SeqCst);
-            idle_off = machine.stopped();
-        }
-        let on = machine.servos_on() && !idle_off;
-        machine.set_servos_ready(enable.ready(ms, on, &settings));
+        let on = servos_on(machine, ms, &settings, &mut enable);
         if son.set_state(PinState::from(on)).is_err() {
             warn!("servo-on output failed");
         }
@@ -107,6 +89,37 @@ pub async fn run<P: OutputPin>(
         stalled = !healthy;
         Timer::after(Duration::from_millis(SERVO_ENABLE_POLL_MS)).await;
     }
+}
+
+/// Publishes the input levels `now` and trips the machine when a driver alarm or the e-stop has
+/// stayed active for the debounce time.
+fn watch_inputs(machine: &Machine, now: InputLevels, settings: &Settings, debounce: &mut Debounce) {
+    machine.set_input_levels(now);
+    let setup = InputSetup::from_settings(settings);
+    let active = setup.stops_active(now);
+    // The debounce clock in step ticks, wrapping as it allows.
+    let ticks = (Instant::now().as_micros() as u32).wrapping_mul(TICKS_PER_US);
+    if let Some(trip) = debounce.sample(active, ticks, setup.debounce_ticks) {
+        machine.trip(trip);
+        debounce.clear();
+    }
+}
+
+/// Whether SON is to be high at `ms`, and the drivers' readiness published: on while the machine
+/// wants the servos on, off after standing still for `$1` ms.
+fn servos_on(machine: &Machine, ms: u32, settings: &Settings, enable: &mut ServoEnable) -> bool {
+    let mut idle_off = enable.idle_off(ms, machine.at_standstill(), settings);
+    if idle_off && enable.is_on() {
+        // Going off for standing still: first no longer ready, then still standing still?
+        // The motion task queues its steps before it looks whether the servos are ready, so
+        // one of the two sees the other.
+        machine.set_servos_ready(false);
+        fence(Ordering::SeqCst);
+        idle_off = machine.stopped();
+    }
+    let on = machine.servos_on() && !idle_off;
+    machine.set_servos_ready(enable.ready(ms, on, settings));
+    on
 }
 
 #[cfg(test)]
