@@ -3,23 +3,10 @@
 //! position, and realtime bytes act whatever link they come on.
 
 use servoplot::geom::Point;
-use servoplot::sim::{self, SimConfig, SimReport, serial::SimSerial};
+use servoplot::sim::serial::SimSerial;
 
-/// Bytes sent at `t_us`, all at once.
-fn paste(link: SimSerial, t_us: u64, text: &[u8]) -> SimSerial {
-    text.iter().fold(link, |l, &b| l.with_byte_at(t_us, b))
-}
-
-fn run(uart: SimSerial, usb: SimSerial) -> SimReport {
-    let report = sim::run(SimConfig { serial: uart, usb, ..SimConfig::default() });
-    assert!(!report.timed_out, "the machine came to rest: {} / {}", report.answers(), report.usb_answers());
-    report
-}
-
-/// The answers to lines (`ok`, `error:N`), in order, without pushed messages and reports.
-fn line_answers(text: &str) -> Vec<&str> {
-    text.lines().filter(|l| *l == "ok" || l.starts_with("error:")).collect()
-}
+mod support;
+use support::links::{line_answers, paste, run};
 
 #[test]
 fn every_line_is_answered_on_the_link_it_came_on() {

@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod links;
+
 use embedded_graphics::Drawable;
 use embedded_graphics::mono_font::MonoTextStyle;
 use embedded_graphics::mono_font::ascii::FONT_5X7;
