@@ -313,29 +313,37 @@ fn assert_axis_rates_within(trace: &Trace, limits: &Limits) {
 }
 
 /// Largest acceleration of each axis, mm/s², from its mean velocity over windows of at least
-/// `window_ticks` (so that single steps do not show as spikes).
+/// `window_us` (so that single steps do not show as spikes). Each axis' windows begin and end
+/// at its own steps, so that a window's distance and duration are exact.
 fn max_axis_accel(trace: &Trace, limits: &Limits, window_us: u64) -> [f64; 2] {
     let window_ticks = window_us * u64::from(TICKS_PER_US);
     let spm = limits.steps_per_mm();
-    let mut windows = Vec::new(); // (mid time s, velocity mm/s per axis)
-    let (mut t, mut w_ticks, mut moved) = (0u64, 0u64, [0i64; 2]);
-    for c in &trace.cmds {
-        w_ticks += c.interval_ticks as u64;
-        moved[0] += c.step.x as i64;
-        moved[1] += c.step.y as i64;
-        if w_ticks >= window_ticks {
-            let dt = w_ticks as f64 / TICK_HZ as f64;
-            let mid = (t as f64 + w_ticks as f64 / 2.0) / TICK_HZ as f64;
-            windows.push((mid, [moved[0] as f64 / spm[0] as f64 / dt, moved[1] as f64 / spm[1] as f64 / dt]));
-            t += w_ticks;
-            w_ticks = 0;
-            moved = [0; 2];
-        }
-    }
     let mut most = [0.0f64; 2];
-    for p in windows.windows(2) {
-        for (axis, most) in most.iter_mut().enumerate() {
-            *most = most.max(((p[1].1[axis] - p[0].1[axis]) / (p[1].0 - p[0].0)).abs());
+    for (axis, most) in most.iter_mut().enumerate() {
+        let mut windows = Vec::new(); // (mid time s, velocity mm/s)
+        let (mut now, mut start, mut moved) = (0u64, None::<u64>, 0i64);
+        for c in &trace.cmds {
+            now += c.interval_ticks as u64;
+            let step = if axis == 0 { c.step.x } else { c.step.y };
+            if step == 0 {
+                continue;
+            }
+            match start {
+                None => start = Some(now),
+                Some(t0) => {
+                    moved += step as i64;
+                    if now - t0 >= window_ticks {
+                        let dt = (now - t0) as f64 / TICK_HZ as f64;
+                        let mid = (t0 + now) as f64 / 2.0 / TICK_HZ as f64;
+                        windows.push((mid, moved as f64 / spm[axis] as f64 / dt));
+                        start = Some(now);
+                        moved = 0;
+                    }
+                }
+            }
+        }
+        for p in windows.windows(2) {
+            *most = most.max(((p[1].1 - p[0].1) / (p[1].0 - p[0].0)).abs());
         }
     }
     most
