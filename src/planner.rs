@@ -1,5 +1,5 @@
 //! Motion planner: turns the steps of queued curves into timed
-//! [`StepCmd`](crate::geom::StepCmd)s — start rate, acceleration, tangential feed, per-axis
+//! [`StepCmd`]s — start rate, acceleration, tangential feed, per-axis
 //! limits, curvature, look-ahead across segments, hold and abort.
 //!
 //! It owns the speed profile and nothing else: it reads no clock (time exists only as the
@@ -112,11 +112,9 @@ mod block;
 mod limits;
 mod lookahead;
 mod ring;
-mod run;
 mod scaling;
 mod segment;
 mod sizes;
-mod state;
 mod stepgen;
 #[cfg(test)]
 mod tests;
@@ -127,17 +125,16 @@ pub use sizes::{
     CHUNK_RING_LEN, CHUNK_STEPS, LEAD_SHARE, PLANNER_BLOCKS, PLANNER_SEGMENTS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL,
     SCAN_STEPS_PER_PUSH, STEP_RING_LEN, STRAIGHT_CHUNK_STEPS,
 };
-pub use state::Planner;
 pub use stepgen::Emitted;
 
-use crate::interp::{Interpolator, Method};
+use crate::geom::StepCmd;
+use crate::interp::{CurveError, Interpolator, Method};
 use crate::job::Feed;
 use crate::overrides::Overrides;
 use lookahead::Lookahead;
-use run::Run;
 use scaling::{Factors, Scale};
 use segment::Segment;
-use state::{Request, ScanPace};
+use stepgen::{Request, StepGen};
 
 /// The planner holds as many segments as it can ([`Planner::is_full`]); try again after the next
 /// [`Planner::next_cmd`].
@@ -161,6 +158,24 @@ pub enum PlannerState {
     Aborting,
 }
 
+/// The speed profile and look-ahead queue; see the [planner's documentation](crate::planner).
+///
+/// `C` is the interpolator type of the motion task (an enum over the curve kinds); `N` the
+/// look-ahead depth in segments ([`PLANNER_SEGMENTS`]). It is two parts handing over through
+/// narrow interfaces, as GRBL's planner and stepper: the look-ahead, which the scan fills and
+/// plans, and the step generator, which takes its front.
+pub struct Planner<C: Interpolator, const N: usize> {
+    limits: Limits,
+    /// The feed and rapid overrides in force.
+    factors: Factors,
+    /// Limits to apply once the planner is idle.
+    pending_limits: Option<Limits>,
+    /// The segments queued, the steps scanned from them and their blocks: the scan's.
+    ahead: Lookahead<C, N>,
+    /// The motion: the step generator's.
+    steps: StepGen,
+}
+
 impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// An idle planner, built in `slot` where it lies: it is 50 KB, too much to build on a
     /// small stack and move (see [`new`](Self::new)). The board builds its planner so, in
@@ -176,11 +191,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             addr_of_mut!((*p).factors).write(Factors::NONE);
             addr_of_mut!((*p).pending_limits).write(None);
             Lookahead::init_in_place(addr_of_mut!((*p).ahead));
-            addr_of_mut!((*p).request).write(Request::Run);
-            addr_of_mut!((*p).speed).write(None);
-            addr_of_mut!((*p).run).write(Run::EMPTY);
-            addr_of_mut!((*p).carry).write(0);
-            addr_of_mut!((*p).pace).write(ScanPace::START);
+            addr_of_mut!((*p).steps).write(StepGen::START);
             slot.assume_init_mut()
         }
     }
@@ -189,32 +200,12 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// that [`init`](Self::init) must write it too.
     #[allow(dead_code)]
     fn every_field(self) {
-        let Planner {
-            limits: _,
-            factors: _,
-            pending_limits: _,
-            ahead: _,
-            request: _,
-            speed: _,
-            run: _,
-            carry: _,
-            pace: _,
-        } = self;
+        let Planner { limits: _, factors: _, pending_limits: _, ahead: _, steps: _ } = self;
     }
 
     /// An idle planner, built as a value (on the host, or in a test).
     pub fn new(limits: Limits) -> Self {
-        Planner {
-            limits,
-            factors: Factors::NONE,
-            pending_limits: None,
-            ahead: Lookahead::new(),
-            request: Request::Run,
-            speed: None,
-            run: Run::EMPTY,
-            carry: 0,
-            pace: ScanPace::START,
-        }
+        Planner { limits, factors: Factors::NONE, pending_limits: None, ahead: Lookahead::new(), steps: StepGen::START }
     }
 
     /// The limits in force.
@@ -233,24 +224,24 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// True when [`push`](Self::push) would refuse: the planner holds `N` segments, or an abort
     /// is braking.
     pub fn is_full(&self) -> bool {
-        self.ahead.held() >= N || self.request == Request::Abort
+        self.ahead.held() >= N || self.steps.request() == Request::Abort
     }
 
     /// Segments [`push`](Self::push) would still take.
     pub fn free_segments(&self) -> usize {
-        if self.request == Request::Abort { 0 } else { N.saturating_sub(self.ahead.held()) }
+        if self.steps.request() == Request::Abort { 0 } else { N.saturating_sub(self.ahead.held()) }
     }
 
     /// True when nothing is left to emit and the machine is at rest.
     pub fn is_idle(&self) -> bool {
-        self.ahead.held() == 0 && self.speed.is_none()
+        self.ahead.held() == 0 && self.steps.speed().is_none()
     }
 
     /// What the planner is doing.
     pub fn state(&self) -> PlannerState {
-        match self.request {
+        match self.steps.request() {
             Request::Abort => PlannerState::Aborting,
-            Request::Hold if self.speed.is_some() => PlannerState::Holding,
+            Request::Hold if self.steps.speed().is_some() => PlannerState::Holding,
             Request::Hold => PlannerState::Held,
             Request::Run if self.is_idle() => PlannerState::Idle,
             Request::Run => PlannerState::Running,
@@ -284,42 +275,33 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         if self.ahead.push(segment).is_err() {
             return Err(PlannerFull);
         }
-        self.scan(SCAN_STEPS_PER_PUSH);
+        self.ahead.scan(&self.limits, self.factors, SCAN_STEPS_PER_PUSH);
         Ok(())
     }
 
     /// Decelerates to a stop on the path; `next_cmd` returns `None` once stopped. While idle it
     /// keeps pushed segments from starting until [`resume`](Self::resume).
     pub fn hold(&mut self) {
-        if self.request == Request::Run {
-            self.request = Request::Hold;
-            self.run.cut();
-        }
+        self.steps.hold();
     }
 
     /// Ends a hold: continues the same path, from the start rate if it had stopped.
     pub fn resume(&mut self) {
-        if self.request == Request::Hold {
-            self.request = Request::Run;
-            self.run.cut();
-        }
+        self.steps.resume();
     }
 
     /// Decelerates to a stop on the path, then drops the rest of the current segment and every
     /// queued one. At rest this happens at once.
     pub fn abort(&mut self) {
-        self.request = Request::Abort;
-        self.run.cut();
-        if self.speed.is_none() {
-            self.rest();
-        }
+        self.steps.abort(&mut self.ahead);
+        self.apply_pending_if_idle();
     }
 
     /// Drops everything at once, without braking: the pulses were cut by a trip, and the machine
     /// stands where they stopped.
     pub fn drop_all(&mut self) {
-        self.request = Request::Abort;
-        self.rest();
+        self.steps.drop_all(&mut self.ahead);
+        self.apply_pending_if_idle();
     }
 
     /// Applies the feed and rapid overrides (GRBL's, percent) to the queued segments and to
@@ -333,35 +315,30 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
         }
         self.factors = factors;
         // Book the steps emitted so far, so that the front block's progress is the motion's.
-        self.run.cut();
-        self.retire_run();
-        self.ahead.apply_factors(&self.limits, factors, self.speed);
+        self.steps.book_emitted(&mut self.ahead, &self.limits);
+        self.ahead.apply_factors(&self.limits, factors, self.steps.speed());
     }
 
-    /// Scans up to about `budget` more steps ahead, under the limits and overrides in force.
-    fn scan(&mut self, budget: usize) {
-        self.ahead.scan(&self.limits, self.factors, budget);
-    }
-
-    /// Scans one chunk ahead; see `Lookahead::scan_chunk`.
-    fn scan_chunk(&mut self) -> Option<usize> {
-        self.ahead.scan_chunk(&self.limits, self.factors)
-    }
-
-    /// Plans the blocks' exit speeds again.
-    fn replan(&mut self) {
-        self.ahead.replan(&self.limits);
-    }
-
-    /// The machine is at rest: finishes an abort, applies pending limits.
-    fn rest(&mut self) {
-        self.speed = None;
-        self.run = Run::EMPTY;
-        if self.request == Request::Abort {
-            self.ahead.clear();
-            self.request = Request::Run;
+    /// The next step command: `None` when there is nothing to emit now (queue empty, or stopped
+    /// by a hold), `Some(Err(e))` where a curve fails (the machine is then at rest; the next call
+    /// goes on with the next segment).
+    pub fn next_cmd(&mut self) -> Option<Result<StepCmd, CurveError>> {
+        let mut cmd = [StepCmd::NONE];
+        let emitted = self.fill(&mut cmd, u32::MAX);
+        match emitted.end {
+            _ if emitted.steps == 1 => Some(Ok(cmd[0])),
+            Some(Err(e)) => Some(Err(e)),
+            _ => None,
         }
+    }
+
+    /// Writes the next step commands into `out`, until it is full, their intervals add up to
+    /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
+    /// step queue this way, one run at a time in a tight loop.
+    pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
+        let emitted = self.steps.fill(&mut self.ahead, &self.limits, self.factors, out, ticks_room);
         self.apply_pending_if_idle();
+        emitted
     }
 
     fn apply_pending_if_idle(&mut self) {

@@ -3,15 +3,21 @@
 //! integer addition; a ramp run (accelerating or braking) applies the acceleration rule step by
 //! step, its block's and chunk's figures worked out once for the run, so each of its steps
 //! costs one square root and one division on the FPU.
+//!
+//! It owns the motion's side of the planner ([`StepGen`]): the request it runs under (run,
+//! hold, abort), the speed reached, the run being emitted and the scan's pace. It takes the
+//! look-ahead's front only through the look-ahead's narrow interface (`front_block`,
+//! `front_chunk`, `front_steps`, `drop_steps`, `book`, `finish_block`), as GRBL's stepper takes
+//! its planner's blocks.
 
 use crate::geom::{Point, StepCmd, TICK_HZ};
 use crate::interp::{CurveError, Interpolator};
 use crate::math;
 use crate::planner::block::{Ahead, Chunk, NM_PER_MM};
-use crate::planner::limits::MIN_SPEED_MM_PER_S;
-use crate::planner::run::{Pace, Ramp, Run};
+use crate::planner::limits::{Limits, MIN_SPEED_MM_PER_S};
+use crate::planner::lookahead::Lookahead;
+use crate::planner::scaling::Factors;
 use crate::planner::sizes::{CHUNK_STEPS, LEAD_SHARE, PLANNER_BLOCKS, SCAN_EVERY_STEPS, SCAN_STEPS_PER_CALL};
-use crate::planner::state::{Planner, Request, ScanPace};
 
 /// 2³², the scale of a step's fraction of a tick.
 const TICK_FRACTION_SCALE: f32 = 4_294_967_296.0;
@@ -28,7 +34,7 @@ const OVER_CAP: f32 = 1.0 + 1.0e-4;
 /// exact times rounded to the nearest tick.
 const HALF_TICK: u32 = 1 << 31;
 
-/// What [`Planner::fill`] wrote, and why it stopped.
+/// What [`Planner::fill`](crate::planner::Planner::fill) wrote, and why it stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Emitted {
     /// Step commands written, from the start of the buffer.
@@ -50,6 +56,96 @@ pub struct Emitted {
     pub end: Option<Result<(), CurveError>>,
 }
 
+/// What the user last asked for: the step generator runs the motion under it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Request {
+    Run,
+    Hold,
+    Abort,
+}
+
+/// The step generator's state: the request the motion runs under, its speed, the run being
+/// emitted and how far the scan has to catch up. It takes the look-ahead's front through the
+/// look-ahead's narrow interface, as GRBL's stepper takes its planner's blocks.
+pub(super) struct StepGen {
+    request: Request,
+    /// Speed of the last step while moving, mm/s; `None` at rest.
+    speed: Option<f32>,
+    /// The run being emitted.
+    run: Run,
+    /// Fraction of a tick carried to the next step, in units of 2⁻³² tick.
+    carry: u32,
+    /// How far the scan has to catch up with the motion, and how fast it does.
+    pace: ScanPace,
+}
+
+/// How fast the scan keeps ahead of the motion (see `StepGen::keep_scanning`).
+#[derive(Clone, Copy, Debug)]
+struct ScanPace {
+    /// Steps emitted since the scan last ran: it scans `rate` times that many, and a chunk more.
+    emitted: usize,
+    /// 2 while the scan's front may cap the motion, 1 once it cannot.
+    rate: usize,
+    /// Steps emitted since `rate` was last worked out.
+    since_check: usize,
+}
+
+impl ScanPace {
+    /// At rest: the look-ahead grows from nothing.
+    const START: ScanPace = ScanPace { emitted: 0, rate: 2, since_check: 0 };
+}
+
+/// Steps of one chunk of one block, timed one way.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    /// Steps in the run, and how many of them are still to emit.
+    steps: u32,
+    left: u32,
+    pace: Pace,
+    /// How far each of its steps advances along the ideal curve, mm (its chunk's `δ_mm`).
+    step_mm: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Pace {
+    /// Every step takes `ticks` and `frac` / 2³² ticks, the fractions carried over.
+    Cruise { ticks: u32, frac: u32 },
+    /// Each step at the speed the acceleration rule allows.
+    Ramp(Ramp),
+}
+
+/// The figures of the acceleration rule for the steps of one chunk of one block.
+#[derive(Clone, Copy, Debug)]
+struct Ramp {
+    /// A step at speed `w` takes `ticks_mm / w` ticks (its length in mm times the tick rate).
+    ticks_mm: f32,
+    /// `2·a·δ`: what one step adds to (or takes from) `v²`.
+    gain: f32,
+    /// `2·a`, for the distance left to brake.
+    two_a: f32,
+    cap2: f32,
+    exit2: f32,
+    /// `v²` from rest, and where braking ends: the start rate for a hold or an abort, the cap
+    /// when braking down to a lower cap (an override lowered it; the motion is not at rest then).
+    start2: f32,
+    /// The step's length, nm, and the distance left in the block before the run, nm.
+    step_nm: u32,
+    left_nm: u32,
+    /// A hold or an abort, or a speed above the cap: decelerate to `start2`.
+    braking: bool,
+    min_ticks: u32,
+}
+
+impl Run {
+    const EMPTY: Run = Run { steps: 0, left: 0, pace: Pace::Cruise { ticks: 0, frac: 0 }, step_mm: 0.0 };
+
+    /// Ends the run after the steps emitted so far: the next step is planned afresh.
+    fn cut(&mut self) {
+        self.steps -= self.left;
+        self.left = 0;
+    }
+}
+
 /// What planning the next run found.
 enum RunStart {
     Ready,
@@ -66,26 +162,84 @@ fn split_ticks(exact_ticks: f32, min_ticks: u32) -> (u32, u32) {
     (ticks, ((exact_ticks - ticks as f32) * TICK_FRACTION_SCALE) as u32)
 }
 
-impl<C: Interpolator, const N: usize> Planner<C, N> {
-    /// The next step command: `None` when there is nothing to emit now (queue empty, or stopped
-    /// by a hold), `Some(Err(e))` where a curve fails (the machine is then at rest; the next call
-    /// goes on with the next segment).
-    pub fn next_cmd(&mut self) -> Option<Result<StepCmd, CurveError>> {
-        let mut cmd = [StepCmd::NONE];
-        let emitted = self.fill(&mut cmd, u32::MAX);
-        match emitted.end {
-            _ if emitted.steps == 1 => Some(Ok(cmd[0])),
-            Some(Err(e)) => Some(Err(e)),
-            _ => None,
+impl StepGen {
+    /// At rest, running what is queued.
+    pub const START: StepGen =
+        StepGen { request: Request::Run, speed: None, run: Run::EMPTY, carry: 0, pace: ScanPace::START };
+
+    /// What the motion runs under.
+    pub fn request(&self) -> Request {
+        self.request
+    }
+
+    /// The speed of the last step while moving, mm/s; `None` at rest.
+    pub fn speed(&self) -> Option<f32> {
+        self.speed
+    }
+
+    /// A hold: brakes to a stop on the path from the next step on.
+    pub fn hold(&mut self) {
+        if self.request == Request::Run {
+            self.request = Request::Hold;
+            self.run.cut();
         }
     }
 
+    /// Ends a hold: goes on along the same path.
+    pub fn resume(&mut self) {
+        if self.request == Request::Hold {
+            self.request = Request::Run;
+            self.run.cut();
+        }
+    }
+
+    /// An abort: brakes to a stop on the path, then `ahead` is emptied. At rest at once.
+    pub fn abort<C: Interpolator, const N: usize>(&mut self, ahead: &mut Lookahead<C, N>) {
+        self.request = Request::Abort;
+        self.run.cut();
+        if self.speed.is_none() {
+            self.rest(ahead);
+        }
+    }
+
+    /// Empties `ahead` at once, without braking: the pulses were cut already.
+    pub fn drop_all<C: Interpolator, const N: usize>(&mut self, ahead: &mut Lookahead<C, N>) {
+        self.request = Request::Abort;
+        self.rest(ahead);
+    }
+
+    /// Ends the run after the steps emitted so far and books them in `ahead`, so that its front
+    /// block's progress is the motion's.
+    pub fn book_emitted<C: Interpolator, const N: usize>(&mut self, ahead: &mut Lookahead<C, N>, limits: &Limits) {
+        self.run.cut();
+        self.retire_run(ahead, limits);
+    }
+
+    /// The machine is at rest: an abort is finished (`ahead` emptied).
+    fn rest<C: Interpolator, const N: usize>(&mut self, ahead: &mut Lookahead<C, N>) {
+        self.speed = None;
+        self.run = Run::EMPTY;
+        if self.request == Request::Abort {
+            ahead.clear();
+            self.request = Request::Run;
+        }
+    }
+}
+
+impl StepGen {
     /// Writes the next step commands into `out`, until it is full, their intervals add up to
     /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
     /// step queue this way, one run at a time in a tight loop.
-    pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
+    pub fn fill<C: Interpolator, const N: usize>(
+        &mut self,
+        ahead: &mut Lookahead<C, N>,
+        limits: &Limits,
+        factors: Factors,
+        out: &mut [StepCmd],
+        ticks_room: u32,
+    ) -> Emitted {
         if self.pace.emitted >= SCAN_EVERY_STEPS {
-            self.keep_scanning();
+            self.keep_scanning(ahead, limits, factors);
         }
         let (mut written, mut ticks, mut dx, mut dy) = (0usize, 0u32, 0i32, 0i32);
         let (mut step_mm, mut step_mm_from, mut step_mm_before) = (0.0, 0, 0.0);
@@ -94,14 +248,14 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
                 break None;
             }
             if self.run.left == 0 {
-                match self.next_run() {
+                match self.next_run(ahead, limits, factors) {
                     RunStart::Ready => {}
                     RunStart::Empty => break Some(Ok(())),
                     RunStart::Failed(e) => break Some(Err(e)),
                 }
             }
             let room = out.len() - written;
-            let steps = self.ahead.front_steps((self.run.left as usize).min(room));
+            let steps = ahead.front_steps((self.run.left as usize).min(room));
             let mut carry = self.carry;
             let mut taken = 0;
             // A ramp that reaches the cap goes on as a cruise; braking ends at `start2`.
@@ -178,7 +332,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             } else if self.run.step_mm != step_mm {
                 (step_mm_before, step_mm_from, step_mm) = (step_mm, written, self.run.step_mm);
             }
-            self.ahead.drop_steps(taken);
+            ahead.drop_steps(taken);
             self.pace.emitted += taken;
             self.run.left -= taken as u32;
             if ends_early {
@@ -186,7 +340,7 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
             }
             written += taken;
             if self.run.left == 0 {
-                self.retire_run();
+                self.retire_run(ahead, limits);
             }
         };
         Emitted { steps: written, ticks, moved: Point::new(dx, dy), step_mm, step_mm_from, step_mm_before, end }
@@ -202,75 +356,84 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// Scanning twice the steps emitted doubles a curve's evaluations while the look-ahead
     /// grows: at a function's top rate the processor has no room for that, so the look-ahead
     /// grows only as far as braking from the caps scanned needs.
-    fn keep_scanning(&mut self) {
-        if self.ahead.steps_free() < CHUNK_STEPS {
+    fn keep_scanning<C: Interpolator, const N: usize>(
+        &mut self,
+        ahead: &mut Lookahead<C, N>,
+        limits: &Limits,
+        factors: Factors,
+    ) {
+        if ahead.steps_free() < CHUNK_STEPS {
             return;
         }
         self.pace.since_check += self.pace.emitted;
         if self.pace.since_check >= SCAN_EVERY_STEPS || self.speed.is_none() {
             // Worked out now and then: it reads every block.
             self.pace.since_check = 0;
-            self.pace.rate = if self.ahead.lead_short(LEAD_SHARE) { 2 } else { 1 };
+            self.pace.rate = if ahead.lead_short(LEAD_SHARE) { 2 } else { 1 };
         }
         let ScanPace { emitted, rate, .. } = self.pace;
         let budget = (rate * emitted + CHUNK_STEPS).min(SCAN_STEPS_PER_CALL);
-        self.scan(budget);
+        ahead.scan(limits, factors, budget);
         self.pace.emitted = emitted.saturating_sub(budget / rate);
     }
 
     /// Plans the next run.
     #[inline(never)]
-    fn next_run(&mut self) -> RunStart {
+    fn next_run<C: Interpolator, const N: usize>(
+        &mut self,
+        ahead: &mut Lookahead<C, N>,
+        limits: &Limits,
+        factors: Factors,
+    ) -> RunStart {
         self.run.cut();
-        self.retire_run();
-        self.apply_pending_if_idle();
+        self.retire_run(ahead, limits);
         if self.request == Request::Hold && self.speed.is_none() {
             return RunStart::Empty;
         }
-        self.keep_scanning();
+        self.keep_scanning(ahead, limits, factors);
         // Every pass returns, drops a finished block, or scans where the motion has caught up
         // with the scan; the bound only guards against the unforeseen.
         for _ in 0..(N + PLANNER_BLOCKS + 8) {
-            let Some(block) = self.ahead.front_block() else {
+            let Some(block) = ahead.front_block() else {
                 // Nothing scanned: scan on (at rest or at the start rate), unless nothing is left.
-                if self.scan_chunk().is_some() {
-                    self.replan();
+                if ahead.scan_chunk(limits, factors).is_some() {
+                    ahead.replan(limits);
                     continue;
                 }
-                self.rest();
+                self.rest(ahead);
                 return RunStart::Empty;
             };
             if let Some(e) = block.error {
-                self.ahead.finish_block();
-                self.rest();
+                ahead.finish_block();
+                self.rest(ahead);
                 return RunStart::Failed(e);
             }
             if block.done_steps >= block.steps {
                 if block.open {
                     // The motion has caught up with the scan (the plan brought it to the start
                     // rate there).
-                    if self.scan_chunk().is_some() {
-                        self.replan();
+                    if ahead.scan_chunk(limits, factors).is_some() {
+                        ahead.replan(limits);
                         continue;
                     }
-                    self.rest();
+                    self.rest(ahead);
                     return RunStart::Empty;
                 }
-                self.ahead.finish_block();
+                ahead.finish_block();
                 continue;
             }
-            let start = math::min(self.limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
+            let start = math::min(limits.start_speed_mm_per_s, block.caps.speed_mm_per_s);
             if self.request != Request::Run && self.speed.is_none_or(|w| w <= start) {
-                self.rest();
+                self.rest(ahead);
                 return RunStart::Empty;
             }
-            let ahead = block.ahead();
-            let Some(chunk) = self.ahead.front_chunk() else {
+            let ahead_of_block = block.ahead();
+            let Some(chunk) = ahead.front_chunk() else {
                 // Every scanned step is in a chunk; only a bug gets here.
-                self.rest();
+                self.rest(ahead);
                 return RunStart::Empty;
             };
-            self.plan_run(&ahead, &chunk, start);
+            self.plan_run(limits, &ahead_of_block, &chunk, start);
             return RunStart::Ready;
         }
         RunStart::Empty
@@ -283,16 +446,16 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// it), the ramp brakes down to it at the acceleration limit, as a hold does to the start
     /// rate; from the start rate or slower, the speed may drop to the cap at once, as it starts
     /// and stops.
-    fn plan_run(&mut self, ahead: &Ahead, chunk: &Chunk, start: f32) {
+    fn plan_run(&mut self, limits: &Limits, ahead: &Ahead, chunk: &Chunk, start: f32) {
         let step_mm = chunk.step_mm;
         let a = ahead.caps.accel_mm_per_s2;
         let cap = ahead.caps.speed_mm_per_s;
         let exit = ahead.exit_mm_per_s;
         let available = chunk.left.min(ahead.steps);
         let hold = self.request != Request::Run;
-        let jump = self.limits.start_speed_mm_per_s;
+        let jump = limits.start_speed_mm_per_s;
         let over = self.speed.filter(|&p| p > cap * OVER_CAP && p > jump);
-        let min_ticks = self.limits.min_interval_ticks;
+        let min_ticks = limits.min_interval_ticks;
         if self.speed.is_none() {
             self.carry = HALF_TICK;
         }
@@ -334,17 +497,17 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
     /// Books the steps emitted in the run just ended against its chunk and block; rests when
     /// the plan is done, or a hold or an abort has braked to the start rate.
     #[inline(never)]
-    pub(crate) fn retire_run(&mut self) {
+    fn retire_run<C: Interpolator, const N: usize>(&mut self, ahead: &mut Lookahead<C, N>, limits: &Limits) {
         let emitted = self.run.steps;
         self.run = Run::EMPTY;
         if emitted == 0 {
             return;
         }
-        let Some(cap_mm_per_s) = self.ahead.book(emitted) else { return };
-        let start = math::min(self.limits.start_speed_mm_per_s, cap_mm_per_s);
+        let Some(cap_mm_per_s) = ahead.book(emitted) else { return };
+        let start = math::min(limits.start_speed_mm_per_s, cap_mm_per_s);
         let stopped = self.request != Request::Run && self.speed.is_some_and(|w| w <= start);
-        if self.ahead.held() == 0 || stopped {
-            self.rest();
+        if ahead.held() == 0 || stopped {
+            self.rest(ahead);
         }
     }
 }
