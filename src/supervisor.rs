@@ -12,8 +12,8 @@
 //!   [`crate::pen`]'s);
 //! - a curve failing part way raises the alarm for it and aborts what was planned;
 //! - a trip raises the alarm for it, unless it is the limit switch a homing approach looks for;
-//! - when the step queue rests (the pulse engine stops after what it holds), and what the task
-//!   waits for after each fill of the queue.
+//! - when pulses may start from rest (servos ready, pen settled), when the step queue rests (the
+//!   pulse engine stops after what it holds), and what the task waits for after each fill.
 
 use crate::inputs::Trip;
 use crate::interp::CurveError;
@@ -115,6 +115,25 @@ pub enum Tripped {
     FoundSwitch,
     /// Raise the alarm for this fault; motion is refused until `$X`.
     Alarm(MotionFault),
+}
+
+/// What pulses starting from rest wait for, as the machine reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StartReady {
+    /// A trip halted the machine: it starts nothing, so nothing is to be waited for.
+    pub halted: bool,
+    /// The servo drivers hold their axes (SON on for `$209`).
+    pub servos_ready: bool,
+    /// The pen is where it was last sent, and has had its settle time (`$212`).
+    pub pen_settled: bool,
+}
+
+impl StartReady {
+    /// True when pulses may start from rest: the servos hold their axes and the pen has settled
+    /// (or the machine is halted).
+    pub fn ready(self) -> bool {
+        self.halted || (self.servos_ready && self.pen_settled)
+    }
 }
 
 /// The decisions of the motion task, and what they remember: the kind of motion taken last and
@@ -331,6 +350,16 @@ mod tests {
         assert_eq!(held, Then { rest: true, plan_empty: Some(false), next: Next::Held });
         let again = s.then(FillEnd::PlanEmpty, PlannerState::Held, false, false, true);
         assert!(!again.rest, "a rest is marked once");
+    }
+
+    #[test]
+    fn pulses_start_from_rest_only_once_the_servos_hold_and_the_pen_has_settled() {
+        let ready = StartReady { halted: false, servos_ready: true, pen_settled: true };
+        assert!(ready.ready());
+        assert!(!StartReady { servos_ready: false, ..ready }.ready(), "servos just switched on");
+        assert!(!StartReady { pen_settled: false, ..ready }.ready(), "pen still moving");
+        let halted = StartReady { halted: true, servos_ready: false, pen_settled: false };
+        assert!(halted.ready(), "a halted machine starts nothing: no wait");
     }
 
     #[test]

@@ -32,7 +32,7 @@ use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner};
 use crate::pulse::{STEP_QUEUE_LEN, StepProducer};
 use crate::settings::Settings;
 use crate::status::RunState;
-use crate::supervisor::{AtRest, FillEnd, Filled, JobOrder, Next, Supervisor, Take, Tripped};
+use crate::supervisor::{AtRest, FillEnd, Filled, JobOrder, Next, StartReady, Supervisor, Take, Tripped};
 
 /// The step queue holds at least this many steps, however long: the pulse engine holds two (the
 /// period counting and the one preloaded after it), so a third is there for the next update
@@ -384,12 +384,12 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
     }
 }
 
-/// True when pulses may start from rest: the servos hold their axes and the pen has settled (or
-/// a trip halted the machine, which starts nothing).
+/// True when pulses may start from rest, as [`StartReady::ready`] says.
 fn ready_to_start(machine: &Machine) -> bool {
     // What this task planned is visible before it looks: see the servo task's going-off check.
     fence(Ordering::SeqCst);
-    machine.halted() || (machine.servos_ready() && machine.pen_settled())
+    StartReady { halted: machine.halted(), servos_ready: machine.servos_ready(), pen_settled: machine.pen_settled() }
+        .ready()
 }
 
 /// Waits until [`ready_to_start`].
