@@ -40,6 +40,7 @@ pub mod signals;
 pub mod son;
 pub mod status;
 pub mod store;
+pub mod supervisor;
 pub mod tasks;
 pub mod text;
 pub mod ui;

@@ -1,18 +1,19 @@
 //! The motion task: turns jobs into curves, curves into timed step commands through the
 //! planner, and feeds them to the pulse engine through the step queue.
 //!
-//! It only moves values: each job arrives with its curve built and checked (`drawing::build`),
-//! and how fast each step goes is decided by the core (`planner::Planner`). Each time it runs it takes controls and
-//! jobs, then fills the step queue in one tight loop — as many steps as fit, up to
-//! `STEP_QUEUE_MAX_US` of motion, so a hold acts within that time even at the slowest feed —
-//! publishes what it queued, and wakes the pulse engine. Then it waits for exactly one of three
-//! things: the queue half emitted, a job when the planner has room for one, or a control
-//! request (or a change of override, which it hands to the planner). On target it runs on its
-//! own interrupt executor, between the pulse engine and everything else.
+//! It decides nothing. Each job arrives with its curve built and checked (`drawing::build`);
+//! how fast each step goes is the planner's ([`crate::planner::Planner`]); the run state it
+//! reports, where the pen goes and when, which job waits, the alarms, when the step queue rests
+//! and what to wait for next are the supervisor's ([`crate::supervisor::Supervisor`]), which it
+//! tells what happened and whose answers it carries out.
 //!
-//! It moves the pen for the jobs that need it elsewhere (see [`crate::pen`]), only at rest: such
-//! a job waits until the motion before it has been emitted. It starts the pulses only once the
-//! servos are ready and the pen has settled.
+//! Each time it runs it takes a trip, controls and jobs, then fills the step queue in one tight
+//! loop — as many steps as fit, up to `STEP_QUEUE_MAX_US` of motion, so a hold acts within that
+//! time even at the slowest feed — publishes what it queued, and wakes the pulse engine. Then it
+//! waits for exactly one of three things: the queue half emitted, a job when the planner has
+//! room for one, or a control request (or a change of override, which it hands to the planner).
+//! It starts the pulses only once the servos are ready and the pen has settled. On target it
+//! runs on its own interrupt executor, between the pulse engine and everything else.
 
 use core::sync::atomic::{Ordering, fence};
 
@@ -23,15 +24,15 @@ use embassy_time::{Duration, Timer};
 use crate::drawing::Drawing;
 use crate::geom::{Point, TICKS_PER_US};
 use crate::inputs::Trip;
-use crate::interp::{Curve, CurveError};
+use crate::interp::Curve;
 use crate::job::{Control, Job, JobKind};
-use crate::machine::{Machine, MotionFault, STEP_QUEUE_MAX_TICKS};
+use crate::machine::{Machine, STEP_QUEUE_MAX_TICKS};
 use crate::overrides::Overrides;
-use crate::pen::Pen;
-use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner, PlannerState};
+use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner};
 use crate::pulse::{STEP_QUEUE_LEN, StepProducer};
 use crate::settings::Settings;
 use crate::status::RunState;
+use crate::supervisor::{AtRest, FillEnd, Filled, JobOrder, Next, StartReady, Supervisor, Take, Tripped};
 
 /// The step queue holds at least this many steps, however long: the pulse engine holds two (the
 /// period counting and the one preloaded after it), so a third is there for the next update
@@ -56,19 +57,6 @@ pub const PUBLISH_BATCH_STEPS: usize = 32;
 /// an empty queue at the start of a curve, while the planner's look-ahead grows, a whole queue
 /// of a function's steps is some 8 ms of the F407; half keeps the poll short.
 pub const FILL_MAX_STEPS: u32 = (STEP_QUEUE_LEN / 2) as u32;
-
-/// Why a fill of the step queue stopped.
-enum FillEnd {
-    /// The queue holds as much as it may.
-    QueueFull,
-    /// This poll queued [`FILL_MAX_STEPS`] and the queue has room still: the task yields and
-    /// goes on.
-    PollDone,
-    /// The planner has nothing more now.
-    PlanEmpty,
-    /// The curve failed part way.
-    CurveFailed(CurveError),
-}
 
 /// What the task has queued for the pulse engine: the totals it publishes, and where the
 /// steps take the pen.
@@ -123,54 +111,21 @@ pub async fn run(
 ) -> ! {
     planner.set_limits(Limits::from_settings(&machine.settings()));
     let mut queued = Queued::at_rest(0, 0, machine.position());
-    // Reported while moving: a jog while the last job taken was one (jogs start only at rest
-    // or behind other jogs).
-    let mut moving = RunState::Run;
+    let mut supervisor = Supervisor::new();
     // The overrides the planner has.
     let mut overrides = Overrides::NONE;
-    // A job that needs the pen elsewhere, waiting for the motion before it to come to rest.
+    // A job that needs the pen elsewhere, held back until the motion before it comes to rest.
     let mut held: Option<Job> = None;
-    // The pen goes up at rest: the last job taken was a keypad drawing.
-    let mut raise_at_rest = false;
     loop {
         if let Some(trip) = machine.take_trip() {
             held = None;
-            halted(machine, planner, &mut steps, &mut queued, trip).await;
+            halted(machine, planner, &mut steps, &mut queued, &supervisor, trip).await;
         }
         if let Some(control) = machine.take_control() {
-            if control == Control::Abort {
-                held = None;
-            }
-            apply(machine, planner, control);
+            apply(machine, planner, control, &mut held);
         }
-        let now = machine.overrides();
-        if now != overrides {
-            // Acts on what is planned from the next run of steps on.
-            overrides = now;
-            planner.set_overrides(now);
-        }
-        while !planner.is_full() {
-            let Some(job) = held.take().or_else(|| machine.next_job()) else { break };
-            // Planned from now on, moving or not yet (the pen or the servos may make it wait).
-            machine.set_plan_empty(false);
-            if let Some(pen) = job.pen
-                && pen != machine.pen()
-            {
-                // The pen moves only at rest: the job waits for what is planned before it.
-                if !planner.is_idle() || !machine.pulses_idle() {
-                    held = Some(job);
-                    break;
-                }
-                machine.set_pen(pen);
-            }
-            raise_at_rest = job.raise_after;
-            let settings = machine.settings();
-            if planner.is_idle() {
-                planner.set_limits(Limits::from_settings(&settings));
-            }
-            work.planned(&job.drawing);
-            moving = plan(machine, planner, job, &settings);
-        }
+        overrides = hand_over_overrides(machine, planner, overrides);
+        take_jobs(machine, planner, &mut supervisor, &mut held, &mut work);
         if machine.pulses_idle() && !planner.is_idle() && !ready_to_start(machine) {
             // Starting from rest: servos off for standing still (`$1`) take their enable delay,
             // a pen just sent elsewhere its settle time. A control meanwhile is taken first.
@@ -178,93 +133,157 @@ pub async fn run(
             continue;
         }
         let steps_before = queued.steps;
-        let filled = fill(machine, planner, &mut steps, &mut queued, &mut work).await;
-        if queued.steps != steps_before {
-            machine.set_plan_empty(false);
-            if machine.run_state() != RunState::Alarm {
-                machine.set_run_state(moving);
-            }
-        }
-        if let FillEnd::CurveFailed(e) = filled {
-            held = None;
-            // A curve stopped part way (the travel guard at the edge, or a curve failing where
-            // the builder's trace did not): a defect upstream, since the builder refuses both.
-            // Stop there, drop what was planned after it (it was planned from a point the pen
-            // never reached, and its lines were answered `ok`) and raise an alarm at once, as
-            // GRBL does: motion is refused until `$X`. The host is told (see the serial task).
-            error!("curve stopped part way: {:?}", e);
-            machine.set_run_state(RunState::Alarm);
-            machine.set_fault(Some(MotionFault::Curve(e)));
-            abort(machine, planner);
-        }
-        let stands = matches!(planner.state(), PlannerState::Idle | PlannerState::Held);
-        if !matches!(filled, FillEnd::QueueFull | FillEnd::PollDone) && stands && !queued.resting {
-            // The motion comes to rest after the steps queued: at its end, or held.
+        let end = fill(machine, planner, &mut steps, &mut queued, &mut work).await;
+        let queued_more = queued.steps != steps_before;
+        let filled = supervisor.filled(end, queued_more, machine.run_state());
+        carry_out(machine, planner, filled, queued_more, &mut held);
+        let then = supervisor.then(end, planner.state(), planner.is_idle(), held.is_some(), queued.resting);
+        if then.rest {
             steps.rest();
             queued.resting = true;
         }
         machine.set_queued(queued.steps, queued.ticks);
         machine.set_plan_free_segments(planner.free_segments());
-        if queued.steps != steps_before {
+        if queued_more {
             kick();
         }
-        match filled {
-            FillEnd::PollDone => yield_now().await,
-            FillEnd::QueueFull => {
-                // Enough motion queued: wait until half of what the pulse engine has not taken
-                // yet is emitted (it holds two steps: the one it emits and the one after), or
-                // for a control.
-                let ahead = machine.queued_ticks().saturating_sub(2 * queued.last_interval_ticks);
-                let wait_us = u64::from(ahead / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
-                select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
+        if let Some(empty) = then.plan_empty {
+            machine.set_plan_empty(empty);
+        }
+        match then.next {
+            Next::Yield => yield_now().await,
+            Next::UntilEmitted => until_half_emitted(machine, &queued).await,
+            Next::Rest => rest(machine, planner, &mut supervisor, held.is_some(), queued.end).await,
+            Next::Held => stand_held(machine, planner).await,
+            Next::Retry => Timer::after(Duration::from_micros(MOTION_RETRY_US)).await,
+        }
+    }
+}
+
+/// The overrides in force, handed to the planner when they differ from `had`, what it has.
+fn hand_over_overrides(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, had: Overrides) -> Overrides {
+    let now = machine.overrides();
+    if now != had {
+        // Acts on what is planned from the next run of steps on.
+        planner.set_overrides(now);
+    }
+    now
+}
+
+/// Takes jobs while the planner has room, the one held back first, and plans each as the
+/// supervisor says: moving the pen first, or holding the job back until the motion rests.
+fn take_jobs(
+    machine: &Machine,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    supervisor: &mut Supervisor,
+    held: &mut Option<Job>,
+    work: &mut impl WorkTime,
+) {
+    while !planner.is_full() {
+        let Some(job) = held.take().or_else(|| machine.next_job()) else { break };
+        // Planned from now on, moving or not yet (the pen or the servos may make it wait).
+        machine.set_plan_empty(false);
+        let at_rest = planner.is_idle() && machine.pulses_idle();
+        match supervisor.take(JobOrder::of(&job), machine.pen(), at_rest) {
+            Take::Hold => {
+                *held = Some(job);
+                break;
             }
-            FillEnd::PlanEmpty | FillEnd::CurveFailed(_) => {
-                machine.set_plan_empty(planner.is_idle() && held.is_none());
-                match planner.state() {
-                    PlannerState::Idle => {
-                        // Everything planned is queued: rest once it has been emitted.
-                        while !machine.pulses_idle() && !machine.halted() {
-                            machine.until_pulses_stopped().await;
-                        }
-                        if machine.run_state() != RunState::Idle {
-                            info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
-                        }
-                        if held.is_some() {
-                            // At rest now: the held job moves the pen and goes on.
-                            continue;
-                        }
-                        if core::mem::take(&mut raise_at_rest) && machine.queued_jobs() == 0 {
-                            machine.set_pen(Pen::Up);
-                        }
-                        // An alarm stays until `$X`.
-                        if machine.run_state() != RunState::Alarm {
-                            machine.set_run_state(RunState::Idle);
-                        }
-                        wait_for_work(machine, planner).await;
-                    }
-                    PlannerState::Held => {
-                        machine.set_run_state(RunState::Hold);
-                        wait_for_work(machine, planner).await;
-                    }
-                    PlannerState::Running | PlannerState::Holding | PlannerState::Aborting => {
-                        Timer::after(Duration::from_micros(MOTION_RETRY_US)).await;
-                    }
+            Take::Plan { pen } => {
+                if let Some(pen) = pen {
+                    machine.set_pen(pen);
                 }
+                let settings = machine.settings();
+                if planner.is_idle() {
+                    planner.set_limits(Limits::from_settings(&settings));
+                }
+                work.planned(&job.drawing);
+                plan(machine, planner, job, &settings);
             }
         }
     }
 }
 
+/// Carries out what the supervisor says of a fill that `queued_more` steps or not: the run
+/// state to publish, and an alarm, which aborts everything (the host is told, see the serial
+/// task).
+fn carry_out(
+    machine: &Machine,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    filled: Filled,
+    queued_more: bool,
+    held: &mut Option<Job>,
+) {
+    if queued_more {
+        machine.set_plan_empty(false);
+    }
+    if let Some(state) = filled.publish {
+        machine.set_run_state(state);
+    }
+    if let Some(fault) = filled.alarm {
+        error!("curve stopped part way: {:?}", fault);
+        machine.set_fault(Some(fault));
+        abort(machine, planner, held);
+    }
+}
+
+/// Waits until half of what the pulse engine has not taken yet is emitted (it holds two steps:
+/// the one it emits and the one after), or for a control.
+async fn until_half_emitted(machine: &Machine, queued: &Queued) {
+    let ahead = machine.queued_ticks().saturating_sub(2 * queued.last_interval_ticks);
+    let wait_us = u64::from(ahead / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
+    select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
+}
+
+/// Everything planned is queued: waits until it has been emitted, at `end`, then does what the
+/// supervisor says of the rest: takes the job `held` back, or moves the pen, publishes the run
+/// state and waits for work.
+async fn rest(
+    machine: &Machine,
+    planner: &Planner<Curve, PLANNER_SEGMENTS>,
+    supervisor: &mut Supervisor,
+    held: bool,
+    end: Point,
+) {
+    while !machine.pulses_idle() && !machine.halted() {
+        machine.until_pulses_stopped().await;
+    }
+    if machine.run_state() != RunState::Idle {
+        info!("at rest at ({}, {}) steps", end.x, end.y);
+    }
+    let settings = machine.settings();
+    match supervisor.at_rest(held, machine.queued_jobs(), machine.run_state(), &settings) {
+        // The held job moves the pen and goes on.
+        AtRest::TakeHeld => {}
+        AtRest::Wait { pen, publish } => {
+            if let Some(pen) = pen {
+                machine.set_pen(pen);
+            }
+            if let Some(state) = publish {
+                machine.set_run_state(state);
+            }
+            wait_for_work(machine, planner).await;
+        }
+    }
+}
+
+/// A hold stands: reports it, and waits for a control or a job.
+async fn stand_held(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>) {
+    machine.set_run_state(RunState::Hold);
+    wait_for_work(machine, planner).await;
+}
+
 /// An input tripped the machine (see [`crate::inputs`]): once the pulse engine has halted,
 /// drops everything planned and queued without braking (the pulses already stopped), takes the
-/// position from the pulses emitted, and raises the alarm. Motion is refused until `$X`. A limit
-/// switch a homing approach ran into is what the approach looked for: no alarm, the homing task
-/// takes it from there.
+/// position from the pulses emitted, and does what the supervisor says: raises the alarm
+/// (motion is refused until `$X`), or hands a limit switch a homing approach ran into to the
+/// homing task.
 async fn halted(
     machine: &Machine,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     steps: &mut StepProducer<'_>,
     queued: &mut Queued,
+    supervisor: &Supervisor,
     trip: Trip,
 ) {
     while machine.pulsing() {
@@ -278,14 +297,17 @@ async fn halted(
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
-    if machine.is_homing_switch(trip) {
-        info!("homing found {:?}", trip);
-        machine.found_switch(trip);
-        return;
+    match supervisor.tripped(trip, machine.is_homing_switch(trip)) {
+        Tripped::FoundSwitch => {
+            info!("homing found {:?}", trip);
+            machine.found_switch(trip);
+        }
+        Tripped::Alarm(fault) => {
+            machine.set_run_state(RunState::Alarm);
+            machine.set_fault(Some(fault));
+            machine.abort_plan();
+        }
     }
-    machine.set_run_state(RunState::Alarm);
-    machine.set_fault(Some(MotionFault::Tripped(trip)));
-    machine.abort_plan();
 }
 
 /// Moves step commands from the planner into the step queue: as many as fit, up to
@@ -341,8 +363,8 @@ async fn fill(
     }
 }
 
-/// Queues the curve of `job` in the planner; the kind of motion it is.
-fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: Job, settings: &Settings) -> RunState {
+/// Queues the curve of `job` in the planner.
+fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: Job, settings: &Settings) {
     let end = job.drawing.end();
     info!("job planned to ({}, {}) steps", end.x, end.y);
     machine.set_drawing(job.drawing.kind());
@@ -360,18 +382,14 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
         // is_full() was false just now and nothing else pushes.
         error!("planner refused a segment it had room for");
     }
-    match job.kind {
-        JobKind::Draw | JobKind::Home => RunState::Run,
-        JobKind::Jog => RunState::Jog,
-    }
 }
 
-/// True when pulses may start from rest: the servos hold their axes and the pen has settled (or
-/// a trip halted the machine, which starts nothing).
+/// True when pulses may start from rest, as [`StartReady::ready`] says.
 fn ready_to_start(machine: &Machine) -> bool {
     // What this task planned is visible before it looks: see the servo task's going-off check.
     fence(Ordering::SeqCst);
-    machine.halted() || (machine.servos_ready() && machine.pen_settled())
+    StartReady { halted: machine.halted(), servos_ready: machine.servos_ready(), pen_settled: machine.pen_settled() }
+        .ready()
 }
 
 /// Waits until [`ready_to_start`].
@@ -392,18 +410,19 @@ async fn wait_for_work(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGME
     }
 }
 
-fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, control: Control) {
+fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, control: Control, held: &mut Option<Job>) {
     info!("control: {:?}", control);
     match control {
         Control::Hold => planner.hold(),
         Control::Resume => planner.resume(),
-        Control::Abort => abort(machine, planner),
+        Control::Abort => abort(machine, planner, held),
     }
 }
 
-/// Decelerates to a stop and drops everything planned and queued, telling the inputs that
-/// positions planned so far are stale.
-fn abort(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>) {
+/// Decelerates to a stop and drops everything planned, queued and `held` back, telling the
+/// inputs that positions planned so far are stale.
+fn abort(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, held: &mut Option<Job>) {
+    *held = None;
     planner.abort();
     machine.abort_plan();
 }
