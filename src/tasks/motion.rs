@@ -21,7 +21,7 @@ use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 
 use crate::drawing::Drawing;
-use crate::geom::{Point, TICKS_PER_US};
+use crate::geom::TICKS_PER_US;
 use crate::inputs::Trip;
 use crate::interp::{Curve, CurveError};
 use crate::job::{Control, Job, JobKind};
@@ -70,13 +70,11 @@ enum FillEnd {
     CurveFailed(CurveError),
 }
 
-/// What the task has queued for the pulse engine: the totals it publishes, and where the
-/// steps take the pen.
+/// What the task has queued for the pulse engine: the totals it publishes. (Where the pen is,
+/// and where the plan ends, the machine says.)
 struct Queued {
     steps: u32,
     ticks: u32,
-    /// Where the steps queued so far take the pen.
-    end: Point,
     /// A rest ends what was published: the pulse engine stops when it is done.
     resting: bool,
     /// The interval of the steps queued last (their mean over the last batch), ticks.
@@ -84,9 +82,9 @@ struct Queued {
 }
 
 impl Queued {
-    /// Nothing queued: the motion rests at `at`, after `steps` and `ticks` so far.
-    fn at_rest(steps: u32, ticks: u32, at: Point) -> Queued {
-        Queued { steps, ticks, end: at, resting: true, last_interval_ticks: 0 }
+    /// Nothing queued: the motion rests, after `steps` and `ticks` so far.
+    fn at_rest(steps: u32, ticks: u32) -> Queued {
+        Queued { steps, ticks, resting: true, last_interval_ticks: 0 }
     }
 }
 
@@ -122,7 +120,7 @@ pub async fn run(
     mut work: impl WorkTime,
 ) -> ! {
     planner.set_limits(Limits::from_settings(&machine.settings()));
-    let mut queued = Queued::at_rest(0, 0, machine.position());
+    let mut queued = Queued::at_rest(0, 0);
     // Reported while moving: a jog while the last job taken was one (jogs start only at rest
     // or behind other jogs).
     let mut moving = RunState::Run;
@@ -227,7 +225,8 @@ pub async fn run(
                             machine.until_pulses_stopped().await;
                         }
                         if machine.run_state() != RunState::Idle {
-                            info!("at rest at ({}, {}) steps", queued.end.x, queued.end.y);
+                            let at = machine.position();
+                            info!("at rest at ({}, {}) steps", at.x, at.y);
                         }
                         if held.is_some() {
                             // At rest now: the held job moves the pen and goes on.
@@ -274,7 +273,7 @@ async fn halted(
     planner.drop_all();
     steps.retract();
     let (emitted_steps, emitted_ticks) = machine.emitted_totals();
-    *queued = Queued::at_rest(emitted_steps, emitted_ticks, machine.position());
+    *queued = Queued::at_rest(emitted_steps, emitted_ticks);
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
@@ -331,7 +330,6 @@ async fn fill(
         }
         queued.steps = queued.steps.wrapping_add(emitted.steps as u32);
         queued.ticks = queued.ticks.wrapping_add(emitted.ticks);
-        queued.end = Point::new(queued.end.x + emitted.moved.x, queued.end.y + emitted.moved.y);
         ticks_room = ticks_room.saturating_sub(emitted.ticks);
         match emitted.end {
             None => {}
