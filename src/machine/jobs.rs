@@ -37,6 +37,10 @@ impl Machine {
     /// Hands `job`, planned from `from`, to the motion task, waiting for room; the plan then
     /// ends where it does. Refused if `from` is not where the plan ends, or stops being so
     /// (an abort) before or while it waits: it was planned from a point the pen will not reach.
+    ///
+    /// The inputs run in thread mode, one poll at a time: between an input's look at the plan's
+    /// end and its job's queueing, only the motion task may come, to take a job (the plan's end
+    /// stays) or to abort (the job is refused here, and dropped if it was queued).
     pub async fn submit(&self, job: Job, from: PlanEnd) -> Result<PlanEnd, Stale> {
         let mut entry = Some((from, job));
         poll_fn(|cx| {
