@@ -8,10 +8,10 @@
 //! change signal that wakes the LCD. The keypad menu is not here: the keypad and LCD tasks share
 //! it in thread mode ([`crate::tasks::panel`]).
 //!
-//! The machine also owns the rule that keeps the inputs' planned positions true: a job is
-//! planned from where the jobs before it end, and an abort drops those. Every job is handed
-//! over with the [`PlanEpoch`] it was planned in; an abort starts a new epoch, and a job from
-//! an earlier one is refused ([`Stale`]) or, if it was queued already, dropped.
+//! The machine also answers where the plan ends, the one point every input plans from
+//! ([`plan_end`](Machine::plan_end)): the end of the last job handed over, or, after an abort,
+//! where the pen stops. A job is handed over with the [`PlanEnd`] it was planned from, and
+//! refused ([`Stale`]) if that is not where the plan ends by then (see [`jobs`]).
 //!
 //! The pen's orders are kept here too: where it is to be, and whether the servo task has seen it
 //! settle there ([`set_pen`](Machine::set_pen), [`pen_settled`](Machine::pen_settled)).
@@ -34,6 +34,7 @@
 //! - the signals `control_requested`, `changed`, `pulses_done`, `homing_requested`,
 //!   `settings_changed` and `faults`: the waiting task's waker, or what was signalled (`()`, a
 //!   `MotionFault`);
+//! - `plan`: where the plan ends, a [`PlanEnd`] twice and a flag (28 bytes);
 //! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
 //!   for room (taken out, and woken outside the lock).
 
@@ -41,6 +42,7 @@ mod from_pulses;
 mod job_queue;
 mod jobs;
 mod path_steps;
+mod plan_end;
 mod published;
 mod pulse_news;
 mod settings;
@@ -65,6 +67,8 @@ pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
 use job_queue::JobQueue;
 use path_steps::PathSteps;
+use plan_end::PlanState;
+pub use plan_end::{PlanEnd, Stale};
 use published::Published;
 use pulse_news::PulseNews;
 
@@ -92,22 +96,12 @@ const _: () = {
     assert!(size_of::<[f32; 2]>() <= LOCKED_VALUE_MAX_BYTES);
     assert!(size_of::<Option<MotionFault>>() <= LOCKED_VALUE_MAX_BYTES);
     assert!(size_of::<Option<Trip>>() <= LOCKED_VALUE_MAX_BYTES);
+    assert!(size_of::<PlanState>() <= LOCKED_VALUE_MAX_BYTES);
     assert!(size_of::<Signal<CriticalSectionRawMutex, MotionFault>>() <= LOCKED_VALUE_MAX_BYTES);
     assert!(size_of::<Signal<CriticalSectionRawMutex, ()>>() <= LOCKED_VALUE_MAX_BYTES);
     // The job queue's waiters: a list of wakers each.
     assert!(size_of::<heapless::Vec<Waker, JOB_SUBMITTERS>>() <= LOCKED_VALUE_MAX_BYTES);
 };
-
-/// The aborts counted when a position was planned: positions planned in an earlier epoch lead
-/// from points the pen never reached.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub struct PlanEpoch(u32);
-
-/// A job planned in an earlier [`PlanEpoch`]: an abort came, and it is not queued.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(target_os = "none", derive(defmt::Format))]
-pub struct Stale;
 
 /// Why [`Machine::try_submit`] did not queue a job.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,8 +122,10 @@ const STATE_ALARM: u8 = 4;
 
 /// Everything the tasks share.
 pub struct Machine {
-    /// Jobs handed over, each with the epoch it was planned in.
-    jobs: JobQueue<(PlanEpoch, Job), JOB_QUEUE_LEN, JOB_SUBMITTERS>,
+    /// Jobs handed over, each with the plan's end it was planned from.
+    jobs: JobQueue<(PlanEnd, Job), JOB_QUEUE_LEN, JOB_SUBMITTERS>,
+    /// Where the plan ends (see [`jobs`]).
+    plan: Mutex<CriticalSectionRawMutex, Cell<PlanState>>,
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
     /// Wakes the motion task when a control is requested or an override changes.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
@@ -139,8 +135,6 @@ pub struct Machine {
     changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
     faults: Signal<CriticalSectionRawMutex, MotionFault>,
-    /// Counts aborts (a control, a curve stopped part way): the current [`PlanEpoch`].
-    aborts: AtomicU32,
     /// The planner holds nothing (set by the motion task).
     plan_empty: AtomicBool,
     /// The host link is in check mode (`$C`): reported as [`RunState::Check`] while idle.
@@ -223,13 +217,13 @@ impl Machine {
         let locked = settings.homing;
         Machine {
             jobs: JobQueue::new(),
+            plan: Mutex::new(Cell::new(PlanState::at(Point::ORIGIN))),
             control: Mutex::new(Cell::new(None)),
             control_requested: Signal::new(),
             overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
             pulses_done: Signal::new(),
             pulse_news: PulseNews::new(),
-            aborts: AtomicU32::new(0),
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
             door: AtomicBool::new(false),
@@ -284,6 +278,8 @@ impl Machine {
             self.origin[axis].store(emitted.wrapping_sub(at), Ordering::Relaxed);
         }
         self.position_lost.store(false, Ordering::Relaxed);
+        // The same point has new coordinates.
+        self.plan_from_pen();
         self.changed.signal(());
     }
 
@@ -336,6 +332,8 @@ impl Machine {
     /// homing task has seen it ([`take_switch_found`](Self::take_switch_found)). Only the
     /// motion task calls this.
     pub fn found_switch(&self, trip: Trip) {
+        // The approach ends here, short of where it was planned to.
+        self.plan_from_pen();
         self.switch_found.lock(|f| f.set(Some(trip)));
     }
 

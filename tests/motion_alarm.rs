@@ -37,12 +37,12 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     // No servo task here: the drivers hold their axes from the start.
     machine.set_servos_ready(true);
     machine.set_pen_settled(machine.pen_order());
-    let epoch = machine.plan_epoch();
+    let start = machine.plan_end().unwrap();
     let first = line_to(150.0, Point::ORIGIN, &loose);
     let end = first.drawing.end();
     let second = line_to(10.0, end, &loose);
-    machine.try_submit(first, epoch).unwrap();
-    machine.try_submit(second, epoch).unwrap();
+    let planned = machine.try_submit(first, start).unwrap();
+    let planned = machine.try_submit(second, planned).unwrap();
 
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
@@ -84,6 +84,8 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     assert!(path.iter().all(|p| p.x <= edge), "a step outside the travel");
     assert_eq!(machine.queued_jobs(), 0, "the job queued behind it was dropped");
     // A job planned before the alarm is refused: it would start where the pen never got.
-    let late = line_to(-10.0, end, &loose);
-    assert_eq!(machine.try_submit(late, epoch), Err(Refused::Stale));
+    let late = line_to(-10.0, planned.at(), &loose);
+    assert_eq!(machine.try_submit(late, planned), Err(Refused::Stale));
+    // The plan ends where the pen stopped.
+    assert_eq!(machine.plan_end().map(|e| e.at()), Some(Point::new(edge, 0)));
 }

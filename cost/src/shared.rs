@@ -17,7 +17,7 @@ use servoplot::geom::Point;
 use servoplot::interp::Shape;
 use servoplot::job::{Control, Feed, Job};
 use servoplot::keypad::{Key, KeyEvent};
-use servoplot::machine::Machine;
+use servoplot::machine::{Machine, PlanEnd};
 use servoplot::settings::Settings;
 use servoplot::tasks::panel::Panel;
 use servoplot::ui::screen::{self, Live};
@@ -34,11 +34,14 @@ pub fn run() {
     let settings = Settings::default();
     let machine = Machine::new(settings);
     let panel = Panel::new();
-    let job =
-        match servoplot::drawing::from_shape(Shape::Straight { to: Point::new(400, 300) }, Point::ORIGIN, &settings) {
-            Ok(drawing) => Job::draw(drawing, Feed::MmPerMin(1_000.0)),
-            Err(_) => panic!("drawing refused"),
-        };
+    // A line out and the line back: each starts where the other ends.
+    let line = |from: Point, to: Point| match servoplot::drawing::from_shape(Shape::Straight { to }, from, &settings) {
+        Ok(drawing) => Job::draw(drawing, Feed::MmPerMin(1_000.0)),
+        Err(_) => panic!("drawing refused"),
+    };
+    let there = Point::new(400, 300);
+    let (out, back) = (line(Point::ORIGIN, there), line(there, Point::ORIGIN));
+    let next = |end: PlanEnd| if end.at() == Point::ORIGIN { out.clone() } else { back.clone() };
     for round in 0..ROUNDS {
         // Keypad task: a key through the menu, then the run screen follows the machine.
         for key in KEYS {
@@ -62,10 +65,12 @@ pub fn run() {
         core::hint::black_box(panel.read(|menu| screen::view(menu, &status, &settings, &live)));
         // Inputs and motion task: jobs handed over until the queue is full, one more waiting for
         // room, then all taken; the motion task waits for the first.
-        let epoch = machine.plan_epoch();
+        let Some(mut end) = machine.plan_end() else { panic!("plan end") };
         waits(machine.job_ready());
-        while machine.try_submit(job.clone(), epoch).is_ok() {}
-        let mut waiting = pin!(machine.submit(job.clone(), epoch));
+        while let Ok(ends) = machine.try_submit(next(end), end) {
+            end = ends;
+        }
+        let mut waiting = pin!(machine.submit(next(end), end));
         let mut queued = poll(waiting.as_mut()).is_ready();
         while let Some(taken) = machine.next_job() {
             core::hint::black_box(taken);

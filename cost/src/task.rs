@@ -80,7 +80,8 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let (producer, mut consumer) = queue.split();
     let mut motion =
         pin!(servoplot::tasks::motion::run(&machine, planner(), producer, || {}, servoplot::tasks::motion::RealTime));
-    if machine.try_submit(job, machine.plan_epoch()).is_err() {
+    let Some(from) = machine.plan_end() else { panic!("plan end") };
+    if machine.try_submit(job, from).is_err() {
         panic!("job queue");
     }
     let waker = noop_waker();

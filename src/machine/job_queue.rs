@@ -1,5 +1,5 @@
-//! The job queue: values (jobs, with the epoch they were planned in) handed from the inputs to
-//! the motion task without a lock around them.
+//! The job queue: values (jobs, with the plan's end they were planned from) handed from the
+//! inputs to the motion task without a lock around them.
 //!
 //! A job is 648 bytes: copied inside a critical section it would mask the pulse interrupt for
 //! about a thousand instructions. Here a producer claims a free slot with one atomic

@@ -317,8 +317,8 @@ pub enum Report {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// A drawing (G0, G1, G2/G3, `$E`, `$O`, `$S`, `$F`) or a `$J=` jog, built and checked;
-    /// the parser's planned position is its end. A jog cancel (0x85) aborts a jog, then
-    /// [`GcodeState::sync_position`].
+    /// the parser's planned position is its end. A jog cancel (0x85) aborts a jog; the parser
+    /// then plans from where it stopped ([`GcodeState::plan_from`]).
     Job(Job),
     /// G4: wait this long once the motion before it has finished.
     Dwell { ms: u32 },
@@ -414,10 +414,18 @@ impl GcodeState {
         self.sync_position(position, settings);
     }
 
-    /// Makes the planned position the machine's real one: after a jog cancel, an abort, an
-    /// alarm, or a move made outside the protocol (keypad). Out of line: four callers.
+    /// Plans on from `end`, where the machine says the plan ends: unchanged if that is where
+    /// the parser planned to (its fractions of a step kept), else the parser's planned position
+    /// becomes `end` (the keypad drew, an abort stopped the pen, or homing moved machine zero).
+    pub fn plan_from(&mut self, end: Point, settings: &Settings) {
+        if end != self.position {
+            self.sync_position(end, settings);
+        }
+    }
+
+    /// Makes the planned position `position`, in steps. Out of line: three callers.
     #[inline(never)]
-    pub fn sync_position(&mut self, position: Point, settings: &Settings) {
+    fn sync_position(&mut self, position: Point, settings: &Settings) {
         self.position = position;
         self.position_mm = [settings.steps_to_mm(Axis::X, position.x), settings.steps_to_mm(Axis::Y, position.y)];
     }

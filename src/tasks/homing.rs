@@ -9,7 +9,7 @@ use crate::geom::{Axis, Point};
 use crate::homing::{HOMING_ORDER, HomingFail, Phase, homed_steps, homing_move, towards_max};
 use crate::inputs::{InputSetup, Trip};
 use crate::job::Job;
-use crate::machine::{Machine, MotionFault, PlanEpoch};
+use crate::machine::{Machine, MotionFault, PlanEnd};
 use crate::status::RunState;
 use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
 
@@ -43,13 +43,13 @@ pub async fn run(machine: &Machine) -> ! {
     }
 }
 
-/// The cycle may go on: no trip raised an alarm (`Err(None)`: it said why), and no abort came
-/// since the cycle began in `epoch`.
-fn still_homing(machine: &Machine, epoch: PlanEpoch) -> Result<(), Option<HomingFail>> {
+/// The cycle may go on: no trip raised an alarm (`Err(None)`: it said why), and the plan ends
+/// at `left`, where the cycle's last move left it: no abort came, nothing else was handed over.
+fn still_homing(machine: &Machine, left: PlanEnd) -> Result<(), Option<HomingFail>> {
     if machine.run_state() == RunState::Alarm || machine.halted() {
         return Err(None);
     }
-    if machine.plan_epoch() != epoch {
+    if machine.plan_end() != Some(left) {
         return Err(Some(HomingFail::Aborted));
     }
     Ok(())
@@ -67,29 +67,31 @@ async fn until_stopped(machine: &Machine) {
 async fn cycle(machine: &Machine) -> Result<(), Option<HomingFail>> {
     let settings = machine.settings();
     // A healthy cycle never aborts: any abort from here on, even between moves, is a reset or a
-    // keypad D that stops it.
-    let epoch = machine.plan_epoch();
+    // keypad D that stops it. Each move is planned from where the one before it left the plan.
+    let mut plan = machine.plan_end().ok_or(HomingFail::Aborted)?;
     for axis in HOMING_ORDER {
         let switch = Trip::Limit { axis, max: towards_max(&settings, axis) };
         for phase in Phase::ALL {
             let step = homing_move(&settings, axis, phase);
-            let from = machine.position();
+            let from = plan.at();
             let to = match axis {
                 Axis::X => Point::new(from.x + step.steps, from.y),
                 Axis::Y => Point::new(from.x, from.y + step.steps),
             };
             let job = Job::homing_move(from, to, step.feed_mm_per_min, &settings).ok_or(HomingFail::Approach(axis))?;
-            machine.submit(job, epoch).await.map_err(|_| HomingFail::Aborted)?;
+            let ends = machine.submit(job, plan).await.map_err(|_| HomingFail::Aborted)?;
             until_stopped(machine).await;
             let found = machine.take_switch_found();
-            still_homing(machine, epoch)?;
+            // Stopped at its switch, the move left the plan where the pen stands.
+            plan = if found.is_some() { ends.then(machine.position()) } else { ends };
+            still_homing(machine, plan)?;
             if phase.approaches() && found != Some(switch) {
                 return Err(Some(HomingFail::Approach(axis)));
             }
             // The switch settles, and the inputs are read again.
             let settle_ms = u64::from(settings.homing_debounce_ms) + SERVO_ENABLE_POLL_MS;
             Timer::after(Duration::from_millis(settle_ms)).await;
-            still_homing(machine, epoch)?;
+            still_homing(machine, plan)?;
             if !phase.approaches() && InputSetup::from_settings(&settings).pressed(machine.input_levels(), switch) {
                 return Err(Some(HomingFail::PullOff(axis)));
             }

@@ -11,7 +11,7 @@ use embedded_hal::digital::{InputPin, OutputPin};
 use crate::drawing::BUILD_SLICE_STEPS;
 use crate::job::{Control, Job};
 use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
-use crate::machine::Machine;
+use crate::machine::{Machine, PlanEnd};
 use crate::pen;
 use crate::tasks::panel::Panel;
 use crate::tasks::slices::BetweenSlices;
@@ -34,8 +34,10 @@ pub async fn run<C: OutputPin, R: InputPin>(
 ) -> ! {
     let mut decoder = KeypadDecoder::new();
     let mut ticker = Ticker::every(Duration::from_millis(KEYPAD_SCAN_PERIOD_MS as u64));
-    // The drawing the menu asked for, built between the scans.
+    // The drawing the menu asked for, built between the scans, and where the plan ended when it
+    // was set up: where it starts.
     let mut building: Option<Building> = None;
+    let mut from: Option<PlanEnd> = None;
     loop {
         if let Some(b) = &mut building {
             let slice = async {
@@ -46,7 +48,7 @@ pub async fn run<C: OutputPin, R: InputPin>(
             // The scan comes first when it is due.
             if let Either::Second(done) = select(ticker.next(), slice).await {
                 if done {
-                    built(machine, panel, &mut building);
+                    built(machine, panel, &mut building, &mut from);
                 }
                 continue;
             }
@@ -59,7 +61,7 @@ pub async fn run<C: OutputPin, R: InputPin>(
             let status = machine.status();
             let settings = machine.settings();
             let action = panel.update(|menu| menu.handle(event, &status, &settings));
-            act(machine, panel, action, &mut building);
+            act(machine, panel, action, &mut building, &mut from);
         }
         // The run screen follows the machine between keys.
         let status = machine.status();
@@ -85,7 +87,7 @@ async fn scan<C: OutputPin, R: InputPin>(columns: &mut [C; 4], rows: &mut [R; 4]
 
 /// Hands the menu the drawing it asked for, walked to its end, and carries out what it asks
 /// for then; the building is spent unless the menu starts it.
-fn built(machine: &Machine, panel: &Panel, building: &mut Option<Building>) {
+fn built(machine: &Machine, panel: &Panel, building: &mut Option<Building>, from: &mut Option<PlanEnd>) {
     let Some(b) = building.as_mut() else { return };
     let status = machine.status();
     let settings = machine.settings();
@@ -94,35 +96,49 @@ fn built(machine: &Machine, panel: &Panel, building: &mut Option<Building>) {
         // Shown, or refused.
         *building = None;
     }
-    act(machine, panel, action, building);
+    act(machine, panel, action, building, from);
 }
 
 /// Carries out a menu action: start or drop a build, queue a job, or pass a control to the
-/// motion task.
-fn act(machine: &Machine, panel: &Panel, action: MenuAction, building: &mut Option<Building>) {
+/// motion task. A drawing or a jog starts where the plan ends (see [`Machine::plan_end`]), and
+/// `from` keeps that end for the drawing being built.
+fn act(
+    machine: &Machine,
+    panel: &Panel,
+    action: MenuAction,
+    building: &mut Option<Building>,
+    from: &mut Option<PlanEnd>,
+) {
     match action {
         MenuAction::None => {}
         MenuAction::Build(request) => {
-            if let Err(why) = Building::start(building, &request, machine.status().position, &machine.settings()) {
+            *from = machine.plan_end();
+            // The menu asks only at rest, when the plan's end is known.
+            let start = from
+                .map_or(Err(UiError::Busy), |end| Building::start(building, &request, end.at(), &machine.settings()));
+            if let Err(why) = start {
                 refuse(panel, why);
             }
         }
         MenuAction::DropBuild => *building = None,
         MenuAction::Start(feed) => {
-            if let Some(mut job) = building.as_mut().and_then(|b| b.job(feed)) {
+            if let Some(mut job) = building.as_mut().and_then(|b| b.job(feed))
+                && let Some(from) = *from
+            {
                 // A pen lift lowers the pen for a keypad drawing and raises it once it is drawn.
                 if let Some(pen) = pen::for_keypad_drawing(&machine.settings()) {
                     job.pen = Some(pen);
                     job.raise_after = true;
                 }
-                queue(machine, panel, job);
+                queue(machine, panel, job, from);
             }
             *building = None;
         }
         MenuAction::JogStart(direction) => {
             // At the edge already, a jog outwards goes nowhere.
-            if let Some(job) = Job::jog(direction, machine.status().position, &machine.settings()) {
-                queue(machine, panel, job);
+            let Some(from) = machine.plan_end() else { return refuse(panel, UiError::Busy) };
+            if let Some(job) = Job::jog(direction, from.at(), &machine.settings()) {
+                queue(machine, panel, job, from);
             }
         }
         MenuAction::JogStop => machine.request(Control::Abort),
@@ -146,13 +162,14 @@ fn change_settings(machine: &Machine, panel: &Panel, changes: &[(u16, f32)]) {
     }
 }
 
-fn queue(machine: &Machine, panel: &Panel, job: Job) {
-    // Planned from the pen as it stands now: the current epoch.
-    if machine.try_submit(job, machine.plan_epoch()).is_err() {
-        // The menu starts jobs only while the machine is idle, so this is a full queue from the
-        // host link: the keypad job is refused, visibly, rather than waiting unseen.
+/// Hands `job`, planned from `from`, to the motion task. The menu starts jobs only while the
+/// machine is idle, so a refusal is the host link's doing: it filled the queue, or handed a job
+/// over since `from` (the keypad's would start where the pen will not be). The keypad job is
+/// refused, visibly, rather than waiting unseen.
+fn queue(machine: &Machine, panel: &Panel, job: Job, from: PlanEnd) {
+    if let Err(why) = machine.try_submit(job, from) {
         refuse(panel, UiError::Busy);
-        warn!("keypad job refused: job queue full");
+        warn!("keypad job refused: {:?}", why);
     }
 }
 

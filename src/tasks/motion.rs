@@ -22,7 +22,7 @@ use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 
 use crate::drawing::Drawing;
-use crate::geom::{Point, TICKS_PER_US};
+use crate::geom::TICKS_PER_US;
 use crate::inputs::Trip;
 use crate::interp::Curve;
 use crate::job::{Control, Job, JobKind};
@@ -58,13 +58,11 @@ pub const PUBLISH_BATCH_STEPS: usize = 32;
 /// of a function's steps is some 8 ms of the F407; half keeps the poll short.
 pub const FILL_MAX_STEPS: u32 = (STEP_QUEUE_LEN / 2) as u32;
 
-/// What the task has queued for the pulse engine: the totals it publishes, and where the
-/// steps take the pen.
+/// What the task has queued for the pulse engine: the totals it publishes. (Where the pen is,
+/// and where the plan ends, the machine says.)
 struct Queued {
     steps: u32,
     ticks: u32,
-    /// Where the steps queued so far take the pen.
-    end: Point,
     /// A rest ends what was published: the pulse engine stops when it is done.
     resting: bool,
     /// The interval of the steps queued last (their mean over the last batch), ticks.
@@ -72,9 +70,9 @@ struct Queued {
 }
 
 impl Queued {
-    /// Nothing queued: the motion rests at `at`, after `steps` and `ticks` so far.
-    fn at_rest(steps: u32, ticks: u32, at: Point) -> Queued {
-        Queued { steps, ticks, end: at, resting: true, last_interval_ticks: 0 }
+    /// Nothing queued: the motion rests, after `steps` and `ticks` so far.
+    fn at_rest(steps: u32, ticks: u32) -> Queued {
+        Queued { steps, ticks, resting: true, last_interval_ticks: 0 }
     }
 }
 
@@ -110,7 +108,7 @@ pub async fn run(
     mut work: impl WorkTime,
 ) -> ! {
     planner.set_limits(Limits::from_settings(&machine.settings()));
-    let mut queued = Queued::at_rest(0, 0, machine.position());
+    let mut queued = Queued::at_rest(0, 0);
     let mut supervisor = Supervisor::new();
     // The overrides the planner has.
     let mut overrides = Overrides::NONE;
@@ -153,7 +151,7 @@ pub async fn run(
         match then.next {
             Next::Yield => yield_now().await,
             Next::UntilEmitted => until_half_emitted(machine, &queued).await,
-            Next::Rest => rest(machine, planner, &mut supervisor, held.is_some(), queued.end).await,
+            Next::Rest => rest(machine, planner, &mut supervisor, held.is_some()).await,
             Next::Held => stand_held(machine, planner).await,
             Next::Retry => Timer::after(Duration::from_micros(MOTION_RETRY_US)).await,
         }
@@ -235,21 +233,16 @@ async fn until_half_emitted(machine: &Machine, queued: &Queued) {
     select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
 }
 
-/// Everything planned is queued: waits until it has been emitted, at `end`, then does what the
+/// Everything planned is queued: waits until it has been emitted, then does what the
 /// supervisor says of the rest: takes the job `held` back, or moves the pen, publishes the run
 /// state and waits for work.
-async fn rest(
-    machine: &Machine,
-    planner: &Planner<Curve, PLANNER_SEGMENTS>,
-    supervisor: &mut Supervisor,
-    held: bool,
-    end: Point,
-) {
+async fn rest(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>, supervisor: &mut Supervisor, held: bool) {
     while !machine.pulses_idle() && !machine.halted() {
         machine.until_pulses_stopped().await;
     }
     if machine.run_state() != RunState::Idle {
-        info!("at rest at ({}, {}) steps", end.x, end.y);
+        let at = machine.position();
+        info!("at rest at ({}, {}) steps", at.x, at.y);
     }
     let settings = machine.settings();
     match supervisor.at_rest(held, machine.queued_jobs(), machine.run_state(), &settings) {
@@ -293,7 +286,7 @@ async fn halted(
     planner.drop_all();
     steps.retract();
     let (emitted_steps, emitted_ticks) = machine.emitted_totals();
-    *queued = Queued::at_rest(emitted_steps, emitted_ticks, machine.position());
+    *queued = Queued::at_rest(emitted_steps, emitted_ticks);
     machine.set_queued(emitted_steps, emitted_ticks);
     machine.set_plan_empty(true);
     machine.set_plan_free_segments(planner.free_segments());
@@ -353,7 +346,6 @@ async fn fill(
         }
         queued.steps = queued.steps.wrapping_add(emitted.steps as u32);
         queued.ticks = queued.ticks.wrapping_add(emitted.ticks);
-        queued.end = Point::new(queued.end.x + emitted.moved.x, queued.end.y + emitted.moved.y);
         ticks_room = ticks_room.saturating_sub(emitted.ticks);
         match emitted.end {
             None => {}

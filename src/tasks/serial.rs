@@ -64,7 +64,7 @@ use embedded_storage::nor_flash::NorFlash;
 use crate::drawing::BUILD_SLICE_STEPS;
 use crate::inputs::{InputSetup, Trip};
 use crate::job::{Control, Job};
-use crate::machine::{Machine, MotionFault, PlanEpoch, Stale};
+use crate::machine::{Machine, MotionFault, PlanEnd, Stale};
 use crate::overrides::Overrides;
 use crate::pen::{self, Pen, PenDepth};
 use crate::planner::PLANNER_SEGMENTS;
@@ -305,8 +305,7 @@ async fn lines<F: NorFlash>(
     between: impl BetweenSlices,
 ) -> ! {
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
-    let epoch = host.machine.plan_epoch();
-    let mut parser = Parser { host, gcode, store, epoch, restart_after_answer: false, between };
+    let mut parser = Parser { host, gcode, store, plan: None, restart_after_answer: false, between };
     let links = [&host.links[0], &host.links[1]];
     if let Err(e) = loaded {
         for link in links {
@@ -357,13 +356,14 @@ async fn lines<F: NorFlash>(
     }
 }
 
-/// The one parser every link's lines go through, and the epoch it plans in: after an abort,
-/// its planned position is stale until the machine stops.
+/// The one parser every link's lines go through, and where the plan ended when it took the line
+/// it carries out: its jobs are handed over as planned from there.
 struct Parser<'h, 'm, F: NorFlash, B: BetweenSlices> {
     host: &'h Host<'m>,
     gcode: GcodeState,
     store: &'h mut Store<F>,
-    epoch: PlanEpoch,
+    /// Where the plan ends as the parser planned (`None` before the first line).
+    plan: Option<PlanEnd>,
     /// The line being answered left check mode: the parser starts over once it is answered.
     restart_after_answer: bool,
     /// The pause between two slices of a line's curve.
@@ -429,7 +429,6 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         *self.host.refresh.borrow_mut() = Refresh::new();
         let settings = machine.settings();
         self.gcode.reset(machine.position(), &settings);
-        self.epoch = machine.plan_epoch();
         link.send(Reply::Welcome(machine.state())).await;
         self.startup_blocks(&[link]).await;
     }
@@ -497,20 +496,19 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     async fn line(&mut self, link: &Link, line: &str) -> Result<(), Unfinished> {
         let machine = self.host.machine;
         loop {
-            if machine.plan_epoch() != self.epoch {
-                // An abort (keypad, jog cancel, a curve stopped part way, a reset on another
-                // link) dropped what was planned: plan on from where the pen stops.
+            // The line starts where the plan ends, whoever handed the last job over (either
+            // link, the keypad, the homing cycle). After an abort (keypad, jog cancel, a curve
+            // stopped part way, a reset on another link), that is where the pen stops.
+            let Some(end) = machine.plan_end() else {
                 self.host.machine_stopped().for_line(link).await?;
-                self.epoch = machine.plan_epoch();
-                self.gcode.sync_position(machine.position(), &machine.settings());
-            }
+                continue;
+            };
+            self.plan = Some(end);
             let settings = machine.settings();
             let state = machine.line_state();
-            if state == RunState::Idle {
-                // The keypad, an abort or a curve that stopped early may have moved the pen
-                // elsewhere than the parser planned. (In check mode the parser plans on from the
-                // lines it checked.)
-                self.gcode.sync_position(machine.position(), &settings);
+            if state != RunState::Check {
+                // In check mode the parser plans on from the lines it checked.
+                self.gcode.plan_from(end.at(), &settings);
             }
             let mut pending = Pending::new();
             self.gcode.parse(line, &settings, state, &mut pending).map_err(Unfinished::Error)?;
@@ -670,15 +668,17 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         Ok(())
     }
 
-    /// Hands a job, planned in the parser's epoch, to the motion task, waiting for room: the
-    /// `ok` goes out once it is queued. A reset on the line's link while it waits drops the job
-    /// silently (the banner follows); an abort before it is queued drops it with `error:9`,
-    /// since it was planned from a point the pen will not reach.
-    async fn queue(&self, link: &Link, job: Job) -> Result<(), Unfinished> {
-        link.unless_reset(self.host.machine.submit(job, self.epoch))
-            .await
-            .ok_or(Unfinished::Reset)?
-            .map_err(|Stale| Unfinished::Error(GrblError::Locked))
+    /// Hands a job, planned from where the plan ended as the line was taken, to the motion
+    /// task, waiting for room: the `ok` goes out once it is queued. A reset on the line's link
+    /// while it waits drops the job silently (the banner follows). A job the plan no longer
+    /// ends where it starts (an abort came, or the keypad handed a job over, since the line was
+    /// taken) is refused with `error:9`: it was planned from a point the pen will not reach.
+    async fn queue(&mut self, link: &Link, job: Job) -> Result<(), Unfinished> {
+        let stale = || Unfinished::Error(GrblError::Locked);
+        let from = self.plan.ok_or_else(stale)?;
+        let queued = link.unless_reset(self.host.machine.submit(job, from)).await.ok_or(Unfinished::Reset)?;
+        self.plan = Some(queued.map_err(|Stale| stale())?);
+        Ok(())
     }
 }
 
