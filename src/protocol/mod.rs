@@ -69,6 +69,7 @@
 
 pub mod framing;
 pub mod gcode;
+pub mod guards;
 pub mod refresh;
 pub mod report;
 pub mod startup;
