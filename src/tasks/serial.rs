@@ -16,6 +16,9 @@
 //! link sent before it, resets the parser and greets that link with the banner; the other links
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
 //!
+//! Where a line is parsed from, and what each command of it waits for, is refused on and answers,
+//! are [`crate::protocol::guards`]'s rules: the line loop waits, acts and answers as they say.
+//!
 //! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
 //! the parser has it after its last line) and the overrides in force (`|Ov:`) when
 //! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions and
@@ -62,19 +65,20 @@ use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
 use crate::drawing::BUILD_SLICE_STEPS;
-use crate::inputs::{InputSetup, Trip};
+use crate::inputs::Trip;
 use crate::job::{Control, Job};
 use crate::machine::{Machine, MotionFault, PlanEnd, Stale};
 use crate::overrides::Overrides;
-use crate::pen::{self, Pen, PenDepth};
+use crate::pen::{Pen, PenDepth};
 use crate::planner::PLANNER_SEGMENTS;
 use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::protocol::gcode::{Offsets, Pending};
+use crate::protocol::guards::{self, Answer, LineStart, Refusal, Reported, Wait};
 use crate::protocol::refresh::Refresh;
 use crate::protocol::report::{Reply, StatusFields};
 use crate::protocol::startup::{STARTUP_LINES, StartupLines};
 use crate::protocol::{Command, GcodeState, GrblError, Report};
-use crate::settings::{SettingError, Settings};
+use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
@@ -195,21 +199,60 @@ impl Host<'_> {
         Until { machine: self.machine, line_of: None, done: Machine::at_rest, then_pen: None, then_ms: 0, timer: None }
     }
 
-    /// Once nothing is queued or moving, sends the pen to `pen` (`depth` deep when down) and
-    /// waits for it to settle.
-    fn pen_to(&self, pen: Pen, depth: PenDepth) -> Until<'_> {
-        Until { then_pen: Some((pen, depth)), ..self.machine_at_rest() }
-    }
-
-    /// Once nothing is queued or moving, waits `ms` milliseconds (G4).
-    fn dwell(&self, ms: u32) -> Until<'_> {
-        Until { then_ms: ms, ..self.machine_at_rest() }
-    }
-
     /// Waits until nothing is queued, planned or moving, held or not, and no homing cycle
     /// runs: the position is final.
     fn machine_stopped(&self) -> Until<'_> {
         Until { done: Machine::at_standstill, ..self.machine_at_rest() }
+    }
+
+    /// The wait of a line of `link` the guards ask for: none, or until it is over (a reset on
+    /// `link` ends it).
+    async fn wait(&self, link: &Link, wait: Wait) -> Result<(), Unfinished> {
+        let until = match wait {
+            Wait::None => return Ok(()),
+            Wait::AtRest => self.machine_at_rest(),
+            Wait::Stopped => self.machine_stopped(),
+            // Once at rest, the pen goes there and settles.
+            Wait::Pen(pen, depth) => Until { then_pen: Some((pen, depth)), ..self.machine_at_rest() },
+            // Once at rest, G4's time.
+            Wait::Dwell { ms } => Until { then_ms: ms, ..self.machine_at_rest() },
+        };
+        until.for_line(link).await
+    }
+
+    /// Does what `command` does to the machine and the startup blocks, once its wait is over.
+    fn act(&self, command: &Command) -> Result<(), Refusal> {
+        let machine = self.machine;
+        match command {
+            Command::Pause => machine.request(Control::Hold),
+            Command::SetSetting { id, value } => {
+                let pen = machine.position();
+                machine
+                    .update_settings(|s| s.set_all_around(&[(*id, *value)], pen))
+                    .map_err(guards::setting_refused)?;
+            }
+            Command::RestoreSettings { startup_lines } => {
+                machine.update_settings(|s| *s = Settings::default());
+                if *startup_lines {
+                    self.startup.borrow_mut().clear();
+                }
+            }
+            Command::StoreStartupLine { index, line } => {
+                self.startup.borrow_mut().set(usize::from(*index), line.clone())
+            }
+            Command::StoreBuildInfo(line) => self.startup.borrow_mut().build_info = line.clone(),
+            Command::Sleep => machine.sleep(),
+            Command::CheckMode { on: true } => machine.set_check_mode(true),
+            // The parser restarts once the line is answered.
+            Command::CheckMode { on: false } => {}
+            Command::Home => {
+                machine.request_homing();
+            }
+            Command::Unlock => machine.unlock(),
+            // Queued; done waiting; or only answered.
+            Command::Job(_) | Command::Dwell { .. } | Command::Pen(..) | Command::ProgramEnd | Command::Report(_) => {}
+        }
+        Ok(())
     }
 }
 
@@ -294,6 +337,15 @@ enum Unfinished {
     Error(GrblError),
     /// A reset came on the line's link: the line gets no answer (the banner follows).
     Reset,
+}
+
+/// Says why a command of a line of `link` was refused, if the guards give a reason; the line is
+/// then answered `error:N`.
+async fn refuse(link: &Link, refusal: Refusal) -> Unfinished {
+    if let Some(text) = refusal.message {
+        link.send(Reply::Message(text)).await;
+    }
+    Unfinished::Error(refusal.error)
 }
 
 /// Says why the flash store gave the defaults, if it did, and runs the startup blocks; then
@@ -438,7 +490,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     async fn startup_blocks(&mut self, links: &[&Link]) {
         let machine = self.host.machine;
         let settings = machine.settings();
-        if machine.state() != RunState::Alarm {
+        if guards::startup_blocks_run(machine.state()) {
             let startup = self.host.startup.borrow().clone();
             for index in 0..STARTUP_LINES {
                 let line = startup.line(index);
@@ -499,38 +551,23 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             // The line starts where the plan ends, whoever handed the last job over (either
             // link, the keypad, the homing cycle). After an abort (keypad, jog cancel, a curve
             // stopped part way, a reset on another link), that is where the pen stops.
-            let Some(end) = machine.plan_end() else {
+            let plan_end = machine.plan_end();
+            let settings = machine.settings();
+            let state = machine.line_state();
+            let LineStart::Parse { end, from_end } = guards::line_start(plan_end, state) else {
                 self.host.machine_stopped().for_line(link).await?;
                 continue;
             };
             self.plan = Some(end);
-            let settings = machine.settings();
-            let state = machine.line_state();
-            if state != RunState::Check {
-                // In check mode the parser plans on from the lines it checked.
+            if from_end {
                 self.gcode.plan_from(end.at(), &settings);
             }
             let mut pending = Pending::new();
             self.gcode.parse(line, &settings, state, &mut pending).map_err(Unfinished::Error)?;
-            // The line's curve, a slice at a time; the other tasks and the links' receivers run
-            // between slices. A reset on the link drops the line unanswered, the parser
-            // unchanged.
-            loop {
-                let slice = pending.advance(BUILD_SLICE_STEPS);
-                if slice.steps > 0 {
-                    self.between.after(&slice).await;
-                }
-                if link.resetting() {
-                    return Err(Unfinished::Reset);
-                }
-                if slice.done {
-                    break;
-                }
-            }
-            if pending.changes_kept(&self.gcode) && !machine.stopped() {
-                // A line that changes what a power cycle keeps (G10, G28.1, G30.1) runs with the
-                // machine stopped, from where the pen stands: a reset meanwhile drops it unrun,
-                // and it is parsed again once the motion before it has ended.
+            self.build(link, &mut pending).await?;
+            if guards::kept_change_waits(pending.changes_kept(&self.gcode), machine.stopped()) {
+                // It runs with the machine stopped, from where the pen stands: a reset meanwhile
+                // drops it unrun, and it is parsed again once the motion before it has ended.
                 self.host.machine_stopped().for_line(link).await?;
                 continue;
             }
@@ -544,128 +581,69 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         }
     }
 
-    /// Carries out one command of a line of `link`: waits for what it waits for (the machine at
-    /// rest or stopped, the pen, a dwell), acts, and sends its answer if it has one.
+    /// Builds the curve of a line of `link` a slice at a time; the other tasks and the links'
+    /// receivers run between slices. A reset on the link drops the line unanswered, the parser
+    /// unchanged.
+    async fn build(&mut self, link: &Link, pending: &mut Pending) -> Result<(), Unfinished> {
+        loop {
+            let slice = pending.advance(BUILD_SLICE_STEPS);
+            if slice.steps > 0 {
+                self.between.after(&slice).await;
+            }
+            if link.resetting() {
+                return Err(Unfinished::Reset);
+            }
+            if slice.done {
+                return Ok(());
+            }
+        }
+    }
+
+    /// Carries out one command of a line of `link` as the guards say: refused, or waited for,
+    /// done, waited on, and answered.
     async fn carry_out(&mut self, link: &Link, settings: &Settings, command: Command) -> Result<(), Unfinished> {
         let (host, machine) = (self.host, self.host.machine);
         if let Command::Job(job) = command {
             return self.queue(link, job).await;
         }
-        if matches!(command, Command::Unlock | Command::Home)
-            && InputSetup::from_settings(settings).stops_active(machine.input_levels()) != 0
-        {
-            // A driver alarm or the e-stop still raised would trip again at once.
-            link.send(Reply::Message("Driver alarm or e-stop still active")).await;
-            return Err(Unfinished::Error(GrblError::Locked));
-        }
-        // One wait for every command that waits before it acts.
-        let wait = match command {
-            Command::Dwell { ms } => Some(host.dwell(ms)),
-            Command::Pen(pen, depth) => Some(host.pen_to(pen, depth)),
-            // M2/M30 turn the spindle off: a pen lift raises the pen.
-            Command::ProgramEnd => match pen::at_program_end(settings) {
-                Some(pen) => Some(host.pen_to(pen, PenDepth::FULL)),
-                None => Some(host.machine_at_rest()),
-            },
-            Command::Pause => Some(host.machine_at_rest()),
-            // A setting applies to the motion after it, never under a move: the planner takes
-            // new limits at rest (see `Planner::set_limits`), so the lines before it end first.
-            // What a power cycle keeps changes only at rest: a reset meanwhile drops the line.
-            Command::SetSetting { .. }
-            | Command::RestoreSettings { .. }
-            | Command::StoreStartupLine { .. }
-            | Command::StoreBuildInfo(_)
-            | Command::Sleep => Some(host.machine_at_rest()),
-            Command::Home => Some(host.machine_stopped()),
-            // The motion task drops what a trip cut short before the pulses may go on.
-            Command::Unlock if machine.halted() => Some(host.machine_stopped()),
-            _ => None,
+        let reported = Reported { input_levels: machine.input_levels(), halted: machine.halted() };
+        let course = match guards::course(&command, reported, settings) {
+            Ok(course) => course,
+            Err(refusal) => return Err(refuse(link, refusal).await),
         };
-        if let Some(wait) = wait {
-            wait.for_line(link).await?;
+        host.wait(link, course.before).await?;
+        if let Err(refusal) = host.act(&command) {
+            return Err(refuse(link, refusal).await);
         }
-        // The startup blocks may change while a report waits for room: a copy.
-        let startup;
-        let reply = match command {
-            // Queued, or done waiting, above.
-            Command::Job(_) | Command::Dwell { .. } | Command::Pen(..) => None,
-            Command::Pause => {
-                machine.request(Control::Hold);
-                None
-            }
-            Command::ProgramEnd => Some(Reply::Message("Pgm End")),
-            Command::SetSetting { id, value } => {
-                let pen = machine.position();
-                match machine.update_settings(|s| s.set_all_around(&[(id, value)], pen)) {
-                    Ok(()) => None,
-                    Err(SettingError::StrandsPen) => {
-                        link.send(Reply::Message("The pen would be outside the travel: setting refused")).await;
-                        return Err(Unfinished::Error(GrblError::TravelExceeded));
-                    }
-                    Err(_) => return Err(Unfinished::Error(GrblError::InvalidStatement)),
-                }
-            }
-            Command::RestoreSettings { startup_lines } => {
-                machine.update_settings(|s| *s = Settings::default());
-                if startup_lines {
-                    host.startup.borrow_mut().clear();
-                }
-                None
-            }
-            Command::StoreStartupLine { index, line } => {
-                host.startup.borrow_mut().set(usize::from(index), line);
-                None
-            }
-            Command::StoreBuildInfo(line) => {
-                host.startup.borrow_mut().build_info = line;
-                None
-            }
-            Command::Report(kind) => {
-                startup = host.startup.borrow().clone();
-                let gcode = &self.gcode;
-                Some(match kind {
-                    Report::Help => Reply::Help,
-                    Report::Settings => Reply::Settings(settings),
-                    Report::ParserState => Reply::ParserState(gcode, settings),
-                    Report::Parameters => Reply::Parameters(gcode, settings),
-                    Report::BuildInfo => Reply::BuildInfo {
-                        info: &startup.build_info,
-                        planner_blocks: PLANNER_SEGMENTS,
-                        rx_buffer_bytes: SERIAL_RX_WINDOW_BYTES,
-                    },
-                    Report::StartupLines => Reply::StartupLines(&startup),
-                })
-            }
-            Command::Sleep => {
-                machine.sleep();
-                Some(Reply::Message("Sleeping"))
-            }
-            Command::CheckMode { on: true } => {
-                machine.set_check_mode(true);
-                Some(Reply::Message("Enabled"))
-            }
-            Command::CheckMode { on: false } => {
-                self.restart_after_answer = true;
-                Some(Reply::Message("Disabled"))
-            }
-            Command::Home => {
-                machine.request_homing();
-                host.machine_stopped().for_line(link).await?;
-                // A failed cycle pushed its alarm.
-                if machine.run_state() == RunState::Alarm {
-                    return Err(Unfinished::Error(GrblError::Locked));
-                }
-                None
-            }
-            Command::Unlock => {
-                machine.unlock();
-                Some(Reply::Message("Caution: Unlocked"))
-            }
-        };
-        if let Some(reply) = reply {
-            link.send(reply).await;
+        host.wait(link, course.after).await?;
+        match course.answer(machine.run_state()) {
+            Ok(Answer::None) => {}
+            Ok(Answer::Message(text)) => link.send(Reply::Message(text)).await,
+            Ok(Answer::Report(kind)) => self.report(link, settings, kind).await,
+            Err(refusal) => return Err(refuse(link, refusal).await),
         }
+        self.restart_after_answer |= course.restart_after_answer;
         Ok(())
+    }
+
+    /// Answers `$`, `$$`, `$G`, `$#`, `$I` or `$N` on `link`.
+    async fn report(&self, link: &Link, settings: &Settings, kind: Report) {
+        // The startup blocks may change while the report waits for room: a copy.
+        let startup = self.host.startup.borrow().clone();
+        let gcode = &self.gcode;
+        let reply = match kind {
+            Report::Help => Reply::Help,
+            Report::Settings => Reply::Settings(settings),
+            Report::ParserState => Reply::ParserState(gcode, settings),
+            Report::Parameters => Reply::Parameters(gcode, settings),
+            Report::BuildInfo => Reply::BuildInfo {
+                info: &startup.build_info,
+                planner_blocks: PLANNER_SEGMENTS,
+                rx_buffer_bytes: SERIAL_RX_WINDOW_BYTES,
+            },
+            Report::StartupLines => Reply::StartupLines(&startup),
+        };
+        link.send(reply).await;
     }
 
     /// Hands a job, planned from where the plan ended as the line was taken, to the motion
