@@ -1,7 +1,7 @@
 //! The host link's GRBL 1.1 line protocol: the pure, synchronous core of the serial link.
 //!
 //! Existing G-code senders (UGS, CNCjs, bCNC) and a plain terminal talk to the plotter as if it
-//! were GRBL 1.1. This module owns the three pure parts of that conversation:
+//! were GRBL 1.1. This module owns the pure parts of that conversation:
 //!
 //! - [`framing`]: bytes in, text lines out ([`LineAssembler`]), and the realtime bytes that
 //!   bypass lines ([`realtime`]);
@@ -9,7 +9,8 @@
 //!   modal state, planned position and error rules, plus the plotter's own curve commands;
 //! - [`report`]: every answer the plotter writes (`ok`, `error:N`, status reports, `$$`, ...);
 //! - [`refresh`]: which status reports carry GRBL's occasional `WCO:` and `Ov:` fields;
-//! - [`startup`]: the startup blocks (`$N0=`, `$N1=`) run after every reset.
+//! - [`startup`]: the startup blocks (`$N0=`, `$N1=`) run after every reset;
+//! - [`guards`]: what each command waits for before it acts, is refused on, and answers.
 //!
 //! It owns no pins, queues or clocks: the serial task feeds it bytes, hands the resulting
 //! commands to the machine and writes the answers. Every line gets exactly one `ok` or
