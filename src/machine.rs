@@ -38,13 +38,15 @@
 //! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
 //!   for room (taken out, and woken outside the lock).
 
-mod from_pulses;
+mod handles;
 mod job_queue;
 mod jobs;
 mod path_steps;
 mod plan_end;
 mod published;
 mod pulse_news;
+mod pulse_side;
+mod pulse_writer;
 mod settings;
 
 use core::cell::Cell;
@@ -55,7 +57,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
-use crate::geom::{Point, StepCmd, TICK_HZ};
+use crate::geom::{Point, TICK_HZ};
 use crate::inputs::{InputLevels, Trip};
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
@@ -65,12 +67,14 @@ use crate::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
+pub use handles::Handles;
 use job_queue::JobQueue;
 use path_steps::PathSteps;
 use plan_end::PlanState;
 pub use plan_end::{PlanEnd, Stale};
 use published::Published;
-use pulse_news::PulseNews;
+use pulse_side::PulseSide;
+pub use pulse_writer::PulseWriter;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -122,6 +126,10 @@ const STATE_ALARM: u8 = 4;
 
 /// Everything the tasks share.
 pub struct Machine {
+    /// What the pulse interrupt writes ([`PulseWriter`]).
+    pulses: PulseSide,
+    /// The writers' handles were handed out ([`handles`](Self::handles)).
+    handed_out: AtomicBool,
     /// Jobs handed over, each with the plan's end it was planned from.
     jobs: JobQueue<(PlanEnd, Job), JOB_QUEUE_LEN, JOB_SUBMITTERS>,
     /// Where the plan ends (see [`jobs`]).
@@ -147,31 +155,16 @@ pub struct Machine {
     plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pulses_done: Signal<CriticalSectionRawMutex, ()>,
-    /// What the pulse interrupt has to tell, not yet delivered (see [`pulse_news`]).
-    pulse_news: PulseNews,
-    /// Pulses emitted (written only by the pulse engine).
-    position: [AtomicI32; 2],
     state: AtomicU8,
     /// Steps queued for the pulse engine so far, and the sum of their intervals in ticks
     /// (written only by the motion task; both wrap).
     queued_steps: AtomicU32,
     queued_ticks: AtomicU32,
-    /// Steps emitted so far and the sum of their intervals (written only by the pulse engine).
-    emitted_steps: AtomicU32,
-    emitted_ticks: AtomicU32,
-    /// The interval of the step emitted last, ticks (written only by the pulse engine), and how
-    /// far the queued steps advance along the ideal curve (written only by the motion task): the
-    /// pen's speed along its path is the one over the other.
-    last_interval_ticks: AtomicU32,
+    /// How far the queued steps advance along the ideal curve (written only by the motion task):
+    /// the pen's speed along its path is this over the interval of the step emitted last.
     path_steps: PathSteps,
     /// Machine position minus work position, mm (written by the host link's parser).
     work_offset_mm: Mutex<CriticalSectionRawMutex, Cell<[f32; 2]>>,
-    /// Times the pulse engine found the queue empty while the motion was not at rest
-    /// (written only by the pulse engine).
-    underruns: AtomicU32,
-    /// Times the step timer's interrupt came a whole period late (written only by the pulse
-    /// engine).
-    missed_updates: AtomicU32,
     /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
     drawing: AtomicU8,
     settings: Published<Settings>,
@@ -183,8 +176,6 @@ pub struct Machine {
     halted: AtomicBool,
     /// The trip the motion task has not yet handled.
     trip: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
-    /// The step timer runs (written only by the pulse engine).
-    pulsing: AtomicBool,
     /// The input levels the servo task read last (written only by it).
     input_levels: AtomicU8,
     /// A homing cycle runs: limit switches ahead are watched, and one found is no alarm.
@@ -216,6 +207,8 @@ impl Machine {
     pub fn new(settings: Settings) -> Self {
         let locked = settings.homing;
         Machine {
+            pulses: PulseSide::new(),
+            handed_out: AtomicBool::new(false),
             jobs: JobQueue::new(),
             plan: Mutex::new(Cell::new(PlanState::at(Point::ORIGIN))),
             control: Mutex::new(Cell::new(None)),
@@ -223,31 +216,23 @@ impl Machine {
             overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
             pulses_done: Signal::new(),
-            pulse_news: PulseNews::new(),
             plan_empty: AtomicBool::new(true),
             check_mode: AtomicBool::new(false),
             door: AtomicBool::new(false),
             asleep: AtomicBool::new(false),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
-            position: [AtomicI32::new(0), AtomicI32::new(0)],
             state: AtomicU8::new(if locked { STATE_ALARM } else { STATE_IDLE }),
             queued_steps: AtomicU32::new(0),
             queued_ticks: AtomicU32::new(0),
-            emitted_steps: AtomicU32::new(0),
-            emitted_ticks: AtomicU32::new(0),
-            last_interval_ticks: AtomicU32::new(0),
             path_steps: PathSteps::new(),
             work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
-            underruns: AtomicU32::new(0),
-            missed_updates: AtomicU32::new(0),
             drawing: AtomicU8::new(0),
             settings: Published::new(settings),
             settings_changed: Signal::new(),
             fault: Mutex::new(Cell::new(None)),
             halted: AtomicBool::new(false),
             trip: Mutex::new(Cell::new(None)),
-            pulsing: AtomicBool::new(false),
             input_levels: AtomicU8::new(0),
             homing: AtomicBool::new(false),
             servos_ready: AtomicBool::new(false),
@@ -264,7 +249,7 @@ impl Machine {
     /// The machine position: the pulses emitted so far, from machine zero.
     pub fn position(&self) -> Point {
         let at = |axis: usize| {
-            let emitted = self.position[axis].load(Ordering::Relaxed);
+            let emitted = self.pulses.emitted_on(axis);
             emitted.wrapping_sub(self.origin[axis].load(Ordering::Relaxed))
         };
         Point::new(at(0), at(1))
@@ -274,7 +259,7 @@ impl Machine {
     /// calls this.
     pub fn set_origin(&self, position: Point) {
         for (axis, at) in [position.x, position.y].into_iter().enumerate() {
-            let emitted = self.position[axis].load(Ordering::Relaxed);
+            let emitted = self.pulses.emitted_on(axis);
             self.origin[axis].store(emitted.wrapping_sub(at), Ordering::Relaxed);
         }
         self.position_lost.store(false, Ordering::Relaxed);
@@ -415,26 +400,12 @@ impl Machine {
 
     /// Motion time queued for the pulse engine and not yet emitted, in ticks.
     pub fn queued_ticks(&self) -> u32 {
-        self.queued_ticks.load(Ordering::Acquire).wrapping_sub(self.emitted_ticks.load(Ordering::Acquire))
+        self.queued_ticks.load(Ordering::Acquire).wrapping_sub(self.pulses.emitted_ticks())
     }
 
     /// Step commands queued for the pulse engine and not yet emitted.
     pub fn queued_steps(&self) -> u32 {
-        self.queued_steps.load(Ordering::Acquire).wrapping_sub(self.emitted_steps.load(Ordering::Acquire))
-    }
-
-    /// Counts the pulses of `cmd`, emitted. Only the pulse engine calls this.
-    #[inline(always)]
-    pub fn emitted(&self, cmd: StepCmd) {
-        // Single writer: a load and a store, no read-modify-write cycle.
-        let [x, y] = &self.position;
-        x.store(x.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.x)), Ordering::Relaxed);
-        y.store(y.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.y)), Ordering::Relaxed);
-        self.last_interval_ticks.store(cmd.interval_ticks, Ordering::Relaxed);
-        let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
-        self.emitted_ticks.store(t, Ordering::Release);
-        let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);
-        self.emitted_steps.store(n, Ordering::Release);
+        self.queued_steps.load(Ordering::Acquire).wrapping_sub(self.pulses.emitted_steps())
     }
 
     /// How fast the pen moves along its path now, mm/min: how far a step advances along the
@@ -442,12 +413,12 @@ impl Machine {
     /// once stopped). Not the lattice step's own length: on a line at 30° the steps are X steps
     /// and diagonal ones, each advancing the same distance along the line at the same pace.
     pub fn speed_mm_per_min(&self) -> f32 {
-        let interval = self.last_interval_ticks.load(Ordering::Relaxed);
+        let interval = self.pulses.last_interval_ticks();
         if self.pulses_idle() || interval == 0 {
             return 0.0;
         }
         // The step emitted last is the one being timed.
-        let step = self.emitted_steps.load(Ordering::Acquire).wrapping_sub(1);
+        let step = self.pulses.emitted_steps().wrapping_sub(1);
         self.path_steps.at(step) * (60.0 * TICK_HZ as f32) / interval as f32
     }
 
@@ -476,11 +447,6 @@ impl Machine {
         self.plan_free.load(Ordering::Relaxed)
     }
 
-    /// Missed step timer updates since power-on.
-    pub fn missed_updates(&self) -> u32 {
-        self.missed_updates.load(Ordering::Relaxed)
-    }
-
     /// The motion task took a job drawing `kind`. Only the motion task calls this.
     pub fn set_drawing(&self, kind: ShapeKind) {
         let code = ShapeKind::ALL.iter().position(|&k| k == kind).map_or(0, |i| i as u8 + 1);
@@ -491,11 +457,6 @@ impl Machine {
     pub fn drawing(&self) -> Option<ShapeKind> {
         let code = self.drawing.load(Ordering::Relaxed);
         ShapeKind::ALL.get(usize::from(code).checked_sub(1)?).copied()
-    }
-
-    /// Step-queue underruns since power-on.
-    pub fn underruns(&self) -> u32 {
-        self.underruns.load(Ordering::Relaxed)
     }
 
     /// Waits until the pulse engine next reports that it stopped.
@@ -515,7 +476,7 @@ impl Machine {
 
     /// True when no step is queued or being emitted.
     pub fn pulses_idle(&self) -> bool {
-        self.queued_steps.load(Ordering::Acquire) == self.emitted_steps.load(Ordering::Acquire)
+        self.queued_steps.load(Ordering::Acquire) == self.pulses.emitted_steps()
     }
 
     pub fn run_state(&self) -> RunState {
@@ -655,14 +616,26 @@ impl Machine {
     /// has not stopped itself already, and starts nothing until [`unlock`](Self::unlock); the
     /// motion task drops what was planned and raises the alarm. A trip while halted is no news.
     pub fn trip(&self, trip: Trip) {
-        if self.halted.swap(true, Ordering::AcqRel) {
-            return;
+        if self.halt(trip) {
+            self.post_trip(trip);
         }
-        self.trip.lock(|t| t.set(Some(trip)));
+    }
+
+    /// Halts the pulses for `trip`; false if they were halted already.
+    fn halt(&self, trip: Trip) -> bool {
+        if self.halted.swap(true, Ordering::AcqRel) {
+            return false;
+        }
         // A limit switch a homing approach looks for stops nothing it does not expect.
         if !self.is_homing_switch(trip) {
             self.position_lost.store(true, Ordering::Relaxed);
         }
+        true
+    }
+
+    /// Leaves `trip` for the motion task, and wakes it and the displays.
+    fn post_trip(&self, trip: Trip) {
+        self.trip.lock(|t| t.set(Some(trip)));
         self.control_requested.signal(());
         self.changed.signal(());
     }
@@ -676,22 +649,6 @@ impl Machine {
     /// The trip the motion task has yet to handle, taking it. Only the motion task calls this.
     pub fn take_trip(&self) -> Option<Trip> {
         self.trip.lock(|t| t.take())
-    }
-
-    /// The step timer starts or stops. Only the pulse engine calls this.
-    pub fn set_pulsing(&self, on: bool) {
-        self.pulsing.store(on, Ordering::Release);
-    }
-
-    /// True while the step timer runs.
-    pub fn pulsing(&self) -> bool {
-        self.pulsing.load(Ordering::Acquire)
-    }
-
-    /// Steps emitted so far and the sum of their intervals (both wrap): after a trip, all there
-    /// will be of what was queued.
-    pub fn emitted_totals(&self) -> (u32, u32) {
-        (self.emitted_steps.load(Ordering::Acquire), self.emitted_ticks.load(Ordering::Acquire))
     }
 
     /// The input levels just read. Only the servo task calls this.
@@ -725,7 +682,7 @@ impl Machine {
             underruns: self.underruns(),
             missed_updates: self.missed_updates(),
             overrides: self.overrides(),
-            emitted_steps: self.emitted_steps.load(Ordering::Acquire),
+            emitted_steps: self.pulses.emitted_steps(),
             work_left: !self.stopped(),
         }
     }

@@ -85,10 +85,11 @@ fn start(spawner: Spawner) {
         why, settings.steps_per_mm[0], settings.steps_per_mm[1], settings.max_pulse_rate_hz
     );
     let machine: &'static Machine = build_machine(MACHINE.uninit(), settings);
+    let Some(handles) = machine.handles() else { defmt::panic!("the machine's handles taken twice") };
     let planner = Planner::init(PLANNER.uninit(), Limits::from_settings(&settings));
 
     let (steps, step_consumer) = STEP_QUEUE.take().split();
-    board::start_pulses(board.step_timer, step_consumer, machine);
+    board::start_pulses(board.step_timer, step_consumer, handles.pulse);
     let motion_spawner: SendSpawner = board::start_motion_executor();
     motion_spawner.spawn(timed(motion(machine, planner, steps), "motion", Executor::Interrupt));
 

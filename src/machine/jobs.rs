@@ -126,6 +126,7 @@ mod tests {
     use crate::geom::{Point, Step, StepCmd};
     use crate::job::Feed;
     use crate::machine::JOB_QUEUE_LEN;
+    use crate::machine::PulseWriter;
     use crate::settings::Settings;
     use core::pin::pin;
     use core::task::{Context, Waker};
@@ -155,7 +156,7 @@ mod tests {
     fn emit(machine: &Machine, dx: i32) {
         let step = Step::new(dx.signum() as i8, 0);
         for _ in 0..dx.abs() {
-            machine.emitted(StepCmd::new(step, 1));
+            PulseWriter::new(machine).emitted(StepCmd::new(step, 1));
         }
         let (steps, ticks) = machine.emitted_totals();
         machine.set_queued(steps, ticks);

@@ -1,6 +1,7 @@
 extern crate std;
 use super::*;
 use crate::geom::{Point, Step};
+use crate::machine::Machine;
 use proptest::prelude::*;
 use std::vec::Vec;
 
@@ -68,7 +69,7 @@ impl StepTimer for MockTimer {
 /// event the preloaded period becomes active, the update counter counts, and the interrupt
 /// runs, unless the timer says it comes late (then the period repeats). `between` runs after
 /// each period, as the motion task could.
-fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, mut between: impl FnMut(usize)) {
+fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: PulseWriter<'_>, max: usize, mut between: impl FnMut(usize)) {
     engine.kick(machine);
     machine.deliver_pulse_news();
     if !core::mem::take(&mut engine.timer_mut().started) {
@@ -114,12 +115,13 @@ fn queue(p: &mut StepProducer<'_>, cmds: &[StepCmd], rest: bool) {
 /// The engine with `settings` run over `cmds` to the end: its timer and the machine.
 fn emit(settings: Settings, cmds: &[StepCmd], late: &[usize]) -> (MockTimer, Machine) {
     let machine = Machine::new(settings);
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, cmds, true);
     let timer = MockTimer { late: late.to_vec(), ..MockTimer::default() };
     let mut engine = PulseEngine::new(timer, c);
-    run(&mut engine, &machine, 10_000, |_| {});
+    run(&mut engine, pulses, 10_000, |_| {});
     let PulseEngine { timer, .. } = engine;
     (timer, machine)
 }
@@ -142,12 +144,13 @@ fn driven(periods: &[(u32, u8, [bool; 2])], invert: u8) -> Point {
 fn steps_become_periods_ending_in_their_pulses_and_the_timer_stops_after_the_rest() {
     // 5 µs pulses, set-up and hold, 20 kHz: no period ending in a pulse under 50 µs.
     let machine = Machine::new(Settings::default());
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)), step(1, 1, us(60)), step(0, 1, us(60))], true);
     machine.set_queued(3, us(220));
     let mut engine = PulseEngine::new(MockTimer::default(), c);
-    run(&mut engine, &machine, 100, |_| {});
+    run(&mut engine, pulses, 100, |_| {});
     let periods: Vec<(u32, u8)> = engine.timer().periods.iter().map(|&(t, a, _)| (t, a)).collect();
     // SIGN is set for the first step of each axis: the hold first, then the rest of the
     // interval; a step in a known direction is one period.
@@ -307,12 +310,13 @@ fn an_interval_longer_than_the_timer_counts_waits_in_pulseless_periods() {
 #[test]
 fn a_queue_run_dry_before_the_rest_is_one_underrun_and_never_a_burst() {
     let machine = Machine::new(Settings::default());
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)); 3], false);
     let mut engine = PulseEngine::new(MockTimer::default(), c);
     // The motion task catches up only after the 10th period, then finishes.
-    run(&mut engine, &machine, 1_000, |k| {
+    run(&mut engine, pulses, 1_000, |k| {
         if k == 10 {
             queue(&mut p, &[step(1, 0, us(100)); 2], true);
         }
@@ -340,6 +344,7 @@ fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts
     // Hard limits, no debounce; normally open switches read low when pressed.
     let settings = Settings { hard_limits: true, input_debounce_ms: 0, ..Settings::default() };
     let machine = Machine::new(settings);
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)); 10], true);
@@ -351,27 +356,28 @@ fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts
         ..MockTimer::default()
     };
     let mut engine = PulseEngine::new(timer, c);
-    run(&mut engine, &machine, 100, |_| {});
+    run(&mut engine, pulses, 100, |_| {});
     assert_eq!(engine.timer().halts, 1);
     assert!(machine.halted());
     assert_eq!(machine.position(), Point::new(4, 0), "the pulses of the periods before");
     assert_eq!(machine.take_trip(), Some(Trip::Limit { axis: Axis::X, max: true }));
-    engine.kick(&machine);
+    engine.kick(pulses);
     assert!(!engine.is_running(), "halted: no kick starts the timer");
     machine.unlock();
-    engine.kick(&machine);
+    engine.kick(pulses);
     assert!(engine.is_running(), "unlocked, the queued steps go on");
 }
 
 #[test]
 fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
     let machine = Machine::new(Settings::default());
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100))], true);
     let mut engine = PulseEngine::new(MockTimer::default(), c);
     let mut more = Some(step(0, 1, us(2_000)));
-    run(&mut engine, &machine, 100, |_| {
+    run(&mut engine, pulses, 100, |_| {
         if let Some(cmd) = more.take() {
             queue(&mut p, &[cmd], true);
         }
@@ -384,7 +390,7 @@ fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
     let (mut p, c) = q.split();
     p.rest();
     let mut engine = PulseEngine::new(MockTimer::default(), c);
-    engine.kick(&machine);
+    engine.kick(pulses);
     assert!(!engine.is_running());
 }
 

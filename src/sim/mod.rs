@@ -206,6 +206,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let flash = config.flash.clone();
     let (mut store, loaded) = Store::open(config.flash, STORE_RANGE);
     let machine = Machine::new(store.kept().settings);
+    let Some(handles) = machine.handles() else { unreachable!("a new machine has its handles") };
     let panel = Panel::new();
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
@@ -239,7 +240,7 @@ pub fn run(config: SimConfig) -> SimReport {
 
     // The board's interrupts: the step timer, and the motion task on its interrupt executor.
     let interrupts = join(
-        step_timer::run(&machine, &mut engine, &kicks),
+        step_timer::run(handles.pulse, &mut engine, &kicks),
         tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu.clone(), &machine)),
     );
     // Thread mode: polled only while no work charged there takes it (see `cpu::ThreadLevel`).

@@ -1,0 +1,28 @@
+//! The writers' handles, handed out once: each task gets the handle to the part of the machine
+//! it writes, and reads the rest through the narrow reads on [`Machine`] (every handle derefs to
+//! it). The setters live on the handles only, so a task cannot write what it does not own.
+//!
+//! The board, the simulator and the tests take the handles from [`Machine::handles`] when they
+//! build the machine, and give each task its own. A handle is a reference: `Copy`, free to pass.
+
+use core::sync::atomic::Ordering;
+
+use super::Machine;
+use super::pulse_writer::PulseWriter;
+
+/// The machine's writers, one handle each.
+#[derive(Clone, Copy)]
+pub struct Handles<'m> {
+    /// For the pulse interrupt.
+    pub pulse: PulseWriter<'m>,
+}
+
+impl Machine {
+    /// The writers' handles: once per machine, `None` after the first call.
+    pub fn handles(&self) -> Option<Handles<'_>> {
+        if self.handed_out.swap(true, Ordering::AcqRel) {
+            return None;
+        }
+        Some(Handles { pulse: PulseWriter::new(self) })
+    }
+}
