@@ -38,6 +38,40 @@
 //! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
 //!   for room (taken out, and woken outside the lock).
 
+/// Defines a writer's handle, `$name`: a `Copy` reference to the machine that derefs to it for
+/// the reads, and whose own methods (in the writer's module) are the writes of its part.
+macro_rules! writer_handle {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy)]
+        pub struct $name<'m> {
+            machine: &'m super::Machine,
+        }
+
+        impl<'m> $name<'m> {
+            /// Only [`Machine::handles`](super::Machine::handles) makes one.
+            pub(super) const fn new(machine: &'m super::Machine) -> Self {
+                $name { machine }
+            }
+
+            /// The machine, to read.
+            #[inline(always)]
+            pub fn machine(self) -> &'m super::Machine {
+                self.machine
+            }
+        }
+
+        impl core::ops::Deref for $name<'_> {
+            type Target = super::Machine;
+
+            #[inline(always)]
+            fn deref(&self) -> &super::Machine {
+                self.machine
+            }
+        }
+    };
+}
+
 mod handles;
 mod job_queue;
 mod jobs;
@@ -47,6 +81,8 @@ mod published;
 mod pulse_news;
 mod pulse_side;
 mod pulse_writer;
+mod servo_side;
+mod servo_writer;
 mod settings;
 
 use core::cell::Cell;
@@ -58,7 +94,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, TICK_HZ};
-use crate::inputs::{InputLevels, Trip};
+use crate::inputs::Trip;
 use crate::interp::ShapeKind;
 use crate::job::{Control, Job};
 use crate::overrides::{OverrideCommand, Overrides};
@@ -75,6 +111,8 @@ pub use plan_end::{PlanEnd, Stale};
 use published::Published;
 use pulse_side::PulseSide;
 pub use pulse_writer::PulseWriter;
+use servo_side::ServoSide;
+pub use servo_writer::ServoWriter;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -128,6 +166,8 @@ const STATE_ALARM: u8 = 4;
 pub struct Machine {
     /// What the pulse interrupt writes ([`PulseWriter`]).
     pulses: PulseSide,
+    /// What the servo task writes ([`ServoWriter`]).
+    servo: ServoSide,
     /// The writers' handles were handed out ([`handles`](Self::handles)).
     handed_out: AtomicBool,
     /// Jobs handed over, each with the plan's end it was planned from.
@@ -176,22 +216,15 @@ pub struct Machine {
     halted: AtomicBool,
     /// The trip the motion task has not yet handled.
     trip: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
-    /// The input levels the servo task read last (written only by it).
-    input_levels: AtomicU8,
     /// A homing cycle runs: limit switches ahead are watched, and one found is no alarm.
     homing: AtomicBool,
     /// Wakes the homing task.
     homing_requested: Signal<CriticalSectionRawMutex, ()>,
     /// The switch a homing approach stopped at, until the homing task takes it.
     switch_found: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
-    /// SON has been high for the drivers' enable delay (written only by the servo task).
-    servos_ready: AtomicBool,
     /// Where the pen is to be, as a [`PenOrder`]: bit 0 set for down, above it a count of the
     /// times it was sent anywhere (changed only at rest).
     pen: AtomicU32,
-    /// The last order the pen servo has had its settle time for (written only by the servo
-    /// task): the pen has settled while it equals `pen`.
-    pen_settled: AtomicU32,
     /// How deep the pen goes down, per mille ([`PenDepth`]): the last `M3 S…`'s.
     pen_depth: AtomicU16,
     /// Pulses emitted at machine zero (written only by the homing task, at rest).
@@ -208,6 +241,7 @@ impl Machine {
         let locked = settings.homing;
         Machine {
             pulses: PulseSide::new(),
+            servo: ServoSide::new(),
             handed_out: AtomicBool::new(false),
             jobs: JobQueue::new(),
             plan: Mutex::new(Cell::new(PlanState::at(Point::ORIGIN))),
@@ -233,11 +267,8 @@ impl Machine {
             fault: Mutex::new(Cell::new(None)),
             halted: AtomicBool::new(false),
             trip: Mutex::new(Cell::new(None)),
-            input_levels: AtomicU8::new(0),
             homing: AtomicBool::new(false),
-            servos_ready: AtomicBool::new(false),
             pen: AtomicU32::new(0),
-            pen_settled: AtomicU32::new(u32::MAX),
             pen_depth: AtomicU16::new(PenDepth::FULL.permille()),
             homing_requested: Signal::new(),
             switch_found: Mutex::new(Cell::new(None)),
@@ -559,18 +590,6 @@ impl Machine {
         !self.asleep.load(Ordering::Relaxed) && !off_for_alarm
     }
 
-    /// Whether the drivers hold their axes: SON high for the enable delay (`$209`). Only the
-    /// servo task calls this.
-    pub fn set_servos_ready(&self, ready: bool) {
-        // Sequentially consistent: the servo task's going-off handshake with the motion task.
-        self.servos_ready.store(ready, Ordering::SeqCst);
-    }
-
-    /// True once the drivers hold their axes; no pulse may go out before.
-    pub fn servos_ready(&self) -> bool {
-        self.servos_ready.load(Ordering::SeqCst)
-    }
-
     /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
     /// wait for [`pen_settled`](Self::pen_settled) before anything moves.
     pub fn set_pen(&self, pen: Pen) {
@@ -600,16 +619,6 @@ impl Machine {
     /// The pen's last order, for the servo task.
     pub fn pen_order(&self) -> PenOrder {
         PenOrder::from_bits(self.pen.load(Ordering::Acquire))
-    }
-
-    /// The pen servo has settled as `order` says. Only the servo task calls this.
-    pub fn set_pen_settled(&self, order: PenOrder) {
-        self.pen_settled.store(order.bits(), Ordering::Release);
-    }
-
-    /// True once the pen is where it was last sent: no pulse may go out before.
-    pub fn pen_settled(&self) -> bool {
-        self.pen_settled.load(Ordering::Acquire) == self.pen.load(Ordering::Acquire)
     }
 
     /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it
@@ -649,16 +658,6 @@ impl Machine {
     /// The trip the motion task has yet to handle, taking it. Only the motion task calls this.
     pub fn take_trip(&self) -> Option<Trip> {
         self.trip.lock(|t| t.take())
-    }
-
-    /// The input levels just read. Only the servo task calls this.
-    pub fn set_input_levels(&self, levels: InputLevels) {
-        self.input_levels.store(levels, Ordering::Relaxed);
-    }
-
-    /// The input levels last read.
-    pub fn input_levels(&self) -> InputLevels {
-        self.input_levels.load(Ordering::Relaxed)
     }
 
     /// `$X`: leaves the alarm, and lets pulses out again after a trip (handled by the motion

@@ -36,8 +36,8 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let machine = Machine::new(tight);
     let handles = machine.handles().unwrap();
     // No servo task here: the drivers hold their axes from the start.
-    machine.set_servos_ready(true);
-    machine.set_pen_settled(machine.pen_order());
+    handles.servo.set_servos_ready(true);
+    handles.servo.set_pen_settled(machine.pen_order());
     let start = machine.plan_end().unwrap();
     let first = line_to(150.0, Point::ORIGIN, &loose);
     let end = first.drawing.end();

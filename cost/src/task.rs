@@ -75,8 +75,8 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let machine = Machine::new(*settings);
     let Some(handles) = machine.handles() else { panic!("handles") };
     // No servo task here: the drivers hold their axes from the start.
-    machine.set_servos_ready(true);
-    machine.set_pen_settled(machine.pen_order());
+    handles.servo.set_servos_ready(true);
+    handles.servo.set_pen_settled(machine.pen_order());
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
     let mut motion =

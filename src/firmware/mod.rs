@@ -24,7 +24,7 @@ use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
 use embassy_time::{Duration, Timer};
 use servoplot::health::{self, Health};
 use servoplot::interp::Curve;
-use servoplot::machine::Machine;
+use servoplot::machine::{Machine, ServoWriter};
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::settings::Settings;
@@ -96,7 +96,7 @@ fn start(spawner: Spawner) {
     let panel: &'static Panel = PANEL.init_with(Panel::new);
     spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad", Executor::ThreadMode));
     spawner.spawn(timed(
-        servo(machine, board.son, board.pen, board.lights, board.watchdog),
+        servo(handles.servo, board.son, board.pen, board.lights, board.watchdog),
         "servo",
         Executor::ThreadMode,
     ));
@@ -182,7 +182,7 @@ async fn serial(host_link: Pin<&'static mut dyn Future<Output = Infallible>>) ->
 
 #[embassy_executor::task]
 async fn servo(
-    machine: &'static Machine,
+    machine: ServoWriter<'static>,
     son: board::Output,
     pen: board::PenPwm,
     lights: [board::Output; 2],

@@ -9,12 +9,15 @@ use core::sync::atomic::Ordering;
 
 use super::Machine;
 use super::pulse_writer::PulseWriter;
+use super::servo_writer::ServoWriter;
 
 /// The machine's writers, one handle each.
 #[derive(Clone, Copy)]
 pub struct Handles<'m> {
     /// For the pulse interrupt.
     pub pulse: PulseWriter<'m>,
+    /// For the servo task.
+    pub servo: ServoWriter<'m>,
 }
 
 impl Machine {
@@ -23,6 +26,6 @@ impl Machine {
         if self.handed_out.swap(true, Ordering::AcqRel) {
             return None;
         }
-        Some(Handles { pulse: PulseWriter::new(self) })
+        Some(Handles { pulse: PulseWriter::new(self), servo: ServoWriter::new(self) })
     }
 }

@@ -1,31 +1,17 @@
 //! The pulse interrupt's handle, [`PulseWriter`]: the writes of the pulses' part of the machine
 //! ([`pulse_side`](super::pulse_side)), and the machine's reads of that part.
 
-use core::ops::Deref;
-
 use super::Machine;
 use crate::geom::StepCmd;
 use crate::inputs::Trip;
 
-/// The pulse interrupt's handle: the writes of the pulses' part of the machine. Reads go through
-/// the machine it derefs to.
-#[derive(Clone, Copy)]
-pub struct PulseWriter<'m> {
-    machine: &'m Machine,
-}
+writer_handle!(
+    /// The pulse interrupt's handle: the writes of the pulses' part of the machine. Reads go
+    /// through the machine it derefs to.
+    PulseWriter
+);
 
-impl<'m> PulseWriter<'m> {
-    /// Only [`Machine::handles`] makes one.
-    pub(super) const fn new(machine: &'m Machine) -> Self {
-        PulseWriter { machine }
-    }
-
-    /// The machine, to read.
-    #[inline(always)]
-    pub fn machine(self) -> &'m Machine {
-        self.machine
-    }
-
+impl PulseWriter<'_> {
     /// Counts the pulses of `cmd`, emitted.
     #[inline(always)]
     pub fn emitted(self, cmd: StepCmd) {
@@ -59,15 +45,6 @@ impl<'m> PulseWriter<'m> {
     /// period the engine then counted (see [`crate::pulse`]).
     pub fn count_missed_update(self) {
         self.machine.pulses.count_missed_update();
-    }
-}
-
-impl Deref for PulseWriter<'_> {
-    type Target = Machine;
-
-    #[inline(always)]
-    fn deref(&self) -> &Machine {
-        self.machine
     }
 }
 

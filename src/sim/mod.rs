@@ -257,7 +257,7 @@ pub fn run(config: SimConfig) -> SimReport {
         ),
         tasks::lcd::run(&machine, &panel, lcd),
         tasks::servo::run(
-            &machine,
+            handles.servo,
             son.clone(),
             || inputs.levels(),
             pen.clone(),
