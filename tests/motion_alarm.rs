@@ -49,7 +49,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let (producer, mut consumer) = queue.split();
     let mut planner: Box<Planner<Curve, PLANNER_SEGMENTS>> = Box::new(Planner::new(Limits::from_settings(&loose)));
     let mut motion = pin!(servoplot::tasks::motion::run(
-        &machine,
+        handles.motion,
         &mut planner,
         producer,
         || {},

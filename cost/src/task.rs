@@ -79,8 +79,13 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     handles.servo.set_pen_settled(machine.pen_order());
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
-    let mut motion =
-        pin!(servoplot::tasks::motion::run(&machine, planner(), producer, || {}, servoplot::tasks::motion::RealTime));
+    let mut motion = pin!(servoplot::tasks::motion::run(
+        handles.motion,
+        planner(),
+        producer,
+        || {},
+        servoplot::tasks::motion::RealTime
+    ));
     let Some(from) = machine.plan_end() else { panic!("plan end") };
     if machine.try_submit(job, from).is_err() {
         panic!("job queue");

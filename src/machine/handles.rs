@@ -8,16 +8,26 @@
 use core::sync::atomic::Ordering;
 
 use super::Machine;
+use super::homing_writer::HomingWriter;
+use super::host_writer::HostWriter;
+use super::motion_writer::MotionWriter;
 use super::pulse_writer::PulseWriter;
 use super::servo_writer::ServoWriter;
 
-/// The machine's writers, one handle each.
+/// The machine's writers, one handle each. The keypad and the LCD have none: the keypad only
+/// posts requests (jobs, controls, a homing cycle, settings), which anyone may, and the LCD reads.
 #[derive(Clone, Copy)]
 pub struct Handles<'m> {
     /// For the pulse interrupt.
     pub pulse: PulseWriter<'m>,
+    /// For the motion task.
+    pub motion: MotionWriter<'m>,
+    /// For the host link.
+    pub host: HostWriter<'m>,
     /// For the servo task.
     pub servo: ServoWriter<'m>,
+    /// For the homing task.
+    pub homing: HomingWriter<'m>,
 }
 
 impl Machine {
@@ -26,6 +36,12 @@ impl Machine {
         if self.handed_out.swap(true, Ordering::AcqRel) {
             return None;
         }
-        Some(Handles { pulse: PulseWriter::new(self), servo: ServoWriter::new(self) })
+        Some(Handles {
+            pulse: PulseWriter::new(self),
+            motion: MotionWriter::new(self),
+            host: HostWriter::new(self),
+            servo: ServoWriter::new(self),
+            homing: HomingWriter::new(self),
+        })
     }
 }

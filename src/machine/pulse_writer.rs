@@ -15,36 +15,36 @@ impl PulseWriter<'_> {
     /// Counts the pulses of `cmd`, emitted.
     #[inline(always)]
     pub fn emitted(self, cmd: StepCmd) {
-        self.machine.pulses.emitted(cmd);
+        self.machine.pulse_side.emitted(cmd);
     }
 
     /// The step timer starts or stops.
     pub fn set_pulsing(self, on: bool) {
-        self.machine.pulses.set_pulsing(on);
+        self.machine.pulse_side.set_pulsing(on);
     }
 
     /// The pulse interrupt saw `trip`: as [`Machine::trip`], the pulse engine halted at once, the
     /// rest in the news.
     pub fn pulse_trip(self, trip: Trip) {
         if self.machine.halt(trip) {
-            self.machine.pulses.tripped(trip);
+            self.machine.pulse_side.tripped(trip);
         }
     }
 
     /// The pulse engine emitted everything queued and stopped.
     pub fn pulses_stopped(self) {
-        self.machine.pulses.stopped();
+        self.machine.pulse_side.stopped();
     }
 
     /// The pulse engine found the queue empty while the motion was not at rest.
     pub fn count_underrun(self) {
-        self.machine.pulses.count_underrun();
+        self.machine.pulse_side.count_underrun();
     }
 
     /// The step timer's interrupt came a whole period late or later: the timer repeated a
     /// period the engine then counted (see [`crate::pulse`]).
     pub fn count_missed_update(self) {
-        self.machine.pulses.count_missed_update();
+        self.machine.pulse_side.count_missed_update();
     }
 }
 
@@ -54,7 +54,7 @@ impl Machine {
     /// it says to the trips' mailbox and the signals, so any context below the pulse interrupt
     /// may call it; only the news interrupt does.
     pub fn deliver_pulse_news(&self) {
-        let news = self.pulses.take_news();
+        let news = self.pulse_side.take_news();
         if let Some(trip) = news.trip {
             self.post_trip(trip);
         }
@@ -73,21 +73,21 @@ impl Machine {
     /// Steps emitted so far and the sum of their intervals (both wrap): after a trip, all there
     /// will be of what was queued.
     pub fn emitted_totals(&self) -> (u32, u32) {
-        (self.pulses.emitted_steps(), self.pulses.emitted_ticks())
+        (self.pulse_side.emitted_steps(), self.pulse_side.emitted_ticks())
     }
 
     /// Step-queue underruns since power-on.
     pub fn underruns(&self) -> u32 {
-        self.pulses.underruns()
+        self.pulse_side.underruns()
     }
 
     /// Missed step timer updates since power-on.
     pub fn missed_updates(&self) -> u32 {
-        self.pulses.missed_updates()
+        self.pulse_side.missed_updates()
     }
 
     /// True while the step timer runs.
     pub fn pulsing(&self) -> bool {
-        self.pulses.pulsing()
+        self.pulse_side.pulsing()
     }
 }

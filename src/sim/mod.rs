@@ -241,14 +241,20 @@ pub fn run(config: SimConfig) -> SimReport {
     // The board's interrupts: the step timer, and the motion task on its interrupt executor.
     let interrupts = join(
         step_timer::run(handles.pulse, &mut engine, &kicks),
-        tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu.clone(), &machine)),
+        tasks::motion::run(
+            handles.motion,
+            &mut planner,
+            steps,
+            || kicks.signal(()),
+            SimCpu::new(cpu.clone(), &machine),
+        ),
     );
     // Thread mode: polled only while no work charged there takes it (see `cpu::ThreadLevel`).
     let thread = ThreadLevel::default();
     let threads = join5(
         tasks::keypad::run(&machine, &panel, columns, rows, SimSlices::new(cpu.clone(), &machine, &thread)),
         tasks::serial::run(
-            &machine,
+            handles.host,
             &mut store,
             loaded,
             (serial.clone(), serial.clone()),
@@ -264,7 +270,7 @@ pub fn run(config: SimConfig) -> SimReport {
             [led.clone(), buzzer.clone()],
             || watchdog.feed(),
         ),
-        tasks::homing::run(&machine),
+        tasks::homing::run(handles.homing),
     );
     let (mut interrupts, mut threads) = (pin!(interrupts), pin!(threads));
     let (irq_flag, thread_flag) =

@@ -5,7 +5,8 @@
 //! off while the machine sleeps (`$SLP`) until a reset, after a driver alarm until `$X`, and,
 //! unless `$1` is 255, once the machine has stood still for `$1` ms. SON comes back on as soon
 //! as there is motion to make, and the machine counts the servos ready `$209` ms later: the
-//! motion task starts no pulse before (see [`Machine::servos_ready`]).
+//! motion task starts no pulse before (see
+//! [`Machine::servos_ready`](crate::machine::Machine::servos_ready)).
 //!
 //! It drives the pen servo's PWM to where the machine wants the pen (when `$213` names a pen
 //! lift) and tells the machine once it has had its settle time (`$212`).
@@ -175,11 +176,11 @@ mod tests {
         };
         step();
         assert!(son.get(), "the servos hold position from power-on");
-        machine.sleep();
+        handles.host.sleep();
         assert_eq!(machine.state(), RunState::Sleep);
         step();
         assert!(!son.get(), "asleep, the servos are off");
-        machine.wake();
+        handles.host.wake();
         step();
         assert!(son.get());
         assert_eq!(machine.state(), RunState::Alarm, "the axes were free: the position is in doubt");
