@@ -4,6 +4,27 @@
 //!
 //! The board, the simulator and the tests take the handles from [`Machine::handles`] when they
 //! build the machine, and give each task its own. A handle is a reference: `Copy`, free to pass.
+//!
+//! A write is a method of its writer's handle, not of the machine:
+//!
+//! ```compile_fail
+//! use servoplot::machine::Machine;
+//! use servoplot::settings::Settings;
+//!
+//! let machine = Machine::new(Settings::default());
+//! // The motion task's write: only its handle has it.
+//! machine.set_queued(1, 1);
+//! ```
+//!
+//! ```
+//! use servoplot::machine::Machine;
+//! use servoplot::settings::Settings;
+//!
+//! let machine = Machine::new(Settings::default());
+//! let handles = machine.handles().unwrap();
+//! handles.motion.set_queued(1, 1);
+//! assert_eq!(machine.queued_steps(), 1);
+//! ```
 
 use core::sync::atomic::Ordering;
 
@@ -43,5 +64,26 @@ impl Machine {
             servo: ServoWriter::new(self),
             homing: HomingWriter::new(self),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Point, Step, StepCmd};
+    use crate::settings::Settings;
+
+    #[test]
+    fn the_handles_come_once_and_write_what_every_task_then_reads() {
+        let machine = Machine::new(Settings::default());
+        let handles = machine.handles().unwrap();
+        assert!(machine.handles().is_none(), "a second set of writers is refused");
+        handles.motion.set_queued(1, 10);
+        assert_eq!((machine.queued_steps(), machine.pulses_idle()), (1, false));
+        handles.pulse.emitted(StepCmd::new(Step::new(1, -1), 10));
+        assert_eq!(machine.position(), Point::new(1, -1));
+        assert!(machine.pulses_idle(), "the step queued is emitted");
+        handles.host.set_work_offset_mm([2.0, 3.0]);
+        assert_eq!(machine.work_offset_mm(), [2.0, 3.0]);
     }
 }
