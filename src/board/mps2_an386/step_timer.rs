@@ -119,8 +119,8 @@ impl StepTimer for ModelStepTimer {
     }
 }
 
-/// The engine and the machine it counts for, owned by the interrupt once [`start`] has put them
-/// in the slot.
+/// The engine and the pulse interrupt's handle to the machine it counts for, owned by the
+/// interrupt once [`start`] has put them in the slot.
 struct Pulses {
     engine: PulseEngine<'static, ModelStepTimer>,
     machine: PulseWriter<'static>,
@@ -137,7 +137,8 @@ unsafe impl Sync for Slot {}
 
 static SLOT: Slot = Slot { filled: AtomicBool::new(false), pulses: UnsafeCell::new(None) };
 
-/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`]. It only
+/// hands the news on, which needs no writer's handle (the engine's handle stays the engine's).
 static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(core::ptr::null_mut());
 
 /// Hands the engine to timer 1's interrupt, at `priority`, and enables the news interrupt at

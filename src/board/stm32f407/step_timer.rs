@@ -150,7 +150,7 @@ impl StepTimer for Tim1StepTimer {
     }
 }
 
-/// The engine and the machine it counts for.
+/// The engine and the pulse interrupt's handle to the machine it counts for.
 struct Pulses {
     engine: PulseEngine<'static, Tim1StepTimer>,
     machine: PulseWriter<'static>,
@@ -164,7 +164,8 @@ static PULSES_CELL: StaticCell<Pulses> = StaticCell::new();
 /// nest in itself), so it takes no lock and masks nothing.
 static PULSES: AtomicPtr<Pulses> = AtomicPtr::new(null_mut());
 
-/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`]. It only
+/// hands the news on, which needs no writer's handle (the engine's handle stays the engine's).
 static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(null_mut());
 
 /// Hands the engine to the interrupt and enables it at `priority`, and the news interrupt
