@@ -8,8 +8,8 @@
 //! - the pulse interrupt ([`PulseWriter`], [`pulse_side`]): the pulses emitted, the emitted
 //!   totals, the last interval, underruns, missed updates, the step timer running, its news;
 //! - the motion task ([`MotionWriter`], [`motion_side`]): what it queued and planned, the job
-//!   it draws, the fault and the run state (with two documented exceptions: `$X` and a failed
-//!   homing cycle);
+//!   it draws, the fault and the run state (with documented exceptions: `$X`, the reset after
+//!   `$SLP`, and a homing cycle's start and failure);
 //! - the host link ([`HostWriter`], [`host_side`]): the overrides, the work offset, check mode,
 //!   sleep, the pen's depth;
 //! - the servo task ([`ServoWriter`], [`servo_side`]): the input levels, the drivers'
@@ -25,7 +25,8 @@
 //! ([`request_homing`](Machine::request_homing); the homing task), the settings
 //! ([`update_settings`](Machine::update_settings); the host link keeps them in flash) and the
 //! trips ([`trip`](Machine::trip); the motion task raises the alarm, `$X` or the homing task
-//! clears it). The pen's orders have two writers, both at rest: the motion task (a keypad
+//! clears it); the switch a homing approach stopped at has one poster, the motion task, and the
+//! homing task takes it. The pen's orders have two writers, both at rest: the motion task (a keypad
 //! drawing's pen lift) and the host link (`M3`, `M5`), each a single read-modify-write of one
 //! word ([`PenOrder`]); the servo task says when the pen has settled.
 //!
