@@ -1,76 +1,134 @@
-//! The state the tasks share: queues between them, the position counters and the settings.
+//! The state the tasks share, split by writer: each task holds a handle to the part it writes,
+//! and reads the rest through narrow methods on [`Machine`].
 //!
-//! One `Machine` exists per plotter (a `static` on target, a local in the simulator). Tasks
-//! receive `&Machine` and talk only through it: the job queue (inputs → motion, [`jobs`]), the
-//! control slot (inputs → motion), the counters of the step queue (the queue itself, motion →
-//! pulses, is a lock-free single-producer single-consumer ring owned by its two ends), the
-//! position counters (written only by the pulse engine), the settings ([`settings`]) and a
-//! change signal that wakes the LCD. The keypad menu is not here: the keypad and LCD tasks share
-//! it in thread mode ([`crate::tasks::panel`]).
+//! One `Machine` exists per plotter (a `static` on target, a local in the simulator). Its
+//! writers' handles come from [`Machine::handles`], once; the board, the simulator and the
+//! tests take them there and give each task its own ([`handles`]). Each part has private fields
+//! and one writer:
+//! - the pulse interrupt ([`PulseWriter`], [`pulse_side`]): the pulses emitted, the emitted
+//!   totals, the last interval, underruns, missed updates, the step timer running, its news;
+//! - the motion task ([`MotionWriter`], [`motion_side`]): what it queued and planned, the job
+//!   it draws, the fault and the run state (with documented exceptions: `$X`, the reset after
+//!   `$SLP`, and a homing cycle's start and failure);
+//! - the host link ([`HostWriter`], [`host_side`]): the overrides, the work offset, check mode,
+//!   sleep, the pen's depth;
+//! - the servo task ([`ServoWriter`], [`servo_side`]): the input levels, the drivers'
+//!   readiness, the pen's settling;
+//! - the homing task ([`HomingWriter`], [`homing_side`]): machine zero.
 //!
-//! The machine also answers where the plan ends, the one point every input plans from
-//! ([`plan_end`](Machine::plan_end)): the end of the last job handed over, or, after an abort,
-//! where the pen stops. A job is handed over with the [`PlanEnd`] it was planned from, and
-//! refused ([`Stale`]) if that is not where the plan ends by then (see [`jobs`]).
+//! The keypad and the LCD write no part of their own: the keypad posts requests, the LCD reads.
 //!
-//! The pen's orders are kept here too: where it is to be, and whether the servo task has seen it
-//! settle there ([`set_pen`](Machine::set_pen), [`pen_settled`](Machine::pen_settled)).
-//!
-//! The machine also owns where machine zero is: the position is the pulses emitted less the
-//! origin homing found ([`set_origin`](Machine::set_origin)), and whether it can be trusted
-//! ([`position_lost`](Machine::position_lost)).
-//!
-//! The overrides (GRBL's feed, rapid and spindle percentages) are one shared word: the host link
-//! sets them, the motion task hands them to its planner, reports and the LCD show them.
+//! State with several writers by nature is a mailbox with one taker, posted to through a
+//! narrow method on `Machine` by anyone and taken through the taker's handle: the jobs and
+//! where the plan ends ([`jobs`]; the motion task takes), the controls
+//! ([`request`](Machine::request); the motion task), a homing request
+//! ([`request_homing`](Machine::request_homing); the homing task), the settings
+//! ([`update_settings`](Machine::update_settings); the host link keeps them in flash) and the
+//! trips ([`trip`](Machine::trip); the motion task raises the alarm, `$X` or the homing task
+//! clears it); the switch a homing approach stopped at has one poster, the motion task, and the
+//! homing task takes it. The pen's orders have two writers, both at rest: the motion task (a keypad
+//! drawing's pen lift) and the host link (`M3`, `M5`), each a single read-modify-write of one
+//! word ([`PenOrder`]); the servo task says when the pen has settled.
 //!
 //! Everything here is shared across priorities, up to the pulse interrupt, which every critical
-//! section holds off. Every counter is an atomic with a single writer; the jobs (648 bytes) and
-//! the settings (116) are handed over without a lock ([`job_queue`], [`published`]). The
-//! critical sections left each copy at most [`LOCKED_VALUE_MAX_BYTES`] in or out (checked
-//! below, at compile time) and wake at most the tasks that wait there:
+//! section holds off. Every counter is an atomic; the jobs (648 bytes) and the settings (116)
+//! are handed over without a lock ([`job_queue`], [`published`]). The critical sections left
+//! each copy at most [`LOCKED_VALUE_MAX_BYTES`] in or out (checked below, at compile time) and
+//! wake at most the tasks that wait there:
 //! - `control`: the control requested and not yet taken (1 byte);
-//! - `work_offset_mm`: the work offset, two `f32`;
-//! - `fault`: an `Option<MotionFault>`; `trip` and `switch_found`: an `Option<Trip>`;
-//! - the signals `control_requested`, `changed`, `pulses_done`, `homing_requested`,
+//! - the host link's work offset, two `f32`;
+//! - the motion's fault, an `Option<MotionFault>`; `trip` and the homing's switch found, an
+//!   `Option<Trip>`;
+//! - the signals `control_requested`, `changed`, `pulses_done`, the homing request,
 //!   `settings_changed` and `faults`: the waiting task's waker, or what was signalled (`()`, a
 //!   `MotionFault`);
 //! - `plan`: where the plan ends, a [`PlanEnd`] twice and a flag (28 bytes);
 //! - the job queue's waiters: the motion task's waker, and the wakers of the inputs waiting
 //!   for room (taken out, and woken outside the lock).
 
-mod from_pulses;
+/// Defines a writer's handle, `$name`: a `Copy` reference to the machine that derefs to it for
+/// the reads, and whose own methods (in the writer's module) are the writes of its part.
+macro_rules! writer_handle {
+    ($(#[$doc:meta])* $name:ident) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy)]
+        pub struct $name<'m> {
+            machine: &'m super::Machine,
+        }
+
+        impl<'m> $name<'m> {
+            /// Only [`Machine::handles`](super::Machine::handles) makes one.
+            pub(super) const fn new(machine: &'m super::Machine) -> Self {
+                $name { machine }
+            }
+
+            /// The machine, to read.
+            #[inline(always)]
+            pub fn machine(self) -> &'m super::Machine {
+                self.machine
+            }
+        }
+
+        impl core::ops::Deref for $name<'_> {
+            type Target = super::Machine;
+
+            #[inline(always)]
+            fn deref(&self) -> &super::Machine {
+                self.machine
+            }
+        }
+    };
+}
+
+mod handles;
+mod homing_side;
+mod homing_writer;
+mod host_side;
+mod host_writer;
 mod job_queue;
 mod jobs;
+mod motion_side;
+mod motion_writer;
 mod path_steps;
 mod plan_end;
 mod published;
 mod pulse_news;
+mod pulse_side;
+mod pulse_writer;
+mod servo_side;
+mod servo_writer;
 mod settings;
 
 use core::cell::Cell;
-use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU8, AtomicU16, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use core::task::Waker;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
-use crate::geom::{Point, StepCmd, TICK_HZ};
-use crate::inputs::{InputLevels, Trip};
-use crate::interp::ShapeKind;
+use crate::geom::{Point, TICK_HZ};
+use crate::inputs::Trip;
 use crate::job::{Control, Job};
-use crate::overrides::{OverrideCommand, Overrides};
-use crate::pen::{Pen, PenDepth, PenOrder};
-use crate::planner::PLANNER_SEGMENTS;
+use crate::pen::{Pen, PenOrder};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
+pub use handles::Handles;
+use homing_side::HomingSide;
+pub use homing_writer::HomingWriter;
+use host_side::HostSide;
+pub use host_writer::HostWriter;
 use job_queue::JobQueue;
-use path_steps::PathSteps;
+use motion_side::MotionSide;
+pub use motion_writer::MotionWriter;
 use plan_end::PlanState;
 pub use plan_end::{PlanEnd, Stale};
 use published::Published;
-use pulse_news::PulseNews;
+use pulse_side::PulseSide;
+pub use pulse_writer::PulseWriter;
+use servo_side::ServoSide;
+pub use servo_writer::ServoWriter;
 
 /// Jobs accepted from the inputs and not yet taken by the planner. Small: the planner holds the
 /// look-ahead; this only decouples the inputs from it.
@@ -113,100 +171,55 @@ pub enum Refused {
     Stale,
 }
 
-/// The run states as [`Machine`] stores them.
-const STATE_IDLE: u8 = 0;
-const STATE_RUN: u8 = 1;
-const STATE_HOLD: u8 = 2;
-const STATE_JOG: u8 = 3;
-const STATE_ALARM: u8 = 4;
-
-/// Everything the tasks share.
+/// Everything the tasks share (see the module documentation).
 pub struct Machine {
-    /// Jobs handed over, each with the plan's end it was planned from.
+    /// What the pulse interrupt writes ([`PulseWriter`]).
+    pulse_side: PulseSide,
+    /// What the motion task writes ([`MotionWriter`]).
+    motion_side: MotionSide,
+    /// What the host link writes ([`HostWriter`]).
+    host_side: HostSide,
+    /// What the servo task writes ([`ServoWriter`]).
+    servo_side: ServoSide,
+    /// What the homing task writes ([`HomingWriter`]), and its mailboxes.
+    homing_side: HomingSide,
+    /// The writers' handles were handed out ([`handles`](Self::handles)).
+    handed_out: AtomicBool,
+    /// Jobs handed over, each with the plan's end it was planned from (a mailbox: anyone
+    /// submits, the motion task takes).
     jobs: JobQueue<(PlanEnd, Job), JOB_QUEUE_LEN, JOB_SUBMITTERS>,
     /// Where the plan ends (see [`jobs`]).
     plan: Mutex<CriticalSectionRawMutex, Cell<PlanState>>,
+    /// The control requested and not yet taken (a mailbox: anyone requests, the motion task
+    /// takes).
     control: Mutex<CriticalSectionRawMutex, Cell<Option<Control>>>,
-    /// Wakes the motion task when a control is requested or an override changes.
+    /// Wakes the motion task when a control is requested, an override changes or a trip comes.
     control_requested: Signal<CriticalSectionRawMutex, ()>,
-    /// The overrides in force, [`Overrides::to_bits`] (written only by the host link).
-    overrides: AtomicU32,
     /// Wakes the LCD task after anything it shows may have changed.
     changed: Signal<CriticalSectionRawMutex, ()>,
     /// Every fault as it happens, for the host link.
     faults: Signal<CriticalSectionRawMutex, MotionFault>,
-    /// The planner holds nothing (set by the motion task).
-    plan_empty: AtomicBool,
-    /// The host link is in check mode (`$C`): reported as [`RunState::Check`] while idle.
-    check_mode: AtomicBool,
-    /// The current hold came from the safety door.
+    /// The current hold came from the safety door: set with the hold, cleared by a resume or
+    /// an abort (part of the controls' mailbox).
     door: AtomicBool,
-    /// `$SLP`: the servos are off until a reset.
-    asleep: AtomicBool,
-    /// Segments the planner has room for (set by the motion task).
-    plan_free: AtomicU8,
     /// Wakes the motion task when the pulse engine has emitted everything queued and stopped.
     pulses_done: Signal<CriticalSectionRawMutex, ()>,
-    /// What the pulse interrupt has to tell, not yet delivered (see [`pulse_news`]).
-    pulse_news: PulseNews,
-    /// Pulses emitted (written only by the pulse engine).
-    position: [AtomicI32; 2],
-    state: AtomicU8,
-    /// Steps queued for the pulse engine so far, and the sum of their intervals in ticks
-    /// (written only by the motion task; both wrap).
-    queued_steps: AtomicU32,
-    queued_ticks: AtomicU32,
-    /// Steps emitted so far and the sum of their intervals (written only by the pulse engine).
-    emitted_steps: AtomicU32,
-    emitted_ticks: AtomicU32,
-    /// The interval of the step emitted last, ticks (written only by the pulse engine), and how
-    /// far the queued steps advance along the ideal curve (written only by the motion task): the
-    /// pen's speed along its path is the one over the other.
-    last_interval_ticks: AtomicU32,
-    path_steps: PathSteps,
-    /// Machine position minus work position, mm (written by the host link's parser).
-    work_offset_mm: Mutex<CriticalSectionRawMutex, Cell<[f32; 2]>>,
-    /// Times the pulse engine found the queue empty while the motion was not at rest
-    /// (written only by the pulse engine).
-    underruns: AtomicU32,
-    /// Times the step timer's interrupt came a whole period late (written only by the pulse
-    /// engine).
-    missed_updates: AtomicU32,
-    /// The kind of the job the motion task took last (`ShapeKind` as its index + 1, 0 for none).
-    drawing: AtomicU8,
+    /// The settings (a mailbox: the thread-mode inputs update them, see [`settings`]).
     settings: Published<Settings>,
     /// Wakes the serial task, which keeps the settings in flash, after they changed.
     settings_changed: Signal<CriticalSectionRawMutex, ()>,
-    fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
     /// An input tripped: the pulse engine stops at once and starts nothing until the alarm is
-    /// cleared. Set by [`trip`](Self::trip), cleared by [`unlock`](Self::unlock).
+    /// cleared. Set by a trip, cleared by `$X` (or a homing cycle's start) and by the homing
+    /// task once it has seen the switch an approach stopped at.
     halted: AtomicBool,
-    /// The trip the motion task has not yet handled.
+    /// The trip the motion task has not yet handled (a mailbox: anyone trips, the motion task
+    /// takes).
     trip: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
-    /// The step timer runs (written only by the pulse engine).
-    pulsing: AtomicBool,
-    /// The input levels the servo task read last (written only by it).
-    input_levels: AtomicU8,
-    /// A homing cycle runs: limit switches ahead are watched, and one found is no alarm.
-    homing: AtomicBool,
-    /// Wakes the homing task.
-    homing_requested: Signal<CriticalSectionRawMutex, ()>,
-    /// The switch a homing approach stopped at, until the homing task takes it.
-    switch_found: Mutex<CriticalSectionRawMutex, Cell<Option<Trip>>>,
-    /// SON has been high for the drivers' enable delay (written only by the servo task).
-    servos_ready: AtomicBool,
     /// Where the pen is to be, as a [`PenOrder`]: bit 0 set for down, above it a count of the
-    /// times it was sent anywhere (changed only at rest).
+    /// times it was sent anywhere (changed only at rest, by the motion task and the host link).
     pen: AtomicU32,
-    /// The last order the pen servo has had its settle time for (written only by the servo
-    /// task): the pen has settled while it equals `pen`.
-    pen_settled: AtomicU32,
-    /// How deep the pen goes down, per mille ([`PenDepth`]): the last `M3 S…`'s.
-    pen_depth: AtomicU16,
-    /// Pulses emitted at machine zero (written only by the homing task, at rest).
-    origin: [AtomicI32; 2],
     /// The pulses stopped without braking, or the axes were free (`$SLP`): the position may be
-    /// wrong until the next homing.
+    /// wrong until the next homing. Set by a trip and by `$SLP`, cleared by homing.
     position_lost: AtomicBool,
 }
 
@@ -216,71 +229,27 @@ impl Machine {
     pub fn new(settings: Settings) -> Self {
         let locked = settings.homing;
         Machine {
+            pulse_side: PulseSide::new(),
+            motion_side: MotionSide::new(if locked { RunState::Alarm } else { RunState::Idle }),
+            host_side: HostSide::new(),
+            servo_side: ServoSide::new(),
+            homing_side: HomingSide::new(),
+            handed_out: AtomicBool::new(false),
             jobs: JobQueue::new(),
             plan: Mutex::new(Cell::new(PlanState::at(Point::ORIGIN))),
             control: Mutex::new(Cell::new(None)),
             control_requested: Signal::new(),
-            overrides: AtomicU32::new(Overrides::NONE.to_bits()),
             changed: Signal::new(),
-            pulses_done: Signal::new(),
-            pulse_news: PulseNews::new(),
-            plan_empty: AtomicBool::new(true),
-            check_mode: AtomicBool::new(false),
-            door: AtomicBool::new(false),
-            asleep: AtomicBool::new(false),
-            plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             faults: Signal::new(),
-            position: [AtomicI32::new(0), AtomicI32::new(0)],
-            state: AtomicU8::new(if locked { STATE_ALARM } else { STATE_IDLE }),
-            queued_steps: AtomicU32::new(0),
-            queued_ticks: AtomicU32::new(0),
-            emitted_steps: AtomicU32::new(0),
-            emitted_ticks: AtomicU32::new(0),
-            last_interval_ticks: AtomicU32::new(0),
-            path_steps: PathSteps::new(),
-            work_offset_mm: Mutex::new(Cell::new([0.0; 2])),
-            underruns: AtomicU32::new(0),
-            missed_updates: AtomicU32::new(0),
-            drawing: AtomicU8::new(0),
+            door: AtomicBool::new(false),
+            pulses_done: Signal::new(),
             settings: Published::new(settings),
             settings_changed: Signal::new(),
-            fault: Mutex::new(Cell::new(None)),
             halted: AtomicBool::new(false),
             trip: Mutex::new(Cell::new(None)),
-            pulsing: AtomicBool::new(false),
-            input_levels: AtomicU8::new(0),
-            homing: AtomicBool::new(false),
-            servos_ready: AtomicBool::new(false),
             pen: AtomicU32::new(0),
-            pen_settled: AtomicU32::new(u32::MAX),
-            pen_depth: AtomicU16::new(PenDepth::FULL.permille()),
-            homing_requested: Signal::new(),
-            switch_found: Mutex::new(Cell::new(None)),
-            origin: [AtomicI32::new(0), AtomicI32::new(0)],
             position_lost: AtomicBool::new(locked),
         }
-    }
-
-    /// The machine position: the pulses emitted so far, from machine zero.
-    pub fn position(&self) -> Point {
-        let at = |axis: usize| {
-            let emitted = self.position[axis].load(Ordering::Relaxed);
-            emitted.wrapping_sub(self.origin[axis].load(Ordering::Relaxed))
-        };
-        Point::new(at(0), at(1))
-    }
-
-    /// Homing found machine zero: the pen, at rest, is at `position`. Only the homing task
-    /// calls this.
-    pub fn set_origin(&self, position: Point) {
-        for (axis, at) in [position.x, position.y].into_iter().enumerate() {
-            let emitted = self.position[axis].load(Ordering::Relaxed);
-            self.origin[axis].store(emitted.wrapping_sub(at), Ordering::Relaxed);
-        }
-        self.position_lost.store(false, Ordering::Relaxed);
-        // The same point has new coordinates.
-        self.plan_from_pen();
-        self.changed.signal(());
     }
 
     /// True when the position may be wrong: from power-on with homing enabled, and after a
@@ -289,66 +258,9 @@ impl Machine {
         self.position_lost.load(Ordering::Relaxed)
     }
 
-    /// Asks the homing task for a cycle; false if one runs already. The state is
-    /// [`RunState::Home`] from now until it ends.
-    pub fn request_homing(&self) -> bool {
-        if self.homing.swap(true, Ordering::AcqRel) {
-            return false;
-        }
-        self.homing_requested.signal(());
-        self.changed.signal(());
-        true
-    }
-
-    /// Waits for a homing request. For the homing task.
-    pub async fn homing_requested(&self) {
-        self.homing_requested.wait().await
-    }
-
-    /// True while a homing cycle runs.
-    pub fn homing(&self) -> bool {
-        self.homing.load(Ordering::Acquire)
-    }
-
-    /// True when `trip` is what a homing approach looks for: a limit switch, while homing.
-    pub fn is_homing_switch(&self, trip: Trip) -> bool {
-        self.homing() && matches!(trip, Trip::Limit { .. })
-    }
-
-    /// True when nothing is queued, planned or moving and no homing cycle runs: the machine
-    /// stands still for good (a homing cycle pauses between its moves).
-    pub fn at_standstill(&self) -> bool {
-        self.stopped() && !self.homing()
-    }
-
-    /// The homing cycle ended: at rest, in an alarm if it failed. Only the homing task calls
-    /// this.
-    pub fn end_homing(&self) {
-        self.homing.store(false, Ordering::Release);
-        self.changed.signal(());
-    }
-
-    /// A homing approach stopped at `trip`'s switch: the pulse engine stays halted until the
-    /// homing task has seen it ([`take_switch_found`](Self::take_switch_found)). Only the
-    /// motion task calls this.
-    pub fn found_switch(&self, trip: Trip) {
-        // The approach ends here, short of where it was planned to.
-        self.plan_from_pen();
-        self.switch_found.lock(|f| f.set(Some(trip)));
-    }
-
-    /// The switch the last homing approach stopped at, if it did, and lets pulses out again.
-    /// Only the homing task calls this.
-    pub fn take_switch_found(&self) -> Option<Trip> {
-        let found = self.switch_found.lock(|f| f.take());
-        if found.is_some() {
-            self.halted.store(false, Ordering::Release);
-        }
-        found
-    }
-
     /// Asks the motion task for `control`; see [`Control::then`] for requests not yet taken.
-    /// A resume or an abort closes the safety door.
+    /// A resume or an abort closes the safety door. A request anyone may post (the host link,
+    /// the keypad); the motion task takes it.
     pub fn request(&self, control: Control) {
         if control != Control::Hold && self.door.swap(false, Ordering::Relaxed) {
             self.changed.signal(());
@@ -374,179 +286,9 @@ impl Machine {
         self.request(Control::Hold);
     }
 
-    /// The feed, rapid and spindle overrides in force.
-    pub fn overrides(&self) -> Overrides {
-        Overrides::from_bits(self.overrides.load(Ordering::Relaxed))
-    }
-
-    /// Changes the overrides by `command` (an override byte from the host link); the motion task
-    /// applies them to the motion in progress at its next refill. Only the host link calls this.
-    pub fn change_overrides(&self, command: OverrideCommand) {
-        self.set_overrides(self.overrides().after(command));
-    }
-
-    /// Sets the overrides: [`Overrides::NONE`] after a reset. Only the host link calls this.
-    pub fn set_overrides(&self, overrides: Overrides) {
-        let bits = overrides.to_bits();
-        if self.overrides.swap(bits, Ordering::Relaxed) != bits {
-            self.control_requested.signal(());
-            self.changed.signal(());
-        }
-    }
-
-    /// The pending control request, if any, taking it.
-    pub fn take_control(&self) -> Option<Control> {
-        self.control.lock(|c| c.take())
-    }
-
-    /// Waits until a control is requested (it may already be) or an override changes.
-    pub async fn control_requested(&self) {
-        if self.control.lock(|c| c.get().is_none()) {
-            self.control_requested.wait().await;
-        }
-    }
-
-    /// The motion task has queued `steps` step commands in all so far, `ticks` ticks of motion
-    /// in all (both wrapping). Only the motion task calls this.
-    pub fn set_queued(&self, steps: u32, ticks: u32) {
-        self.queued_ticks.store(ticks, Ordering::Release);
-        self.queued_steps.store(steps, Ordering::Release);
-    }
-
-    /// Motion time queued for the pulse engine and not yet emitted, in ticks.
-    pub fn queued_ticks(&self) -> u32 {
-        self.queued_ticks.load(Ordering::Acquire).wrapping_sub(self.emitted_ticks.load(Ordering::Acquire))
-    }
-
-    /// Step commands queued for the pulse engine and not yet emitted.
-    pub fn queued_steps(&self) -> u32 {
-        self.queued_steps.load(Ordering::Acquire).wrapping_sub(self.emitted_steps.load(Ordering::Acquire))
-    }
-
-    /// Counts the pulses of `cmd`, emitted. Only the pulse engine calls this.
-    #[inline(always)]
-    pub fn emitted(&self, cmd: StepCmd) {
-        // Single writer: a load and a store, no read-modify-write cycle.
-        let [x, y] = &self.position;
-        x.store(x.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.x)), Ordering::Relaxed);
-        y.store(y.load(Ordering::Relaxed).wrapping_add(i32::from(cmd.step.y)), Ordering::Relaxed);
-        self.last_interval_ticks.store(cmd.interval_ticks, Ordering::Relaxed);
-        let t = self.emitted_ticks.load(Ordering::Relaxed).wrapping_add(cmd.interval_ticks);
-        self.emitted_ticks.store(t, Ordering::Release);
-        let n = self.emitted_steps.load(Ordering::Relaxed).wrapping_add(1);
-        self.emitted_steps.store(n, Ordering::Release);
-    }
-
-    /// How fast the pen moves along its path now, mm/min: how far a step advances along the
-    /// ideal curve over the interval of the step being emitted; 0 at rest (stopped, or held
-    /// once stopped). Not the lattice step's own length: on a line at 30° the steps are X steps
-    /// and diagonal ones, each advancing the same distance along the line at the same pace.
-    pub fn speed_mm_per_min(&self) -> f32 {
-        let interval = self.last_interval_ticks.load(Ordering::Relaxed);
-        if self.pulses_idle() || interval == 0 {
-            return 0.0;
-        }
-        // The step emitted last is the one being timed.
-        let step = self.emitted_steps.load(Ordering::Acquire).wrapping_sub(1);
-        self.path_steps.at(step) * (60.0 * TICK_HZ as f32) / interval as f32
-    }
-
-    /// The steps of a batch queued after `first` steps (counted as `set_queued` counts them)
-    /// each advance `step_mm` along the ideal curve (see
-    /// [`speed_mm_per_min`](Self::speed_mm_per_min)). Only the motion task calls this.
-    pub fn set_path_step_mm(&self, first: u32, step_mm: f32) {
-        self.path_steps.record(first, step_mm);
-    }
-
-    /// The work coordinate offset the host link's parser plans with (machine = work + offset),
-    /// mm.
-    pub fn work_offset_mm(&self) -> [f32; 2] {
-        self.work_offset_mm.lock(|o| o.get())
-    }
-
-    /// Sets the work coordinate offset; only the host link's parser calls this.
-    pub fn set_work_offset_mm(&self, offset_mm: [f32; 2]) {
-        if self.work_offset_mm.lock(|o| o.replace(offset_mm)) != offset_mm {
-            self.changed.signal(());
-        }
-    }
-
-    /// Planner segments free: how many more drawings the planner could take now.
-    pub fn plan_free_segments(&self) -> u8 {
-        self.plan_free.load(Ordering::Relaxed)
-    }
-
-    /// Missed step timer updates since power-on.
-    pub fn missed_updates(&self) -> u32 {
-        self.missed_updates.load(Ordering::Relaxed)
-    }
-
-    /// The motion task took a job drawing `kind`. Only the motion task calls this.
-    pub fn set_drawing(&self, kind: ShapeKind) {
-        let code = ShapeKind::ALL.iter().position(|&k| k == kind).map_or(0, |i| i as u8 + 1);
-        self.drawing.store(code, Ordering::Relaxed);
-    }
-
-    /// The kind of the job the motion task took last, if any.
-    pub fn drawing(&self) -> Option<ShapeKind> {
-        let code = self.drawing.load(Ordering::Relaxed);
-        ShapeKind::ALL.get(usize::from(code).checked_sub(1)?).copied()
-    }
-
-    /// Step-queue underruns since power-on.
-    pub fn underruns(&self) -> u32 {
-        self.underruns.load(Ordering::Relaxed)
-    }
-
-    /// Waits until the pulse engine next reports that it stopped.
-    pub async fn until_pulses_stopped(&self) {
-        self.pulses_done.wait().await
-    }
-
-    /// Waits until anything a display shows may have changed.
+    /// Waits until anything a display shows may have changed. For the LCD task.
     pub async fn changed(&self) {
         self.changed.wait().await
-    }
-
-    /// Waits for the next fault (a curve stopped part way), for the host link.
-    pub async fn next_fault(&self) -> MotionFault {
-        self.faults.wait().await
-    }
-
-    /// True when no step is queued or being emitted.
-    pub fn pulses_idle(&self) -> bool {
-        self.queued_steps.load(Ordering::Acquire) == self.emitted_steps.load(Ordering::Acquire)
-    }
-
-    pub fn run_state(&self) -> RunState {
-        match self.state.load(Ordering::Relaxed) {
-            STATE_RUN => RunState::Run,
-            STATE_HOLD => RunState::Hold,
-            STATE_JOG => RunState::Jog,
-            STATE_ALARM => RunState::Alarm,
-            _ => RunState::Idle,
-        }
-    }
-
-    /// Sets the motion's state. Check mode is not one: see [`set_check_mode`](Self::set_check_mode).
-    pub fn set_run_state(&self, state: RunState) {
-        let v = match state {
-            RunState::Idle | RunState::Check | RunState::Sleep | RunState::Home => STATE_IDLE,
-            RunState::Run => STATE_RUN,
-            RunState::Hold => STATE_HOLD,
-            RunState::Jog => STATE_JOG,
-            RunState::Alarm => STATE_ALARM,
-        };
-        if self.state.swap(v, Ordering::Relaxed) != v {
-            self.changed.signal(());
-        }
-    }
-
-    /// The host link enters or leaves check mode (`$C`); only the serial task calls this.
-    pub fn set_check_mode(&self, on: bool) {
-        if self.check_mode.swap(on, Ordering::Relaxed) != on {
-            self.changed.signal(());
-        }
     }
 
     /// The state to report and to act on: the run state, [`RunState::Sleep`] after `$SLP`,
@@ -554,10 +296,10 @@ impl Machine {
     /// checks its lines at rest.
     pub fn state(&self) -> RunState {
         match self.run_state() {
-            _ if self.asleep.load(Ordering::Relaxed) => RunState::Sleep,
+            _ if self.host_side.asleep() => RunState::Sleep,
             RunState::Alarm => RunState::Alarm,
             _ if self.homing() => RunState::Home,
-            RunState::Idle if self.check_mode.load(Ordering::Relaxed) => RunState::Check,
+            RunState::Idle if self.host_side.check_mode() => RunState::Check,
             state => state,
         }
     }
@@ -572,62 +314,22 @@ impl Machine {
         }
     }
 
-    /// `$SLP` at rest: the servos go off (the board drops SON, see [`servos_on`](Self::servos_on))
-    /// until [`wake`](Self::wake). Only the serial task calls this.
-    pub fn sleep(&self) {
-        self.asleep.store(true, Ordering::Relaxed);
-        // The axes are free until the reset.
-        self.position_lost.store(true, Ordering::Relaxed);
-        self.changed.signal(());
-    }
-
-    /// A reset after `$SLP`: the servos come back on and the machine is in alarm, since the free
-    /// axes may have been moved. Nothing when not asleep.
-    pub fn wake(&self) {
-        if self.asleep.swap(false, Ordering::Relaxed) {
-            self.set_run_state(RunState::Alarm);
-            self.changed.signal(());
-        }
-    }
-
     /// Whether the servo drivers are to be enabled (SON high): not asleep, and not after a
     /// driver alarm until it is cleared.
     pub fn servos_on(&self) -> bool {
         let driver_alarm = matches!(self.fault(), Some(MotionFault::Tripped(Trip::DriverAlarm(_))));
         let off_for_alarm = driver_alarm && self.halted();
-        !self.asleep.load(Ordering::Relaxed) && !off_for_alarm
+        !self.host_side.asleep() && !off_for_alarm
     }
 
-    /// Whether the drivers hold their axes: SON high for the enable delay (`$209`). Only the
-    /// servo task calls this.
-    pub fn set_servos_ready(&self, ready: bool) {
-        // Sequentially consistent: the servo task's going-off handshake with the motion task.
-        self.servos_ready.store(ready, Ordering::SeqCst);
-    }
-
-    /// True once the drivers hold their axes; no pulse may go out before.
-    pub fn servos_ready(&self) -> bool {
-        self.servos_ready.load(Ordering::SeqCst)
-    }
-
-    /// Sends the pen to `pen`; the motion task and the host link call this only at rest, and
-    /// wait for [`pen_settled`](Self::pen_settled) before anything moves.
-    pub fn set_pen(&self, pen: Pen) {
-        let depth = PenDepth::from_permille(self.pen_depth.load(Ordering::Relaxed));
+    /// Sends the pen to `pen` at the depth in force. For the pen's two writers, both at rest.
+    fn send_pen(&self, pen: Pen) {
+        let depth = self.host_side.pen_depth();
         let sent = self.pen.fetch_update(Ordering::AcqRel, Ordering::Acquire, |bits| {
             PenOrder::from_bits(bits).then(pen, depth).map(PenOrder::bits)
         });
         if sent.is_ok() {
             self.changed.signal(());
-        }
-    }
-
-    /// How deep the pen goes down from now on (`M3 S…`); a pen down now goes there. The host
-    /// link calls this only at rest, as [`set_pen`](Self::set_pen).
-    pub fn set_pen_depth(&self, depth: PenDepth) {
-        self.pen_depth.store(depth.permille(), Ordering::Relaxed);
-        if self.pen() == Pen::Down {
-            self.set_pen(Pen::Down);
         }
     }
 
@@ -641,28 +343,32 @@ impl Machine {
         PenOrder::from_bits(self.pen.load(Ordering::Acquire))
     }
 
-    /// The pen servo has settled as `order` says. Only the servo task calls this.
-    pub fn set_pen_settled(&self, order: PenOrder) {
-        self.pen_settled.store(order.bits(), Ordering::Release);
-    }
-
-    /// True once the pen is where it was last sent: no pulse may go out before.
-    pub fn pen_settled(&self) -> bool {
-        self.pen_settled.load(Ordering::Acquire) == self.pen.load(Ordering::Acquire)
-    }
-
     /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it
-    /// has not stopped itself already, and starts nothing until [`unlock`](Self::unlock); the
-    /// motion task drops what was planned and raises the alarm. A trip while halted is no news.
+    /// has not stopped itself already, and starts nothing until `$X`; the motion task drops
+    /// what was planned and raises the alarm. A trip while halted is no news. A request anyone
+    /// may post (the servo task's inputs; the pulse interrupt has its own,
+    /// [`PulseWriter::pulse_trip`]); the motion task takes it.
     pub fn trip(&self, trip: Trip) {
-        if self.halted.swap(true, Ordering::AcqRel) {
-            return;
+        if self.halt(trip) {
+            self.post_trip(trip);
         }
-        self.trip.lock(|t| t.set(Some(trip)));
+    }
+
+    /// Halts the pulses for `trip`; false if they were halted already.
+    fn halt(&self, trip: Trip) -> bool {
+        if self.halted.swap(true, Ordering::AcqRel) {
+            return false;
+        }
         // A limit switch a homing approach looks for stops nothing it does not expect.
         if !self.is_homing_switch(trip) {
             self.position_lost.store(true, Ordering::Relaxed);
         }
+        true
+    }
+
+    /// Leaves `trip` for the motion task, and wakes it and the displays.
+    fn post_trip(&self, trip: Trip) {
+        self.trip.lock(|t| t.set(Some(trip)));
         self.control_requested.signal(());
         self.changed.signal(());
     }
@@ -673,40 +379,9 @@ impl Machine {
         self.halted.load(Ordering::Relaxed)
     }
 
-    /// The trip the motion task has yet to handle, taking it. Only the motion task calls this.
-    pub fn take_trip(&self) -> Option<Trip> {
-        self.trip.lock(|t| t.take())
-    }
-
-    /// The step timer starts or stops. Only the pulse engine calls this.
-    pub fn set_pulsing(&self, on: bool) {
-        self.pulsing.store(on, Ordering::Release);
-    }
-
-    /// True while the step timer runs.
-    pub fn pulsing(&self) -> bool {
-        self.pulsing.load(Ordering::Acquire)
-    }
-
-    /// Steps emitted so far and the sum of their intervals (both wrap): after a trip, all there
-    /// will be of what was queued.
-    pub fn emitted_totals(&self) -> (u32, u32) {
-        (self.emitted_steps.load(Ordering::Acquire), self.emitted_ticks.load(Ordering::Acquire))
-    }
-
-    /// The input levels just read. Only the servo task calls this.
-    pub fn set_input_levels(&self, levels: InputLevels) {
-        self.input_levels.store(levels, Ordering::Relaxed);
-    }
-
-    /// The input levels last read.
-    pub fn input_levels(&self) -> InputLevels {
-        self.input_levels.load(Ordering::Relaxed)
-    }
-
-    /// `$X`: leaves the alarm, and lets pulses out again after a trip (handled by the motion
-    /// task by now: the machine has stopped). Only the serial task calls this.
-    pub fn unlock(&self) {
+    /// Leaves the alarm, and lets pulses out again after a trip (handled by the motion task by
+    /// now: the machine has stopped). For `$X` and a homing cycle's start.
+    fn unlock(&self) {
         if self.run_state() == RunState::Alarm {
             self.set_run_state(RunState::Idle);
         }
@@ -725,37 +400,9 @@ impl Machine {
             underruns: self.underruns(),
             missed_updates: self.missed_updates(),
             overrides: self.overrides(),
-            emitted_steps: self.emitted_steps.load(Ordering::Acquire),
+            emitted_steps: self.emitted_totals().0,
             work_left: !self.stopped(),
         }
-    }
-
-    pub fn set_fault(&self, fault: Option<MotionFault>) {
-        self.fault.lock(|f| f.set(fault));
-        if let Some(f) = fault {
-            self.faults.signal(f);
-        }
-        self.changed.signal(());
-    }
-
-    /// The fault that ended the last job early, if any.
-    pub fn fault(&self) -> Option<MotionFault> {
-        self.fault.lock(|f| f.get())
-    }
-
-    /// Whether the planner holds anything. Only the motion task calls this.
-    pub fn set_plan_empty(&self, empty: bool) {
-        self.plan_empty.store(empty, Ordering::Release);
-    }
-
-    /// How many segments the planner has room for. Only the motion task calls this.
-    pub fn set_plan_free_segments(&self, free: usize) {
-        self.plan_free.store(free.min(usize::from(u8::MAX)) as u8, Ordering::Relaxed);
-    }
-
-    /// True when nothing is queued, planned or moving, held or not: the position is final.
-    pub fn stopped(&self) -> bool {
-        self.plan_empty.load(Ordering::Acquire) && self.jobs.is_empty() && self.pulses_idle()
     }
 
     /// True when the machine waits for its inputs: idle, or stopped in an alarm.

@@ -34,12 +34,12 @@
 //!   engine learns from the timer how many update events really happened
 //!   ([`StepTimer::update_count`]), counts the repeated pulses into the position with the SIGN
 //!   levels they went out with (so the position stays the pulses emitted), counts the fault
-//!   ([`Machine::count_missed_update`]), trips the machine ([`Trip::MissedUpdate`]) and lets the
+//!   ([`PulseWriter::count_missed_update`](crate::machine::PulseWriter::count_missed_update)), trips the machine ([`Trip::MissedUpdate`]) and lets the
 //!   timer stop once the repeat under way is out, whole.
 //!
 //! At the start of each period the engine also samples the machine's inputs ([`crate::inputs`]):
 //! the limit switches the step now starting runs towards, the drivers' alarms and the emergency
-//! stop. Once one has tripped, or anything else has tripped the machine ([`Machine::trip`]), it
+//! stop. Once one has tripped, or anything else has tripped the machine ([`Machine::trip`](crate::machine::Machine::trip)), it
 //! halts the timer before that period's pulse, so the pulses stop within one period, and starts
 //! nothing until the alarm is cleared.
 //!
@@ -49,7 +49,7 @@
 
 use crate::geom::{Axis, StepCmd, TICK_HZ, TICKS_PER_US, us_to_ticks};
 use crate::inputs::{ALWAYS_WATCHED, Debounce, InputLevels, InputSetup, LIMITS, Trip};
-use crate::machine::Machine;
+use crate::machine::PulseWriter;
 use crate::math;
 use crate::settings::Settings;
 
@@ -314,7 +314,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     }
 
     /// The motion task queued commands: starts the timer if it is stopped and a step is queued.
-    pub fn kick(&mut self, machine: &Machine) {
+    pub fn kick(&mut self, machine: PulseWriter<'_>) {
         if self.running || machine.halted() {
             return;
         }
@@ -341,7 +341,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// A period starts (the timer's update event): drives SIGN for this period's pulse if it
     /// changes, counts the pulses of the period that ended, and preloads the next period. What
     /// it calls on the way of every pulse is `#[inline(always)]` (`cost/` counts it per pulse).
-    pub fn on_period(&mut self, machine: &Machine) {
+    pub fn on_period(&mut self, machine: PulseWriter<'_>) {
         if !self.running {
             return;
         }
@@ -378,7 +378,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// pulse the timer stops, unless more came in behind the rest.
     #[cold]
     #[inline(never)]
-    fn after_pause(&mut self, machine: &Machine) {
+    fn after_pause(&mut self, machine: PulseWriter<'_>) {
         if let Some((cmd, ticks)) = self.pending {
             self.pending = None;
             self.preload_pulse_after(cmd, ticks, StepBits::of(cmd));
@@ -395,7 +395,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// The interrupt came `extra` whole periods late: see the module documentation.
     #[cold]
     #[inline(never)]
-    fn missed_updates(&mut self, machine: &Machine, extra: u16) {
+    fn missed_updates(&mut self, machine: PulseWriter<'_>, extra: u16) {
         if self.active.kind == Kind::Step {
             machine.emitted(self.active.cmd);
         }
@@ -429,7 +429,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// Samples the inputs the active period watches; true once the machine has tripped, by them
     /// or otherwise.
     #[inline(always)]
-    fn tripped(&mut self, machine: &Machine) -> bool {
+    fn tripped(&mut self, machine: PulseWriter<'_>) -> bool {
         let levels = self.timer.input_levels();
         let toward = self.active.toward;
         let active = self.inputs.active(levels) & (toward | ALWAYS_WATCHED);
@@ -443,7 +443,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     }
 
     /// The timer has stopped: the engine is ready for the next kick.
-    fn stopped(&mut self, machine: &Machine) {
+    fn stopped(&mut self, machine: PulseWriter<'_>) {
         self.running = false;
         self.active = Period::TAIL;
         self.preloaded = Period::TAIL;
@@ -480,7 +480,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// directions) builds it in place. `MAY_STARVE`: an underrun may be under way (not after a
     /// step, which the queue had).
     #[inline(always)]
-    fn preload_queued<const MAY_STARVE: bool>(&mut self, machine: &Machine) {
+    fn preload_queued<const MAY_STARVE: bool>(&mut self, machine: PulseWriter<'_>) {
         let Some(cmd) = self.queue.pop() else {
             self.preload_dry(machine);
             return;
@@ -507,7 +507,7 @@ impl<'q, T: StepTimer> PulseEngine<'q, T> {
     /// The queue has nothing: the rest, or an underrun.
     #[cold]
     #[inline(never)]
-    fn preload_dry(&mut self, machine: &Machine) {
+    fn preload_dry(&mut self, machine: PulseWriter<'_>) {
         if self.queue.at_rest() {
             self.preload(TAIL_TICKS, 0, Period::TAIL);
             return;

@@ -159,7 +159,7 @@ fn the_position_is_unknown_from_power_on_with_homing_on_and_after_a_hard_limit_u
     use servoplot::settings::Settings;
     let machine = Machine::new(Settings { homing: true, ..Settings::default() });
     assert!(machine.status().position_lost, "powered on, not homed");
-    machine.set_origin(Point::new(-19_900, -19_900));
+    machine.handles().unwrap().homing.set_origin(Point::new(-19_900, -19_900));
     assert!(!machine.status().position_lost, "homed");
     assert_eq!(machine.position(), Point::new(-19_900, -19_900));
     // During homing the switch an approach looks for is no loss; an e-stop is.
@@ -167,7 +167,7 @@ fn the_position_is_unknown_from_power_on_with_homing_on_and_after_a_hard_limit_u
     machine.trip(Trip::Limit { axis: Axis::X, max: false });
     assert!(!machine.status().position_lost, "the switch homing looked for");
     let machine = Machine::new(Settings { homing: true, ..Settings::default() });
-    machine.set_origin(Point::new(-19_900, -19_900));
+    machine.handles().unwrap().homing.set_origin(Point::new(-19_900, -19_900));
     assert!(machine.request_homing());
     machine.trip(Trip::EStop);
     assert!(machine.status().position_lost, "an e-stop during homing");

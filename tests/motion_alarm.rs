@@ -34,9 +34,10 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let loose = Settings::default();
     let tight = Settings { max_travel_mm: [50.0, 50.0], ..Settings::default() };
     let machine = Machine::new(tight);
+    let handles = machine.handles().unwrap();
     // No servo task here: the drivers hold their axes from the start.
-    machine.set_servos_ready(true);
-    machine.set_pen_settled(machine.pen_order());
+    handles.servo.set_servos_ready(true);
+    handles.servo.set_pen_settled(machine.pen_order());
     let start = machine.plan_end().unwrap();
     let first = line_to(150.0, Point::ORIGIN, &loose);
     let end = first.drawing.end();
@@ -48,7 +49,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     let (producer, mut consumer) = queue.split();
     let mut planner: Box<Planner<Curve, PLANNER_SEGMENTS>> = Box::new(Planner::new(Limits::from_settings(&loose)));
     let mut motion = pin!(servoplot::tasks::motion::run(
-        &machine,
+        handles.motion,
         &mut planner,
         producer,
         || {},
@@ -63,11 +64,11 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
         // The pulse side emits everything queued, each step after its interval.
         while let Some(cmd) = consumer.pop() {
             clock::jump_to(clock::now_ticks() + u64::from(cmd.interval_ticks.div_ceil(TICKS_PER_US)));
-            machine.emitted(cmd);
+            handles.pulse.emitted(cmd);
             path.push(machine.position());
         }
         if machine.pulses_idle() {
-            machine.pulses_stopped();
+            handles.pulse.pulses_stopped();
             machine.deliver_pulse_news();
         }
         if machine.stopped() && machine.run_state() == RunState::Alarm {

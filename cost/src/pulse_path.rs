@@ -11,7 +11,7 @@ use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 
 use servoplot::geom::{Axis, StepCmd, TICKS_PER_US};
 use servoplot::inputs::InputLevels;
-use servoplot::machine::Machine;
+use servoplot::machine::{Machine, PulseWriter};
 use servoplot::pulse::{PulseEngine, StepQueue, StepTimer};
 use servoplot::settings::Settings;
 
@@ -111,7 +111,7 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
 
 struct Pulses {
     engine: PulseEngine<'static, ModelStepTimer>,
-    machine: &'static Machine,
+    machine: PulseWriter<'static>,
 }
 
 /// The engine of the run under way, for the interrupt: as the board's, a pointer the interrupt
@@ -165,7 +165,7 @@ mod static_machine {
 static mut QUEUE: StepQueue = StepQueue::new();
 
 /// Emits `steps` (at most the queue's capacity less one) and reports the run's instructions.
-pub fn measure(steps: &[StepCmd], label: &str, machine: &'static Machine) {
+pub fn measure(steps: &[StepCmd], label: &str, machine: PulseWriter<'static>) {
     // SAFETY: each run splits the queue anew while the interrupt is off; nothing else uses it.
     let queue: &'static mut StepQueue = unsafe { &mut *addr_of_mut!(QUEUE) };
     *queue = StepQueue::new();
@@ -206,7 +206,8 @@ pub fn measure(steps: &[StepCmd], label: &str, machine: &'static Machine) {
     report_steps("pulse", label, "both", steps.len() as u64);
 }
 
-/// The machine the pulse path counts for.
-pub fn machine(settings: Settings) -> &'static Machine {
-    MACHINE.init(Machine::new(settings))
+/// The pulse interrupt's handle to the machine the pulse path counts for.
+pub fn machine(settings: Settings) -> PulseWriter<'static> {
+    let Some(handles) = MACHINE.init(Machine::new(settings)).handles() else { panic!("handles") };
+    handles.pulse
 }

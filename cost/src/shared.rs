@@ -33,6 +33,8 @@ const KEYS: [Key; 6] = [Key::Digit(8), Key::Digit(2), Key::Hash, Key::Digit(5), 
 pub fn run() {
     let settings = Settings::default();
     let machine = Machine::new(settings);
+    let Some(handles) = machine.handles() else { panic!("handles") };
+    let (motion, host) = (handles.motion, handles.host);
     let panel = Panel::new();
     // A line out and the line back: each starts where the other ends.
     let line = |from: Point, to: Point| match servoplot::drawing::from_shape(Shape::Straight { to }, from, &settings) {
@@ -66,13 +68,13 @@ pub fn run() {
         // Inputs and motion task: jobs handed over until the queue is full, one more waiting for
         // room, then all taken; the motion task waits for the first.
         let Some(mut end) = machine.plan_end() else { panic!("plan end") };
-        waits(machine.job_ready());
+        waits(motion.job_ready());
         while let Ok(ends) = machine.try_submit(next(end), end) {
             end = ends;
         }
         let mut waiting = pin!(machine.submit(next(end), end));
         let mut queued = poll(waiting.as_mut()).is_ready();
-        while let Some(taken) = machine.next_job() {
+        while let Some(taken) = motion.next_job() {
             core::hint::black_box(taken);
             if !queued {
                 queued = poll(waiting.as_mut()).is_ready();
@@ -81,13 +83,13 @@ pub fn run() {
         // Host link and keypad change a setting, the LCD and the serial task waiting for it; the
         // motion task and the pulse engine read them.
         waits(machine.changed());
-        waits(machine.settings_changed());
+        waits(host.settings_changed());
         let _ = machine.update_settings(|s| s.set(110, 2_000.0 + round as f32));
         core::hint::black_box(machine.settings());
         // Reports: the status, and a control requested and taken.
         core::hint::black_box(machine.status());
         machine.request(Control::Hold);
-        core::hint::black_box(machine.take_control());
+        core::hint::black_box(motion.take_control());
     }
 }
 

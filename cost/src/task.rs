@@ -73,13 +73,19 @@ const MAX_POLLS: usize = 100_000;
 /// the steps it queued. Returns the steps emitted.
 pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
     let machine = Machine::new(*settings);
+    let Some(handles) = machine.handles() else { panic!("handles") };
     // No servo task here: the drivers hold their axes from the start.
-    machine.set_servos_ready(true);
-    machine.set_pen_settled(machine.pen_order());
+    handles.servo.set_servos_ready(true);
+    handles.servo.set_pen_settled(machine.pen_order());
     let mut queue = StepQueue::new();
     let (producer, mut consumer) = queue.split();
-    let mut motion =
-        pin!(servoplot::tasks::motion::run(&machine, planner(), producer, || {}, servoplot::tasks::motion::RealTime));
+    let mut motion = pin!(servoplot::tasks::motion::run(
+        handles.motion,
+        planner(),
+        producer,
+        || {},
+        servoplot::tasks::motion::RealTime
+    ));
     let Some(from) = machine.plan_end() else { panic!("plan end") };
     if machine.try_submit(job, from).is_err() {
         panic!("job queue");
@@ -123,12 +129,12 @@ pub fn measure(case: &str, method: &str, job: Job, settings: &Settings) -> u64 {
             }
             set_clock(at);
             last_pulse_ticks = at_ticks;
-            machine.emitted(cmd);
+            handles.pulse.emitted(cmd);
             emitted += 1;
             next_pulse_at = None;
         }
         if next_pulse_at.is_none() && machine.pulses_idle() {
-            machine.pulses_stopped();
+            handles.pulse.pulses_stopped();
             machine.deliver_pulse_news();
         }
         if wake_at != u64::MAX {

@@ -24,7 +24,7 @@ use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
 use embassy_time::{Duration, Timer};
 use servoplot::health::{self, Health};
 use servoplot::interp::Curve;
-use servoplot::machine::Machine;
+use servoplot::machine::{HomingWriter, HostWriter, Machine, MotionWriter, ServoWriter};
 use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::pulse::{StepProducer, StepQueue};
 use servoplot::settings::Settings;
@@ -85,23 +85,24 @@ fn start(spawner: Spawner) {
         why, settings.steps_per_mm[0], settings.steps_per_mm[1], settings.max_pulse_rate_hz
     );
     let machine: &'static Machine = build_machine(MACHINE.uninit(), settings);
+    let Some(handles) = machine.handles() else { defmt::panic!("the machine's handles taken twice") };
     let planner = Planner::init(PLANNER.uninit(), Limits::from_settings(&settings));
 
     let (steps, step_consumer) = STEP_QUEUE.take().split();
-    board::start_pulses(board.step_timer, step_consumer, machine);
+    board::start_pulses(board.step_timer, step_consumer, handles.pulse);
     let motion_spawner: SendSpawner = board::start_motion_executor();
-    motion_spawner.spawn(timed(motion(machine, planner, steps), "motion", Executor::Interrupt));
+    motion_spawner.spawn(timed(motion(handles.motion, planner, steps), "motion", Executor::Interrupt));
 
     let panel: &'static Panel = PANEL.init_with(Panel::new);
     spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad", Executor::ThreadMode));
     spawner.spawn(timed(
-        servo(machine, board.son, board.pen, board.lights, board.watchdog),
+        servo(handles.servo, board.son, board.pen, board.lights, board.watchdog),
         "servo",
         Executor::ThreadMode,
     ));
-    spawner.spawn(timed(homing(machine), "homing", Executor::ThreadMode));
+    spawner.spawn(timed(homing(handles.homing), "homing", Executor::ThreadMode));
     let links = LINKS.init((board.host, board.second_link));
-    let host_link = HOST_LINK.place(|| host_link(machine, store, loaded, links));
+    let host_link = HOST_LINK.place(|| host_link(handles.host, store, loaded, links));
     let Some(host_link) = host_link else { defmt::panic!("the host link's future placed twice") };
     spawner.spawn(timed(serial(host_link), "serial", Executor::ThreadMode));
     spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd", Executor::ThreadMode));
@@ -142,7 +143,7 @@ fn timed<S>(token: Result<SpawnToken<S>, SpawnError>, name: &'static str, execut
 
 #[embassy_executor::task]
 async fn motion(
-    machine: &'static Machine,
+    machine: MotionWriter<'static>,
     planner: &'static mut Planner<Curve, PLANNER_SEGMENTS>,
     steps: StepProducer<'static>,
 ) -> ! {
@@ -162,7 +163,7 @@ async fn keypad(
 /// The host link's future, on the two links' ends (by reference: what the future holds at first
 /// is then a few words, and it is built straight into its slot).
 fn host_link(
-    machine: &'static Machine,
+    machine: HostWriter<'static>,
     store: &'static mut Store<board::Flash>,
     loaded: Result<(), StoreError>,
     links: &'static mut Links,
@@ -181,7 +182,7 @@ async fn serial(host_link: Pin<&'static mut dyn Future<Output = Infallible>>) ->
 
 #[embassy_executor::task]
 async fn servo(
-    machine: &'static Machine,
+    machine: ServoWriter<'static>,
     son: board::Output,
     pen: board::PenPwm,
     lights: [board::Output; 2],
@@ -191,7 +192,7 @@ async fn servo(
 }
 
 #[embassy_executor::task]
-async fn homing(machine: &'static Machine) -> ! {
+async fn homing(machine: HomingWriter<'static>) -> ! {
     tasks::homing::run(machine).await
 }
 

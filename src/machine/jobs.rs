@@ -10,9 +10,9 @@
 
 use core::cell::Cell;
 use core::future::poll_fn;
-use core::sync::atomic::Ordering;
 use core::task::Poll;
 
+use super::motion_writer::MotionWriter;
 use super::plan_end::{PlanEnd, PlanState, Stale};
 use super::{Machine, Refused};
 use crate::job::Job;
@@ -81,20 +81,29 @@ impl Machine {
         self.jobs.len()
     }
 
-    /// Waits until a job is queued (it may already be). For the motion task.
-    pub async fn job_ready(&self) {
-        self.jobs.ready().await
+    /// The pen stands elsewhere than the plan said, with nothing queued (a homing approach
+    /// stopped at its switch, or machine zero moved): the plan ends where it stands.
+    pub(super) fn plan_from_pen(&self) {
+        let pen = self.position();
+        self.plan(|p| p.restart_at(pen));
+    }
+}
+
+/// The jobs' taker: the motion task.
+impl MotionWriter<'_> {
+    /// Waits until a job is queued (it may already be).
+    pub async fn job_ready(self) {
+        self.machine().jobs.ready().await
     }
 
     /// The next job planned from where the jobs taken before it end, dropping those planned
-    /// before an abort (their senders were refused, or the abort's message covers them). Only
-    /// the motion task calls this.
-    pub fn next_job(&self) -> Option<Job> {
+    /// before an abort (their senders were refused, or the abort's message covers them).
+    pub fn next_job(self) -> Option<Job> {
         loop {
-            let (from, job) = self.jobs.pop()?;
-            if self.plan(|p| p.take(from, job.drawing.end())) {
+            let (from, job) = self.machine().jobs.pop()?;
+            if self.machine().plan(|p| p.take(from, job.drawing.end())) {
                 // Taken, it is planned before anything else may look: nothing has stopped.
-                self.plan_empty.store(false, Ordering::Release);
+                self.set_plan_empty(false);
                 return Some(job);
             }
             warn!("job planned before an abort dropped");
@@ -103,19 +112,11 @@ impl Machine {
 
     /// An abort: every end planned so far is stale, so that jobs planned from one are refused,
     /// and the plan ends where the pen stops; drops every queued job, which wakes the inputs
-    /// waiting to hand one over (to be refused). Only the motion task calls this, once its
-    /// planner has dropped its plan.
-    pub fn abort_plan(&self) {
-        self.plan(PlanState::abort);
+    /// waiting to hand one over (to be refused). Once the planner has dropped its plan.
+    pub fn abort_plan(self) {
+        self.machine().plan(PlanState::abort);
         // A job handed over before this and queued after it is dropped by `next_job`.
-        self.jobs.clear();
-    }
-
-    /// The pen stands elsewhere than the plan said, with nothing queued (a homing approach
-    /// stopped at its switch, or machine zero moved): the plan ends where it stands.
-    pub(super) fn plan_from_pen(&self) {
-        let pen = self.position();
-        self.plan(|p| p.restart_at(pen));
+        self.machine().jobs.clear();
     }
 }
 
@@ -126,6 +127,12 @@ mod tests {
     use crate::geom::{Point, Step, StepCmd};
     use crate::job::Feed;
     use crate::machine::JOB_QUEUE_LEN;
+    use crate::machine::PulseWriter;
+
+    /// The motion task's handle, for the motion task's part.
+    fn motion(machine: &Machine) -> MotionWriter<'_> {
+        MotionWriter::new(machine)
+    }
     use crate::settings::Settings;
     use core::pin::pin;
     use core::task::{Context, Waker};
@@ -155,20 +162,20 @@ mod tests {
     fn emit(machine: &Machine, dx: i32) {
         let step = Step::new(dx.signum() as i8, 0);
         for _ in 0..dx.abs() {
-            machine.emitted(StepCmd::new(step, 1));
+            PulseWriter::new(machine).emitted(StepCmd::new(step, 1));
         }
         let (steps, ticks) = machine.emitted_totals();
-        machine.set_queued(steps, ticks);
+        motion(machine).set_queued(steps, ticks);
     }
 
     /// The motion task's part: takes every job queued, and runs them: the pen ends where the
     /// last one does. The X each ends at.
     fn run_all(machine: &Machine) -> std::vec::Vec<i32> {
-        let taken: std::vec::Vec<Job> = core::iter::from_fn(|| machine.next_job()).collect();
+        let taken: std::vec::Vec<Job> = core::iter::from_fn(|| motion(machine).next_job()).collect();
         if let Some(last) = taken.last() {
             emit(machine, last.drawing.end().x - machine.position().x);
         }
-        machine.set_plan_empty(true);
+        motion(machine).set_plan_empty(true);
         taken.iter().map(end_x).collect()
     }
 
@@ -219,13 +226,13 @@ mod tests {
         let first = machine.try_submit(line(start, 10.0), start).unwrap();
         let second = machine.try_submit(line(first, 20.0), first).unwrap();
         // The motion task takes the first and stops 3 steps along it.
-        assert_eq!(machine.next_job().map(|j| end_x(&j)), Some(x(10.0)));
+        assert_eq!(motion(&machine).next_job().map(|j| end_x(&j)), Some(x(10.0)));
         emit(&machine, 3);
-        machine.abort_plan();
+        motion(&machine).abort_plan();
         assert_eq!(machine.queued_jobs(), 0, "the second was dropped");
         assert_eq!(machine.plan_end(), None, "unknown until the machine stops");
         assert_eq!(machine.try_submit(line(second, 30.0), second), Err(Refused::Stale));
-        machine.set_plan_empty(true);
+        motion(&machine).set_plan_empty(true);
         let stopped = machine.plan_end().unwrap();
         assert_eq!(stopped.at(), Point::new(3, 0), "where the pen stopped");
         assert_eq!(machine.try_submit(line(second, 30.0), second), Err(Refused::Stale));
@@ -238,7 +245,7 @@ mod tests {
     fn an_abort_at_rest_still_refuses_what_was_planned_before_it() {
         let machine = Machine::new(Settings::default());
         let before = machine.plan_end().unwrap();
-        machine.abort_plan();
+        motion(&machine).abort_plan();
         let after = machine.plan_end().unwrap();
         assert_eq!(after.at(), before.at(), "the pen did not move");
         assert_ne!(after, before);
@@ -252,10 +259,10 @@ mod tests {
         let before = machine.plan_end().unwrap();
         // The input's job was handed over, then the abort came before it was in the queue.
         machine.plan(|p| p.hand_over(before, Point::ORIGIN, Point::new(x(1.0), 0))).unwrap();
-        machine.abort_plan();
+        motion(&machine).abort_plan();
         machine.jobs.push((before, line(before, 1.0))).unwrap();
         assert_eq!(machine.plan_end(), None, "the machine has not stopped: a job is queued");
-        assert!(machine.next_job().is_none(), "the motion task drops it");
+        assert!(motion(&machine).next_job().is_none(), "the motion task drops it");
         let after = machine.plan_end().unwrap();
         machine.try_submit(line(after, 2.0), after).unwrap();
         assert_eq!(run_all(&machine), [x(2.0)]);
@@ -266,7 +273,7 @@ mod tests {
         let machine = Machine::new(Settings::default());
         let start = machine.plan_end().unwrap();
         let ends = machine.try_submit(line(start, 10.0), start).unwrap();
-        machine.next_job().unwrap();
+        motion(&machine).next_job().unwrap();
         emit(&machine, 7);
         machine.plan_from_pen();
         assert_eq!(machine.plan_end(), Some(ends.then(Point::new(7, 0))));
@@ -287,14 +294,14 @@ mod tests {
         let mut waiting = pin!(machine.submit(line(end, 50.0), end));
         assert!(waiting.as_mut().poll(&mut cx).is_pending(), "the queue is full");
         assert_eq!(machine.plan_end(), Some(end), "not handed over while it waits");
-        machine.next_job().unwrap();
+        motion(&machine).next_job().unwrap();
         let Poll::Ready(Ok(after)) = waiting.as_mut().poll(&mut cx) else { panic!("room made") };
         assert_eq!(after.at(), Point::new(x(50.0), 0));
         assert_eq!(machine.queued_jobs(), JOB_QUEUE_LEN);
 
         let mut refused = pin!(machine.submit(line(after, 60.0), after));
         assert!(refused.as_mut().poll(&mut cx).is_pending());
-        machine.abort_plan();
+        motion(&machine).abort_plan();
         assert_eq!(refused.as_mut().poll(&mut cx), Poll::Ready(Err(Stale)));
         assert_eq!(machine.queued_jobs(), 0, "nothing queued after the abort");
     }
@@ -303,7 +310,7 @@ mod tests {
     fn the_motion_task_waits_for_a_job_and_is_woken_by_its_handing_over() {
         let machine = Machine::new(Settings::default());
         let mut cx = Context::from_waker(Waker::noop());
-        let mut ready = pin!(machine.job_ready());
+        let mut ready = pin!(motion(&machine).job_ready());
         assert!(ready.as_mut().poll(&mut cx).is_pending());
         let end = machine.plan_end().unwrap();
         machine.try_submit(line(end, 1.0), end).unwrap();

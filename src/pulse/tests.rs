@@ -1,6 +1,7 @@
 extern crate std;
 use super::*;
 use crate::geom::{Point, Step};
+use crate::machine::Machine;
 use proptest::prelude::*;
 use std::vec::Vec;
 
@@ -68,7 +69,7 @@ impl StepTimer for MockTimer {
 /// event the preloaded period becomes active, the update counter counts, and the interrupt
 /// runs, unless the timer says it comes late (then the period repeats). `between` runs after
 /// each period, as the motion task could.
-fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: &Machine, max: usize, mut between: impl FnMut(usize)) {
+fn run(engine: &mut PulseEngine<'_, MockTimer>, machine: PulseWriter<'_>, max: usize, mut between: impl FnMut(usize)) {
     engine.kick(machine);
     machine.deliver_pulse_news();
     if !core::mem::take(&mut engine.timer_mut().started) {
@@ -111,17 +112,21 @@ fn queue(p: &mut StepProducer<'_>, cmds: &[StepCmd], rest: bool) {
     }
 }
 
-/// The engine with `settings` run over `cmds` to the end: its timer and the machine.
-fn emit(settings: Settings, cmds: &[StepCmd], late: &[usize]) -> (MockTimer, Machine) {
+/// The engine with `settings` run over `cmds` to the end: its timer, the machine, and the trip
+/// the motion task would take then.
+fn emit(settings: Settings, cmds: &[StepCmd], late: &[usize]) -> (MockTimer, Machine, Option<Trip>) {
     let machine = Machine::new(settings);
+    let handles = machine.handles().unwrap();
+    let pulses = handles.pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, cmds, true);
     let timer = MockTimer { late: late.to_vec(), ..MockTimer::default() };
     let mut engine = PulseEngine::new(timer, c);
-    run(&mut engine, &machine, 10_000, |_| {});
+    run(&mut engine, pulses, 10_000, |_| {});
     let PulseEngine { timer, .. } = engine;
-    (timer, machine)
+    let trip = handles.motion.take_trip();
+    (timer, machine, trip)
 }
 
 /// Where the pulses of `periods` take the pen as the drivers count them: each by the SIGN level
@@ -142,12 +147,14 @@ fn driven(periods: &[(u32, u8, [bool; 2])], invert: u8) -> Point {
 fn steps_become_periods_ending_in_their_pulses_and_the_timer_stops_after_the_rest() {
     // 5 µs pulses, set-up and hold, 20 kHz: no period ending in a pulse under 50 µs.
     let machine = Machine::new(Settings::default());
+    let handles = machine.handles().unwrap();
+    let pulses = handles.pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)), step(1, 1, us(60)), step(0, 1, us(60))], true);
-    machine.set_queued(3, us(220));
+    handles.motion.set_queued(3, us(220));
     let mut engine = PulseEngine::new(MockTimer::default(), c);
-    run(&mut engine, &machine, 100, |_| {});
+    run(&mut engine, pulses, 100, |_| {});
     let periods: Vec<(u32, u8)> = engine.timer().periods.iter().map(|&(t, a, _)| (t, a)).collect();
     // SIGN is set for the first step of each axis: the hold first, then the rest of the
     // interval; a step in a known direction is one period.
@@ -169,7 +176,7 @@ fn a_direction_change_holds_sign_after_the_last_pulse_and_sets_it_up_before_the_
     // 10 µs.
     let fast = Settings { max_pulse_rate_hz: 100_000.0, ..Settings::default() };
     let cmds = [step(1, 0, us(50)), step(-1, 0, us(10)), step(-1, 0, us(10)), step(-1, 1, us(10))];
-    let (timer, machine) = emit(fast, &cmds, &[]);
+    let (timer, machine, _) = emit(fast, &cmds, &[]);
     let ticks: Vec<u32> = timer.periods.iter().map(|p| p.0).collect();
     assert_eq!(ticks, [us(5), us(45), us(5), us(12), us(10), us(5), us(12)]);
     // SIGN changes at the start of the period that ends with the reversed pulse, never under
@@ -179,7 +186,7 @@ fn a_direction_change_holds_sign_after_the_last_pulse_and_sets_it_up_before_the_
     assert_eq!(machine.position(), Point::new(-2, 1));
     // At 20 kHz the 50 µs floor of `$205` leaves the set-up room: the pulse's period is the
     // rest of the interval.
-    let (timer, _) = emit(Settings::default(), &cmds, &[]);
+    let (timer, _, _) = emit(Settings::default(), &cmds, &[]);
     let ticks: Vec<u32> = timer.periods.iter().map(|p| p.0).collect();
     assert_eq!(ticks, [us(5), us(45), us(5), us(45), us(50), us(5), us(45)]);
 }
@@ -190,7 +197,7 @@ fn at_200_khz_a_pulse_of_2_5_us_is_as_long_low_as_high() {
     let timing = Timing::new(&fastest, LATENCY_TICKS);
     assert_eq!((timing.width_ticks, timing.min_period_ticks), (10, 20));
     // Commands asking for less get the period of `$205`.
-    let (timer, machine) = emit(fastest, &[step(1, 0, 1); 20], &[]);
+    let (timer, machine, _) = emit(fastest, &[step(1, 0, 1); 20], &[]);
     assert!(timer.periods.iter().skip(2).all(|p| p.0 == 20 && p.1 == 1));
     assert_eq!(machine.position(), Point::new(20, 0));
     // A 2.6 µs pulse does not fit twice in 5 µs in whole ticks (11 + 11 > 20): refused.
@@ -258,7 +265,7 @@ proptest! {
             .map(|&(x, y, interval)| step(x, y, interval))
             .collect();
         prop_assume!(!cmds.is_empty());
-        let (timer, machine) = emit(settings, &cmds, &[]);
+        let (timer, machine, _) = emit(settings, &cmds, &[]);
         let timing = Timing::new(&settings, LATENCY_TICKS);
         let line = timeline(&timer.periods, timing.width_ticks);
         for axis in 0..2 {
@@ -294,7 +301,7 @@ proptest! {
 
 #[test]
 fn an_interval_longer_than_the_timer_counts_waits_in_pulseless_periods() {
-    let (timer, machine) = emit(Settings::default(), &[step(0, -1, 600_000), step(0, -1, 400)], &[]);
+    let (timer, machine, _) = emit(Settings::default(), &[step(0, -1, 600_000), step(0, -1, 400)], &[]);
     let periods = &timer.periods;
     let until_first: u32 = periods.iter().take_while(|p| p.1 == 0).map(|p| p.0).sum::<u32>();
     let first = periods.iter().position(|p| p.1 != 0).unwrap();
@@ -307,12 +314,13 @@ fn an_interval_longer_than_the_timer_counts_waits_in_pulseless_periods() {
 #[test]
 fn a_queue_run_dry_before_the_rest_is_one_underrun_and_never_a_burst() {
     let machine = Machine::new(Settings::default());
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)); 3], false);
     let mut engine = PulseEngine::new(MockTimer::default(), c);
     // The motion task catches up only after the 10th period, then finishes.
-    run(&mut engine, &machine, 1_000, |k| {
+    run(&mut engine, pulses, 1_000, |k| {
         if k == 10 {
             queue(&mut p, &[step(1, 0, us(100)); 2], true);
         }
@@ -340,6 +348,8 @@ fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts
     // Hard limits, no debounce; normally open switches read low when pressed.
     let settings = Settings { hard_limits: true, input_debounce_ms: 0, ..Settings::default() };
     let machine = Machine::new(settings);
+    let handles = machine.handles().unwrap();
+    let pulses = handles.pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100)); 10], true);
@@ -351,27 +361,28 @@ fn a_limit_switch_ahead_halts_the_timer_before_the_next_pulse_and_nothing_starts
         ..MockTimer::default()
     };
     let mut engine = PulseEngine::new(timer, c);
-    run(&mut engine, &machine, 100, |_| {});
+    run(&mut engine, pulses, 100, |_| {});
     assert_eq!(engine.timer().halts, 1);
     assert!(machine.halted());
     assert_eq!(machine.position(), Point::new(4, 0), "the pulses of the periods before");
-    assert_eq!(machine.take_trip(), Some(Trip::Limit { axis: Axis::X, max: true }));
-    engine.kick(&machine);
+    assert_eq!(handles.motion.take_trip(), Some(Trip::Limit { axis: Axis::X, max: true }));
+    engine.kick(pulses);
     assert!(!engine.is_running(), "halted: no kick starts the timer");
-    machine.unlock();
-    engine.kick(&machine);
+    handles.host.unlock();
+    engine.kick(pulses);
     assert!(engine.is_running(), "unlocked, the queued steps go on");
 }
 
 #[test]
 fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
     let machine = Machine::new(Settings::default());
+    let pulses = machine.handles().unwrap().pulse;
     let mut q = StepQueue::new();
     let (mut p, c) = q.split();
     queue(&mut p, &[step(1, 0, us(100))], true);
     let mut engine = PulseEngine::new(MockTimer::default(), c);
     let mut more = Some(step(0, 1, us(2_000)));
-    run(&mut engine, &machine, 100, |_| {
+    run(&mut engine, pulses, 100, |_| {
         if let Some(cmd) = more.take() {
             queue(&mut p, &[cmd], true);
         }
@@ -384,7 +395,7 @@ fn steps_queued_behind_a_rest_before_the_timer_stops_go_on_from_rest() {
     let (mut p, c) = q.split();
     p.rest();
     let mut engine = PulseEngine::new(MockTimer::default(), c);
-    engine.kick(&machine);
+    engine.kick(pulses);
     assert!(!engine.is_running());
 }
 
@@ -393,7 +404,7 @@ fn an_interrupt_a_period_late_counts_the_repeated_pulse_and_stops_in_an_alarm() 
     let cmds = [step(1, 1, us(100)); 10];
     // Update events: 0 the start's hold (both axes' SIGN at once), 1 the first step, 2 the
     // second, 3 the third (its interrupt one period late).
-    let (timer, machine) = emit(Settings::default(), &cmds, &[3]);
+    let (timer, machine, trip) = emit(Settings::default(), &cmds, &[3]);
     // The timer repeated the step it had preloaded, pulse and all, then ran it once more and
     // stopped: two pulses more than the steps emitted by then.
     let pulses = timer.periods.iter().filter(|p| p.1 != 0).count();
@@ -401,7 +412,7 @@ fn an_interrupt_a_period_late_counts_the_repeated_pulse_and_stops_in_an_alarm() 
     assert_eq!(machine.position(), driven(&timer.periods, 0), "the position is the pulses the drivers took");
     assert_eq!(machine.missed_updates(), 1);
     assert!(machine.halted());
-    assert_eq!(machine.take_trip(), Some(Trip::MissedUpdate));
+    assert_eq!(trip, Some(Trip::MissedUpdate));
     assert!(!timer.running);
     assert_eq!(timer.halts, 1, "halted at the end of the repeat, between pulses");
     // Every pulse whole: the repeat ran to its end.
@@ -409,7 +420,7 @@ fn an_interrupt_a_period_late_counts_the_repeated_pulse_and_stops_in_an_alarm() 
     assert_eq!((last_ticks, last_axes), (us(100), 3));
 
     // Two periods late: two repeats and the one under way, all counted; one fault.
-    let (timer, machine) = emit(Settings::default(), &cmds, &[3, 4]);
+    let (timer, machine, _) = emit(Settings::default(), &cmds, &[3, 4]);
     let pulses = timer.periods.iter().filter(|p| p.1 != 0).count();
     assert_eq!(pulses, 5);
     assert_eq!(machine.position(), Point::new(5, 5));
@@ -423,9 +434,9 @@ fn a_late_interrupt_where_sign_was_to_change_counts_the_pulses_by_the_sign_they_
     let cmds = [step(1, 0, us(100)), step(1, 0, us(100)), step(-1, 0, us(100)), step(-1, 0, us(100))];
     // Update events: 0 the start's hold, 1 the first step, 2 the second, 3 the hold before the
     // reversal, 4 the reversed step (its interrupt late).
-    let (timer, machine) = emit(Settings::default(), &cmds, &[4]);
+    let (timer, machine, trip) = emit(Settings::default(), &cmds, &[4]);
     assert_eq!(machine.position(), driven(&timer.periods, 0));
     assert_eq!(machine.position(), Point::new(4, 0), "two forward steps and the late one twice, all forward");
     assert_eq!(machine.missed_updates(), 1);
-    assert_eq!(machine.take_trip(), Some(Trip::MissedUpdate));
+    assert_eq!(trip, Some(Trip::MissedUpdate));
 }

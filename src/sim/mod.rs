@@ -206,6 +206,7 @@ pub fn run(config: SimConfig) -> SimReport {
     let flash = config.flash.clone();
     let (mut store, loaded) = Store::open(config.flash, STORE_RANGE);
     let machine = Machine::new(store.kept().settings);
+    let Some(handles) = machine.handles() else { unreachable!("a new machine has its handles") };
     let panel = Panel::new();
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
@@ -239,15 +240,21 @@ pub fn run(config: SimConfig) -> SimReport {
 
     // The board's interrupts: the step timer, and the motion task on its interrupt executor.
     let interrupts = join(
-        step_timer::run(&machine, &mut engine, &kicks),
-        tasks::motion::run(&machine, &mut planner, steps, || kicks.signal(()), SimCpu::new(cpu.clone(), &machine)),
+        step_timer::run(handles.pulse, &mut engine, &kicks),
+        tasks::motion::run(
+            handles.motion,
+            &mut planner,
+            steps,
+            || kicks.signal(()),
+            SimCpu::new(cpu.clone(), &machine),
+        ),
     );
     // Thread mode: polled only while no work charged there takes it (see `cpu::ThreadLevel`).
     let thread = ThreadLevel::default();
     let threads = join5(
         tasks::keypad::run(&machine, &panel, columns, rows, SimSlices::new(cpu.clone(), &machine, &thread)),
         tasks::serial::run(
-            &machine,
+            handles.host,
             &mut store,
             loaded,
             (serial.clone(), serial.clone()),
@@ -256,14 +263,14 @@ pub fn run(config: SimConfig) -> SimReport {
         ),
         tasks::lcd::run(&machine, &panel, lcd),
         tasks::servo::run(
-            &machine,
+            handles.servo,
             son.clone(),
             || inputs.levels(),
             pen.clone(),
             [led.clone(), buzzer.clone()],
             || watchdog.feed(),
         ),
-        tasks::homing::run(&machine),
+        tasks::homing::run(handles.homing),
     );
     let (mut interrupts, mut threads) = (pin!(interrupts), pin!(threads));
     let (irq_flag, thread_flag) =

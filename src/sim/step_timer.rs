@@ -20,7 +20,7 @@ use embassy_time::{Instant, Timer};
 
 use crate::geom::{Axis, TICKS_PER_US};
 use crate::inputs::InputLevels;
-use crate::machine::Machine;
+use crate::machine::PulseWriter;
 use crate::pulse::{PulseEngine, StepTimer};
 use crate::sim::clock;
 use crate::sim::inputs::SimInputs;
@@ -148,8 +148,12 @@ async fn until(t_ticks: u64) {
 }
 
 /// Runs the timer forever: waits for the motion task's kick, then counts periods until the
-/// engine stops it.
-pub async fn run(machine: &Machine, engine: &mut PulseEngine<'_, SimStepTimer>, kicks: &Signal<NoopRawMutex, ()>) -> ! {
+/// engine stops it. The pulse interrupt's handle, `machine`, is its own.
+pub async fn run(
+    machine: PulseWriter<'_>,
+    engine: &mut PulseEngine<'_, SimStepTimer>,
+    kicks: &Signal<NoopRawMutex, ()>,
+) -> ! {
     loop {
         kicks.wait().await;
         engine.kick(machine);

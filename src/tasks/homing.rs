@@ -9,7 +9,7 @@ use crate::geom::{Axis, Point};
 use crate::homing::{HOMING_ORDER, HomingFail, Phase, homed_steps, homing_move, towards_max};
 use crate::inputs::{InputSetup, Trip};
 use crate::job::Job;
-use crate::machine::{Machine, MotionFault, PlanEnd};
+use crate::machine::{HomingWriter, MotionFault, PlanEnd};
 use crate::status::RunState;
 use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
 
@@ -17,7 +17,7 @@ use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
 pub const HOMING_POLL_MS: u64 = 5;
 
 /// Runs a homing cycle at each request, forever.
-pub async fn run(machine: &Machine) -> ! {
+pub async fn run(machine: HomingWriter<'_>) -> ! {
     loop {
         machine.homing_requested().await;
         // Whatever was queued before the request goes first.
@@ -34,8 +34,7 @@ pub async fn run(machine: &Machine) -> ! {
                 Err(None) => {}
                 Err(Some(fail)) => {
                     warn!("homing failed: {:?}", fail);
-                    machine.set_run_state(RunState::Alarm);
-                    machine.set_fault(Some(MotionFault::Homing(fail)));
+                    machine.fail(MotionFault::Homing(fail));
                 }
             }
         }
@@ -45,7 +44,7 @@ pub async fn run(machine: &Machine) -> ! {
 
 /// The cycle may go on: no trip raised an alarm (`Err(None)`: it said why), and the plan ends
 /// at `left`, where the cycle's last move left it: no abort came, nothing else was handed over.
-fn still_homing(machine: &Machine, left: PlanEnd) -> Result<(), Option<HomingFail>> {
+fn still_homing(machine: HomingWriter<'_>, left: PlanEnd) -> Result<(), Option<HomingFail>> {
     if machine.run_state() == RunState::Alarm || machine.halted() {
         return Err(None);
     }
@@ -56,7 +55,7 @@ fn still_homing(machine: &Machine, left: PlanEnd) -> Result<(), Option<HomingFai
 }
 
 /// Waits until nothing is queued, planned or moving.
-async fn until_stopped(machine: &Machine) {
+async fn until_stopped(machine: HomingWriter<'_>) {
     while !machine.stopped() {
         Timer::after(Duration::from_millis(HOMING_POLL_MS)).await;
     }
@@ -64,7 +63,7 @@ async fn until_stopped(machine: &Machine) {
 
 /// Every move of every axis, then machine zero; see [`crate::homing`]. `Err(None)` when a trip
 /// raised an alarm of its own.
-async fn cycle(machine: &Machine) -> Result<(), Option<HomingFail>> {
+async fn cycle(machine: HomingWriter<'_>) -> Result<(), Option<HomingFail>> {
     let settings = machine.settings();
     // A healthy cycle never aborts: any abort from here on, even between moves, is a reset or a
     // keypad D that stops it. Each move is planned from where the one before it left the plan.

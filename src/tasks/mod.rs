@@ -1,6 +1,12 @@
 //! The async loops of the firmware, generic over embedded-hal / embedded-io-async traits so the
 //! STM32 board and the simulated board run the same code. They wait, read, write and hand values
 //! to the core; they decide nothing. Boards wrap each in an `#[embassy_executor::task]`.
+//!
+//! A task that writes part of the shared machine runs on its writer's handle (the motion task
+//! on a [`MotionWriter`](crate::machine::MotionWriter), the host link on a
+//! [`HostWriter`](crate::machine::HostWriter), the servo and homing tasks on theirs), which
+//! reads the rest of the machine too; the keypad and the LCD, which only post requests and read,
+//! take the machine itself.
 
 pub mod homing;
 pub mod keypad;

@@ -26,7 +26,7 @@ use crate::geom::TICKS_PER_US;
 use crate::inputs::Trip;
 use crate::interp::Curve;
 use crate::job::{Control, Job, JobKind};
-use crate::machine::{Machine, STEP_QUEUE_MAX_TICKS};
+use crate::machine::{MotionWriter, STEP_QUEUE_MAX_TICKS};
 use crate::overrides::Overrides;
 use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner};
 use crate::pulse::{STEP_QUEUE_LEN, StepProducer};
@@ -101,7 +101,7 @@ impl WorkTime for RealTime {
 /// place: it is 50 KB). `steps` is the producer end of the step queue; `kick` wakes the pulse
 /// engine after steps were published; `work` lets the time of the work pass (see [`WorkTime`]).
 pub async fn run(
-    machine: &Machine,
+    machine: MotionWriter<'_>,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     mut steps: StepProducer<'_>,
     mut kick: impl FnMut(),
@@ -159,7 +159,11 @@ pub async fn run(
 }
 
 /// The overrides in force, handed to the planner when they differ from `had`, what it has.
-fn hand_over_overrides(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, had: Overrides) -> Overrides {
+fn hand_over_overrides(
+    machine: MotionWriter<'_>,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    had: Overrides,
+) -> Overrides {
     let now = machine.overrides();
     if now != had {
         // Acts on what is planned from the next run of steps on.
@@ -171,7 +175,7 @@ fn hand_over_overrides(machine: &Machine, planner: &mut Planner<Curve, PLANNER_S
 /// Takes jobs while the planner has room, the one held back first, and plans each as the
 /// supervisor says: moving the pen first, or holding the job back until the motion rests.
 fn take_jobs(
-    machine: &Machine,
+    machine: MotionWriter<'_>,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     supervisor: &mut Supervisor,
     held: &mut Option<Job>,
@@ -206,7 +210,7 @@ fn take_jobs(
 /// state to publish, and an alarm, which aborts everything (the host is told, see the serial
 /// task).
 fn carry_out(
-    machine: &Machine,
+    machine: MotionWriter<'_>,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     filled: Filled,
     queued_more: bool,
@@ -227,7 +231,7 @@ fn carry_out(
 
 /// Waits until half of what the pulse engine has not taken yet is emitted (it holds two steps:
 /// the one it emits and the one after), or for a control.
-async fn until_half_emitted(machine: &Machine, queued: &Queued) {
+async fn until_half_emitted(machine: MotionWriter<'_>, queued: &Queued) {
     let ahead = machine.queued_ticks().saturating_sub(2 * queued.last_interval_ticks);
     let wait_us = u64::from(ahead / 2 / TICKS_PER_US).max(MOTION_RETRY_US);
     select(Timer::after(Duration::from_micros(wait_us)), machine.control_requested()).await;
@@ -236,7 +240,12 @@ async fn until_half_emitted(machine: &Machine, queued: &Queued) {
 /// Everything planned is queued: waits until it has been emitted, then does what the
 /// supervisor says of the rest: takes the job `held` back, or moves the pen, publishes the run
 /// state and waits for work.
-async fn rest(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>, supervisor: &mut Supervisor, held: bool) {
+async fn rest(
+    machine: MotionWriter<'_>,
+    planner: &Planner<Curve, PLANNER_SEGMENTS>,
+    supervisor: &mut Supervisor,
+    held: bool,
+) {
     while !machine.pulses_idle() && !machine.halted() {
         machine.until_pulses_stopped().await;
     }
@@ -261,7 +270,7 @@ async fn rest(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>, sup
 }
 
 /// A hold stands: reports it, and waits for a control or a job.
-async fn stand_held(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>) {
+async fn stand_held(machine: MotionWriter<'_>, planner: &Planner<Curve, PLANNER_SEGMENTS>) {
     machine.set_run_state(RunState::Hold);
     wait_for_work(machine, planner).await;
 }
@@ -272,7 +281,7 @@ async fn stand_held(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS
 /// (motion is refused until `$X`), or hands a limit switch a homing approach ran into to the
 /// homing task.
 async fn halted(
-    machine: &Machine,
+    machine: MotionWriter<'_>,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     steps: &mut StepProducer<'_>,
     queued: &mut Queued,
@@ -307,7 +316,7 @@ async fn halted(
 /// [`STEP_QUEUE_MAX_TICKS`] of motion queued but never fewer than [`STEP_QUEUE_MIN_STEPS`]
 /// steps, and at most [`FILL_MAX_STEPS`], published [`PUBLISH_BATCH_STEPS`] at a time.
 async fn fill(
-    machine: &Machine,
+    machine: MotionWriter<'_>,
     planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
     steps: &mut StepProducer<'_>,
     queued: &mut Queued,
@@ -356,7 +365,7 @@ async fn fill(
 }
 
 /// Queues the curve of `job` in the planner.
-fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: Job, settings: &Settings) {
+fn plan(machine: MotionWriter<'_>, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: Job, settings: &Settings) {
     let end = job.drawing.end();
     info!("job planned to ({}, {}) steps", end.x, end.y);
     machine.set_drawing(job.drawing.kind());
@@ -377,7 +386,7 @@ fn plan(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, job: 
 }
 
 /// True when pulses may start from rest, as [`StartReady::ready`] says.
-fn ready_to_start(machine: &Machine) -> bool {
+fn ready_to_start(machine: MotionWriter<'_>) -> bool {
     // What this task planned is visible before it looks: see the servo task's going-off check.
     fence(Ordering::SeqCst);
     StartReady { halted: machine.halted(), servos_ready: machine.servos_ready(), pen_settled: machine.pen_settled() }
@@ -385,14 +394,14 @@ fn ready_to_start(machine: &Machine) -> bool {
 }
 
 /// Waits until [`ready_to_start`].
-async fn until_ready_to_start(machine: &Machine) {
+async fn until_ready_to_start(machine: MotionWriter<'_>) {
     while !ready_to_start(machine) {
         Timer::after(Duration::from_millis(SERVO_READY_POLL_MS)).await;
     }
 }
 
 /// Waits for a control, or for a job while the planner has room to take it.
-async fn wait_for_work(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGMENTS>) {
+async fn wait_for_work(machine: MotionWriter<'_>, planner: &Planner<Curve, PLANNER_SEGMENTS>) {
     if planner.is_full() {
         machine.control_requested().await;
     } else {
@@ -402,7 +411,12 @@ async fn wait_for_work(machine: &Machine, planner: &Planner<Curve, PLANNER_SEGME
     }
 }
 
-fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, control: Control, held: &mut Option<Job>) {
+fn apply(
+    machine: MotionWriter<'_>,
+    planner: &mut Planner<Curve, PLANNER_SEGMENTS>,
+    control: Control,
+    held: &mut Option<Job>,
+) {
     info!("control: {:?}", control);
     match control {
         Control::Hold => planner.hold(),
@@ -413,7 +427,7 @@ fn apply(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, cont
 
 /// Decelerates to a stop and drops everything planned, queued and `held` back, telling the
 /// inputs that positions planned so far are stale.
-fn abort(machine: &Machine, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, held: &mut Option<Job>) {
+fn abort(machine: MotionWriter<'_>, planner: &mut Planner<Curve, PLANNER_SEGMENTS>, held: &mut Option<Job>) {
     *held = None;
     planner.abort();
     machine.abort_plan();

@@ -67,7 +67,7 @@ use embedded_storage::nor_flash::NorFlash;
 use crate::drawing::BUILD_SLICE_STEPS;
 use crate::inputs::Trip;
 use crate::job::{Control, Job};
-use crate::machine::{Machine, MotionFault, PlanEnd, Stale};
+use crate::machine::{HostWriter, Machine, MotionFault, PlanEnd, Stale};
 use crate::overrides::Overrides;
 use crate::pen::{Pen, PenDepth};
 use crate::planner::PLANNER_SEGMENTS;
@@ -106,7 +106,7 @@ pub const SERIAL_IDLE_POLL_MS: u64 = 5;
 
 /// What the loops of every link share.
 struct Host<'m> {
-    machine: &'m Machine,
+    machine: HostWriter<'m>,
     /// When status reports carry `WCO:` and `Ov:`.
     refresh: RefCell<Refresh>,
     /// The startup blocks, run after every reset.
@@ -118,7 +118,7 @@ struct Host<'m> {
 /// keeping what a power cycle keeps in `store` (the board's, in static storage); `loaded` says
 /// whether power-on read it back. `between` is the pause between two slices of a build.
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
-    machine: &Machine,
+    machine: HostWriter<'_>,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
     first: (R1, W1),
@@ -261,7 +261,7 @@ impl Host<'_> {
 /// gives up when a reset comes on that link. One type, its poll out of line, serves every wait
 /// of the line loop for the machine.
 struct Until<'m> {
-    machine: &'m Machine,
+    machine: HostWriter<'m>,
     /// The link whose line waits: a reset there ends the wait with [`Unfinished::Reset`].
     line_of: Option<&'m Link>,
     done: fn(&Machine) -> bool,
@@ -295,7 +295,7 @@ impl Future for Until<'_> {
                 }
                 self.timer = None;
             }
-            let wait_ms = if !(self.done)(self.machine) {
+            let wait_ms = if !(self.done)(&self.machine) {
                 SERIAL_IDLE_POLL_MS
             } else if let Some((pen, depth)) = self.then_pen.take() {
                 self.machine.set_pen_depth(depth);

@@ -5,7 +5,8 @@
 //! off while the machine sleeps (`$SLP`) until a reset, after a driver alarm until `$X`, and,
 //! unless `$1` is 255, once the machine has stood still for `$1` ms. SON comes back on as soon
 //! as there is motion to make, and the machine counts the servos ready `$209` ms later: the
-//! motion task starts no pulse before (see [`Machine::servos_ready`]).
+//! motion task starts no pulse before (see
+//! [`Machine::servos_ready`](crate::machine::Machine::servos_ready)).
 //!
 //! It drives the pen servo's PWM to where the machine wants the pen (when `$213` names a pen
 //! lift) and tells the machine once it has had its settle time (`$212`).
@@ -24,7 +25,7 @@ use embedded_hal::pwm::SetDutyCycle;
 
 use crate::geom::TICKS_PER_US;
 use crate::inputs::{Debounce, InputLevels, InputSetup};
-use crate::machine::Machine;
+use crate::machine::ServoWriter;
 use crate::pen::{PEN_SERVO_PERIOD_US, PenServo};
 use crate::settings::Settings;
 use crate::signals::Signals;
@@ -40,7 +41,7 @@ pub const SERVO_ENABLE_POLL_MS: u64 = 10;
 /// `pen` (the pen servo's 50 Hz PWM) and `lights` (the run LED and the buzzer, active high), and
 /// calls `feed` (the watchdog's) while the machine makes progress.
 pub async fn run<P: OutputPin>(
-    machine: &Machine,
+    machine: ServoWriter<'_>,
     mut son: P,
     mut levels: impl FnMut() -> InputLevels,
     mut pen: impl SetDutyCycle,
@@ -80,7 +81,7 @@ pub async fn run<P: OutputPin>(
         if settled {
             machine.set_pen_settled(order);
         }
-        let healthy = progress.healthy(ms, Look::of(machine));
+        let healthy = progress.healthy(ms, Look::of(&machine));
         if healthy {
             feed();
         } else if !stalled {
@@ -93,7 +94,7 @@ pub async fn run<P: OutputPin>(
 
 /// Publishes the input levels `now` and trips the machine when a driver alarm or the e-stop has
 /// stayed active for the debounce time.
-fn watch_inputs(machine: &Machine, now: InputLevels, settings: &Settings, debounce: &mut Debounce) {
+fn watch_inputs(machine: ServoWriter<'_>, now: InputLevels, settings: &Settings, debounce: &mut Debounce) {
     machine.set_input_levels(now);
     let setup = InputSetup::from_settings(settings);
     let active = setup.stops_active(now);
@@ -107,7 +108,7 @@ fn watch_inputs(machine: &Machine, now: InputLevels, settings: &Settings, deboun
 
 /// Whether SON is to be high at `ms`, and the drivers' readiness published: on while the machine
 /// wants the servos on, off after standing still for `$1` ms.
-fn servos_on(machine: &Machine, ms: u32, settings: &Settings, enable: &mut ServoEnable) -> bool {
+fn servos_on(machine: ServoWriter<'_>, ms: u32, settings: &Settings, enable: &mut ServoEnable) -> bool {
     let mut idle_off = enable.idle_off(ms, machine.at_standstill(), settings);
     if idle_off && enable.is_on() {
         // Going off for standing still: first no longer ready, then still standing still?
@@ -126,6 +127,7 @@ fn servos_on(machine: &Machine, ms: u32, settings: &Settings, enable: &mut Servo
 mod tests {
     extern crate std;
     use super::*;
+    use crate::machine::Machine;
     use crate::settings::Settings;
     use crate::status::RunState;
     use core::cell::Cell;
@@ -156,10 +158,17 @@ mod tests {
     fn son_is_low_while_the_machine_sleeps_and_a_reset_wakes_it_in_alarm() {
         crate::sim::clock::reset();
         let machine = Machine::new(Settings::default());
+        let handles = machine.handles().unwrap();
         let son = Cell::new(false);
         let led = Cell::new(false);
-        let mut task =
-            pin!(run(&machine, Pin(&son), || 0, crate::sim::pins::SimPen::default(), [Pin(&led), Pin(&led)], || {}));
+        let mut task = pin!(run(
+            handles.servo,
+            Pin(&son),
+            || 0,
+            crate::sim::pins::SimPen::default(),
+            [Pin(&led), Pin(&led)],
+            || {}
+        ));
         let mut cx = Context::from_waker(Waker::noop());
         let mut step = || {
             let _ = task.as_mut().poll(&mut cx);
@@ -167,11 +176,11 @@ mod tests {
         };
         step();
         assert!(son.get(), "the servos hold position from power-on");
-        machine.sleep();
+        handles.host.sleep();
         assert_eq!(machine.state(), RunState::Sleep);
         step();
         assert!(!son.get(), "asleep, the servos are off");
-        machine.wake();
+        handles.host.wake();
         step();
         assert!(son.get());
         assert_eq!(machine.state(), RunState::Alarm, "the axes were free: the position is in doubt");

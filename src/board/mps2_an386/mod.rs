@@ -32,7 +32,7 @@ use defmt_semihosting as _;
 use embassy_executor::{SendSpawner, Spawner};
 use embassy_time::Delay;
 use servoplot::inputs::InputLevels;
-use servoplot::machine::Machine;
+use servoplot::machine::PulseWriter;
 use servoplot::pulse::StepConsumer;
 use servoplot::tasks::lcd::St7920Lcd;
 use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
@@ -124,7 +124,7 @@ pub fn init(_spawner: Spawner) -> Board {
 }
 
 /// Hands the pulse engine to the step timer's interrupt, at the pulse priority.
-pub fn start_pulses(timer: ModelStepTimer, steps: StepConsumer<'static>, machine: &'static Machine) {
+pub fn start_pulses(timer: ModelStepTimer, steps: StepConsumer<'static>, machine: PulseWriter<'static>) {
     step_timer::start(timer, steps, machine, priority::PULSE, priority::PULSE_NEWS);
 }
 

@@ -17,7 +17,7 @@ use core::sync::atomic::{AtomicBool, AtomicPtr, AtomicU32, Ordering};
 use cortex_m::peripheral::NVIC;
 use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
 use servoplot::inputs::{InputLevels, LIMITS};
-use servoplot::machine::Machine;
+use servoplot::machine::{Machine, PulseWriter};
 use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
 
 use super::clock::CLOCKS_PER_US;
@@ -119,11 +119,11 @@ impl StepTimer for ModelStepTimer {
     }
 }
 
-/// The engine and the machine it counts for, owned by the interrupt once [`start`] has put them
-/// in the slot.
+/// The engine and the pulse interrupt's handle to the machine it counts for, owned by the
+/// interrupt once [`start`] has put them in the slot.
 struct Pulses {
     engine: PulseEngine<'static, ModelStepTimer>,
-    machine: &'static Machine,
+    machine: PulseWriter<'static>,
 }
 
 struct Slot {
@@ -137,7 +137,8 @@ unsafe impl Sync for Slot {}
 
 static SLOT: Slot = Slot { filled: AtomicBool::new(false), pulses: UnsafeCell::new(None) };
 
-/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`]. It only
+/// hands the news on, which needs no writer's handle (the engine's handle stays the engine's).
 static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(core::ptr::null_mut());
 
 /// Hands the engine to timer 1's interrupt, at `priority`, and enables the news interrupt at
@@ -145,14 +146,14 @@ static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(core::ptr::null_mut());
 pub fn start(
     timer: ModelStepTimer,
     steps: StepConsumer<'static>,
-    machine: &'static Machine,
+    machine: PulseWriter<'static>,
     priority: u8,
     news_priority: u8,
 ) {
     if SLOT.filled.load(Ordering::Acquire) {
         return;
     }
-    NEWS_FOR.store(core::ptr::from_ref(machine).cast_mut(), Ordering::Release);
+    NEWS_FOR.store(core::ptr::from_ref(machine.machine()).cast_mut(), Ordering::Release);
     // SAFETY: the priority is set before the line is unmasked; the handler only reads NEWS_FOR.
     unsafe {
         let mut core = cortex_m::Peripherals::steal();

@@ -57,7 +57,7 @@ use embassy_time::Delay;
 use embedded_hal::delay::DelayNs;
 use embedded_hal_bus::spi::ExclusiveDevice;
 use servoplot::inputs::InputLevels;
-use servoplot::machine::Machine;
+use servoplot::machine::PulseWriter;
 use servoplot::pulse::StepConsumer;
 use servoplot::tasks::lcd::St7920Lcd;
 use static_cell::StaticCell;
@@ -294,7 +294,7 @@ pub fn init(spawner: Spawner) -> Board {
 }
 
 /// Hands the pulse engine to the step timer's interrupt, at the pulse priority.
-pub fn start_pulses(timer: Tim1StepTimer, steps: StepConsumer<'static>, machine: &'static Machine) {
+pub fn start_pulses(timer: Tim1StepTimer, steps: StepConsumer<'static>, machine: PulseWriter<'static>) {
     step_timer::start(timer, steps, machine, Priority::from(priority::PULSE), Priority::from(priority::PULSE_NEWS));
 }
 

@@ -23,7 +23,7 @@ use static_cell::StaticCell;
 use super::inputs::InputPins;
 use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
 use servoplot::inputs::InputLevels;
-use servoplot::machine::Machine;
+use servoplot::machine::{Machine, PulseWriter};
 use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
 
 /// The channels driving X and Y PULS.
@@ -150,10 +150,10 @@ impl StepTimer for Tim1StepTimer {
     }
 }
 
-/// The engine and the machine it counts for.
+/// The engine and the pulse interrupt's handle to the machine it counts for.
 struct Pulses {
     engine: PulseEngine<'static, Tim1StepTimer>,
-    machine: &'static Machine,
+    machine: PulseWriter<'static>,
 }
 
 /// Where [`start`] builds the engine, once.
@@ -164,7 +164,8 @@ static PULSES_CELL: StaticCell<Pulses> = StaticCell::new();
 /// nest in itself), so it takes no lock and masks nothing.
 static PULSES: AtomicPtr<Pulses> = AtomicPtr::new(null_mut());
 
-/// The machine the engine's news is for, for the news interrupt: set once by [`start`].
+/// The machine the engine's news is for, for the news interrupt: set once by [`start`]. It only
+/// hands the news on, which needs no writer's handle (the engine's handle stays the engine's).
 static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(null_mut());
 
 /// Hands the engine to the interrupt and enables it at `priority`, and the news interrupt
@@ -172,11 +173,11 @@ static NEWS_FOR: AtomicPtr<Machine> = AtomicPtr::new(null_mut());
 pub fn start(
     timer: Tim1StepTimer,
     steps: StepConsumer<'static>,
-    machine: &'static Machine,
+    machine: PulseWriter<'static>,
     priority: interrupt::Priority,
     news_priority: interrupt::Priority,
 ) {
-    NEWS_FOR.store(core::ptr::from_ref(machine).cast_mut(), Ordering::Release);
+    NEWS_FOR.store(core::ptr::from_ref(machine.machine()).cast_mut(), Ordering::Release);
     interrupt::TIM7.set_priority(news_priority);
     interrupt::TIM7.unpend();
     // SAFETY: the handler below only reads NEWS_FOR, set just above.
