@@ -22,7 +22,7 @@ const IMAGES: [(&str, &str); 2] =
     [("servoplot", "src/board/stm32f407/memory.x"), ("servoplot-mps2-an386", "src/board/mps2_an386/memory.x")];
 
 /// The LCD's texts, `name | English | 中文` a line.
-const TEXTS: &str = "src/ui/texts.txt";
+const TEXTS: &str = "src/panel/texts.txt";
 /// The first of the characters that stand for Chinese glyphs on the screen's lines: the k-th
 /// glyph is `HANZI_FIRST + k`, two bytes in UTF-8 up to U+07FF, as it is two columns wide on the
 /// screen.
@@ -280,7 +280,7 @@ fn write_texts(out: &Path) {
     };
 
     let mut src = String::from(
-        "/// A text of the LCD, in either language: see `src/ui/texts.txt`.\n\
+        "/// A text of the LCD, in either language: see `src/panel/texts.txt`.\n\
          #[derive(Clone, Copy, Debug, PartialEq, Eq)]\n\
          #[cfg_attr(target_os = \"none\", derive(defmt::Format))]\n\
          pub enum Msg {\n",

@@ -29,12 +29,12 @@ mod rates;
 use std::hint::black_box;
 use std::time::Instant;
 
-use servoplot::expr;
 use servoplot::geom::{Point, Rotation, TICK_HZ};
-use servoplot::interp::{Curve, Interpolator, Method, Shape};
-use servoplot::job::Feed;
+use servoplot::motion::expr;
+use servoplot::motion::interp::{Curve, Interpolator, Method, Shape};
+use servoplot::motion::job::Feed;
 
-use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner, plot_time_lower_bound};
+use servoplot::motion::planner::{Limits, PLANNER_SEGMENTS, Planner, plot_time_lower_bound};
 use servoplot::settings::Settings;
 
 /// Feed of every drawing in the benchmark, mm/min (the default `$203`).
@@ -210,7 +210,7 @@ fn build(case: &CurveCase, method: Method) -> Result<Curve, String> {
 
 /// Where the builder says the curve ends: its last lattice point.
 fn built_end(case: &CurveCase, method: Method) -> Result<Point, String> {
-    let drawing = servoplot::drawing::from_shape((case.shape)(), Point::ORIGIN, &settings_for(method));
+    let drawing = servoplot::motion::drawing::from_shape((case.shape)(), Point::ORIGIN, &settings_for(method));
     drawing.map(|d| d.end()).map_err(|e| format!("{e:?}"))
 }
 

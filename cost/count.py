@@ -307,7 +307,7 @@ BUILD_KINDS = {
     "sine": ["b-sine-flat", "b-sine", "b-sine-steep"],
     "function": ["b-fn3", "b-fn6", "b-fn9", "b-fn-steep", "b-fn18", "b-fn30"],
 }
-# The front ends' slice (src/drawing/builder.rs, BUILD_SLICE_STEPS), and the longest a slice may
+# The front ends' slice (src/motion/drawing/builder.rs, BUILD_SLICE_STEPS), and the longest a slice may
 # take on the board.
 BUILD_SLICE_STEPS = 1536
 BUILD_SLICE_BUDGET_MS = 2.0

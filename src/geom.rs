@@ -80,7 +80,7 @@ impl Step {
 
     /// The axes the step moves and which way, as bits: bit 0 X backward, bit 1 Y backward, bit 2
     /// X forward, bit 3 Y forward (the order of the limit switches it runs towards, see
-    /// `crate::inputs`). A table lookup: a move of -1, 0 or +1 has the low bits 11, 00 or 01.
+    /// `crate::machine_io::inputs`). A table lookup: a move of -1, 0 or +1 has the low bits 11, 00 or 01.
     pub const fn directions(self) -> u8 {
         const BITS: [u8; 16] = {
             let mut bits = [0; 16];

@@ -108,9 +108,9 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
 use crate::geom::{Point, TICK_HZ};
-use crate::inputs::Trip;
-use crate::job::{Control, Job};
-use crate::pen::{Pen, PenOrder};
+use crate::machine_io::inputs::Trip;
+use crate::machine_io::pen::{Pen, PenOrder};
+use crate::motion::job::{Control, Job};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
@@ -343,7 +343,7 @@ impl Machine {
         PenOrder::from_bits(self.pen.load(Ordering::Acquire))
     }
 
-    /// An input tripped (see [`crate::inputs`]): the pulse engine stops at its next period if it
+    /// An input tripped (see [`crate::machine_io::inputs`]): the pulse engine stops at its next period if it
     /// has not stopped itself already, and starts nothing until `$X`; the motion task drops
     /// what was planned and raises the alarm. A trip while halted is no news. A request anyone
     /// may post (the servo task's inputs; the pulse interrupt has its own,

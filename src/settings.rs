@@ -7,8 +7,8 @@
 
 pub mod presets;
 
-use crate::language::Language;
-use crate::method::Method;
+use crate::motion::method::Method;
+use crate::panel::language::Language;
 use crate::unit::Unit;
 
 /// Why a setting was not changed.
@@ -25,7 +25,7 @@ pub enum SettingError {
 }
 
 /// Identifies one setting: its `$` number, its unit and its range. Its name on the LCD is the
-/// UI's ([`crate::ui::texts::SETTING_NAMES`]).
+/// UI's ([`crate::panel::texts::SETTING_NAMES`]).
 #[derive(Clone, Copy, Debug)]
 pub struct SettingInfo {
     pub id: u16,
@@ -80,7 +80,7 @@ enum Field<'a> {
 }
 
 /// Every setting, in `$$` listing order. On/off settings are 0 or 1. Their names are the
-/// `Setting<id>` lines of `src/ui/texts.txt`.
+/// `Setting<id>` lines of `src/panel/texts.txt`.
 pub const SETTING_INFO: &[SettingInfo] = &[
     SettingInfo { id: 0, unit: Unit::Us, min: 2.5, max: 100.0 },
     // 255 always on
@@ -243,7 +243,7 @@ pub struct Settings {
     pub pen_down_us: u32,
     /// How long the pen takes to get where it was sent: no pulse goes out before ($212).
     pub pen_settle_ms: u32,
-    /// How the pen is lifted, see [`crate::pen::PenLift`] ($213).
+    /// How the pen is lifted, see [`crate::machine_io::pen::PenLift`] ($213).
     pub pen_lift: u8,
     /// The run LED lights while a drawing runs ($214).
     pub run_led: bool,

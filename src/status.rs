@@ -2,10 +2,10 @@
 //! reports and the menu see it.
 
 use crate::geom::Point;
-use crate::homing::HomingFail;
-use crate::inputs::Trip;
-use crate::interp::CurveError;
-use crate::overrides::Overrides;
+use crate::machine_io::homing::HomingFail;
+use crate::machine_io::inputs::Trip;
+use crate::motion::interp::CurveError;
+use crate::motion::overrides::Overrides;
 
 /// The machine's run state, named as GRBL reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -43,7 +43,7 @@ impl RunState {
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub enum MotionFault {
     /// The curve ended part way: the travel guard stopped it at the edge (see
-    /// [`crate::interp::Curve`]).
+    /// [`crate::motion::interp::Curve`]).
     Curve(CurveError),
     /// An input stopped the machine at once: a limit switch, a driver alarm, the emergency stop.
     Tripped(Trip),

@@ -38,8 +38,8 @@ use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
 
-use crate::protocol::gcode::Offsets;
-use crate::protocol::startup::StartupLines;
+use crate::host::gcode::Offsets;
+use crate::host::startup::StartupLines;
 use crate::settings::Settings;
 
 pub use record::{BadRecord, LAYOUT_TAG, RECORD_MAX_BYTES, Record};

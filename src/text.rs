@@ -17,7 +17,7 @@ impl Display for Text<'_> {
 
 /// A string fitted to `width` bytes: cut if longer (before the character that would not fit
 /// whole), filled with spaces if shorter, on the right (`right: false`) or on the left. On the
-/// LCD a byte is a column (see `ui::texts`).
+/// LCD a byte is a column (see `panel::texts`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Padded<'a> {
     pub text: &'a str,

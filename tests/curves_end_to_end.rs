@@ -2,7 +2,7 @@
 //! the G-code parser planned it, stays on the ideal curve, and closed curves close.
 
 use servoplot::geom::Point;
-use servoplot::protocol::{Command, GcodeState};
+use servoplot::host::{Command, GcodeState};
 use servoplot::settings::Settings;
 use servoplot::sim;
 use servoplot::status::RunState;

@@ -4,13 +4,13 @@
 //! misses draw. The keypad's function mode shows the same refusal on the LCD.
 
 use servoplot::geom::Point;
-use servoplot::keypad::Key;
-use servoplot::protocol::{Command, GcodeState};
+use servoplot::host::{Command, GcodeState};
+use servoplot::panel::FunctionPreset;
+use servoplot::panel::expr_entry::{EXPR_TOKENS, ExprEntry};
+use servoplot::panel::keypad::Key;
 use servoplot::settings::Settings;
 use servoplot::sim;
 use servoplot::status::RunState;
-use servoplot::ui::FunctionPreset;
-use servoplot::ui::expr_entry::{EXPR_TOKENS, ExprEntry};
 
 mod support;
 

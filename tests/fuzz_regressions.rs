@@ -1,8 +1,8 @@
 //! Inputs the fuzz targets (`fuzz/`) found faults with, each kept as a test of what a user sees:
 //! a clear error, and nothing changed: no motion planned, no position lost.
 
-use servoplot::protocol::GrblError;
-use servoplot::protocol::gcode::GcodeState;
+use servoplot::host::GrblError;
+use servoplot::host::gcode::GcodeState;
 use servoplot::settings::Settings;
 use servoplot::status::RunState;
 

@@ -154,8 +154,8 @@ fn the_keypad_homes_too_and_d_aborts_it() {
 
 #[test]
 fn the_position_is_unknown_from_power_on_with_homing_on_and_after_a_hard_limit_until_homed() {
-    use servoplot::inputs::Trip;
     use servoplot::machine::Machine;
+    use servoplot::machine_io::inputs::Trip;
     use servoplot::settings::Settings;
     let machine = Machine::new(Settings { homing: true, ..Settings::default() });
     assert!(machine.status().position_lost, "powered on, not homed");

@@ -3,7 +3,7 @@
 //! them across a power cycle, and a change that clashes with the other settings changes nothing
 //! and says why. The splash greets in the language kept.
 
-use servoplot::language::Language;
+use servoplot::panel::language::Language;
 use servoplot::settings::presets::SpeedPreset;
 use servoplot::settings::{SETTING_INFO, Settings};
 use servoplot::sim::flash::SimFlash;

@@ -3,8 +3,8 @@
 
 use embedded_graphics::prelude::{Point as Px, Size};
 use embedded_graphics::primitives::Rectangle;
+use servoplot::panel::trail::{self, Trail};
 use servoplot::sim::{self, lcd::Frame};
-use servoplot::ui::trail::{self, Trail};
 
 mod support;
 

@@ -8,13 +8,13 @@
 use core::pin::pin;
 use core::task::{Context, Poll, Waker};
 
-use servoplot::drawing::{self, Request};
 use servoplot::geom::{Point, TICKS_PER_US};
-use servoplot::interp::Curve;
-use servoplot::job::{Feed, Job};
 use servoplot::machine::{Machine, MotionFault, Refused};
-use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
-use servoplot::pulse::StepQueue;
+use servoplot::motion::drawing::{self, Request};
+use servoplot::motion::interp::Curve;
+use servoplot::motion::job::{Feed, Job};
+use servoplot::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use servoplot::motion::pulse::StepQueue;
 use servoplot::settings::Settings;
 use servoplot::sim::clock;
 use servoplot::status::RunState;
@@ -80,7 +80,7 @@ fn a_curve_stopped_by_the_travel_guard_raises_an_alarm_and_drops_the_queue() {
     }
     let edge = (50.0 * loose.steps_per_mm[0]) as i32;
     assert_eq!(machine.run_state(), RunState::Alarm);
-    assert_eq!(machine.fault(), Some(MotionFault::Curve(servoplot::interp::CurveError::Travel)));
+    assert_eq!(machine.fault(), Some(MotionFault::Curve(servoplot::motion::interp::CurveError::Travel)));
     assert_eq!(machine.position(), Point::new(edge, 0), "stopped at the edge");
     assert!(path.iter().all(|p| p.x <= edge), "a step outside the travel");
     assert_eq!(machine.queued_jobs(), 0, "the job queued behind it was dropped");

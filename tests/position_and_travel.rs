@@ -13,8 +13,8 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 use servoplot::decimal::{Syntax, parse_prefix};
 use servoplot::geom::Point;
+use servoplot::panel::FunctionPreset;
 use servoplot::sim::{self, SimConfig, SimReport, serial::SimSerial};
-use servoplot::ui::FunctionPreset;
 
 // ----- helpers ------------------------------------------------------------------------------
 

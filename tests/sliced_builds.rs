@@ -2,15 +2,15 @@
 //! (`--cpu f407`): a drawing whose walk takes seconds of the board's time is built while the
 //! watchdog is fed, status reports are answered and keys are read, and a reset abandons it.
 
-use servoplot::drawing::{self, Request};
 use servoplot::geom::Point;
-use servoplot::interp::Interpolator;
+use servoplot::machine_io::watchdog::WATCHDOG_TIMEOUT_MS;
+use servoplot::motion::drawing::{self, Request};
+use servoplot::motion::interp::Interpolator;
 use servoplot::settings::Settings;
 use servoplot::sim::cpu::CpuModel;
 use servoplot::sim::keys::KeyScript;
 use servoplot::sim::serial::SimSerial;
 use servoplot::sim::{self, KeysStart, SimConfig, SimReport};
-use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
 
 mod support;
 
@@ -88,7 +88,7 @@ fn a_function_built_for_seconds_keeps_the_link_and_the_watchdog_alive_then_is_dr
     let at_start = path.iter().position(|p| *p == start).expect("the pen reached X -199 mm");
     let drawn = &path[at_start..];
     assert!(drawn.len() > 10_000, "{} steps drawn", drawn.len());
-    let expr = servoplot::expr::parse("sin((x+199)/0.4)*190").unwrap();
+    let expr = servoplot::motion::expr::parse("sin((x+199)/0.4)*190").unwrap();
     let request = Request::Function { expr, x0_mm: -199.0, x1_mm: 199.0 };
     let drawing = drawing::build(&request, start, &settings_200()).unwrap().unwrap();
     let mut curve = drawing.into_curve();

@@ -2,9 +2,9 @@
 //! or at a crawl, holding, homing, standing still), the servo task feeds the watchdog well within
 //! its timeout, so the board is never reset under a healthy machine.
 
+use servoplot::machine_io::watchdog::WATCHDOG_TIMEOUT_MS;
 use servoplot::sim::inputs::{InputScript, Switches};
 use servoplot::sim::{self, SimConfig, serial::SimSerial};
-use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
 
 #[test]
 fn a_healthy_machine_always_feeds_the_watchdog() {

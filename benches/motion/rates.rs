@@ -3,7 +3,7 @@
 //! instructions counted on a Cortex-M4F), at rates from slow to fast, and keeps the last rate
 //! at which the pulses never had to wait for the motion task (0 step-queue underruns).
 
-use servoplot::interp::Method;
+use servoplot::motion::interp::Method;
 use servoplot::settings::Settings;
 use servoplot::sim::cpu::CpuModel;
 use servoplot::sim::serial::SimSerial;

@@ -8,10 +8,10 @@
 //! expression's size (`walked ...`).
 
 use cortex_m_semihosting::hprintln;
-use servoplot::drawing::{BUILD_SLICE_STEPS, Builder, EllipseParams, Request, SineParams};
 use servoplot::geom::Point;
-use servoplot::interp::{Method, Shape};
-use servoplot::job::Job;
+use servoplot::motion::drawing::{BUILD_SLICE_STEPS, Builder, EllipseParams, Request, SineParams};
+use servoplot::motion::interp::{Method, Shape};
+use servoplot::motion::job::Job;
 use servoplot::settings::Settings;
 
 use crate::{FEED, cost_mark, method_name, report, task};
@@ -21,7 +21,7 @@ use crate::{FEED, cost_mark, method_name, report, task};
 const HEAVY: &str = "x/8+.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5+.5^.5^.5^.5^.5^.5^.5^.5^.5^.5^.5";
 
 fn function(src: &str, x0_mm: f32, x1_mm: f32) -> Request {
-    match servoplot::expr::parse(src) {
+    match servoplot::motion::expr::parse(src) {
         Ok(expr) => Request::Function { expr, x0_mm, x1_mm },
         Err(_) => panic!("expression"),
     }
@@ -93,7 +93,7 @@ fn walk(name: &str, method: Method, mut b: Builder) -> (u64, u8) {
 
 /// One slice, as the front ends walk it.
 #[inline(never)]
-fn advance(b: &mut Builder) -> servoplot::drawing::Slice {
+fn advance(b: &mut Builder) -> servoplot::motion::drawing::Slice {
     b.advance(BUILD_SLICE_STEPS)
 }
 
@@ -117,7 +117,7 @@ pub fn runs(only: &str) {
         }
         for method in [Method::Classic, Method::Diagonal] {
             let settings = Settings { method, ..Settings::default() };
-            let drawing = match servoplot::drawing::build(&request, Point::ORIGIN, &settings) {
+            let drawing = match servoplot::motion::drawing::build(&request, Point::ORIGIN, &settings) {
                 Ok(Some(d)) => d,
                 _ => panic!("motion case refused"),
             };

@@ -13,10 +13,10 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use defmt_rtt as _;
 use servoplot::geom::Point;
-use servoplot::interp::{Curve, Interpolator, Method, Shape};
-use servoplot::job::{Feed, Job};
+use servoplot::motion::interp::{Curve, Interpolator, Method, Shape};
+use servoplot::motion::job::{Feed, Job};
 
-use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use servoplot::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::settings::Settings;
 
 /// Where the runner's plugin snapshots the instruction counter: called between measured pieces.
@@ -51,10 +51,10 @@ const INTERP_BATCH_STEPS: usize = 16;
 
 /// Steps per `fill` call when the planner runs alone: half the step queue, as the motion task
 /// takes them.
-const PLANNER_BATCH_STEPS: usize = servoplot::pulse::STEP_QUEUE_LEN / 2;
+const PLANNER_BATCH_STEPS: usize = servoplot::motion::pulse::STEP_QUEUE_LEN / 2;
 
 pub fn cases() -> [(&'static str, Shape); 10] {
-    let f = |src: &str| match servoplot::expr::parse(src) {
+    let f = |src: &str| match servoplot::motion::expr::parse(src) {
         Ok(e) => e,
         Err(_) => panic!("expression"),
     };
@@ -180,7 +180,7 @@ fn main() -> ! {
             let n = with_planner(c, method, limits);
             cost_mark();
             report("planner", name, method, n);
-            let drawing = match servoplot::drawing::from_shape(shape.clone(), Point::ORIGIN, &settings) {
+            let drawing = match servoplot::motion::drawing::from_shape(shape.clone(), Point::ORIGIN, &settings) {
                 Ok(d) => d,
                 Err(_) => panic!("drawing refused"),
             };

@@ -10,9 +10,9 @@ use core::ptr::{addr_of, addr_of_mut, null_mut, read_volatile, write_volatile};
 use core::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
 
 use servoplot::geom::{Axis, StepCmd, TICKS_PER_US};
-use servoplot::inputs::InputLevels;
 use servoplot::machine::{Machine, PulseWriter};
-use servoplot::pulse::{PulseEngine, StepQueue, StepTimer};
+use servoplot::machine_io::inputs::InputLevels;
+use servoplot::motion::pulse::{PulseEngine, StepQueue, StepTimer};
 use servoplot::settings::Settings;
 
 use crate::{cost_mark, report_steps};

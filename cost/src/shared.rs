@@ -14,13 +14,13 @@ use core::pin::pin;
 use core::task::{Context, Poll};
 
 use servoplot::geom::Point;
-use servoplot::interp::Shape;
-use servoplot::job::{Control, Feed, Job};
-use servoplot::keypad::{Key, KeyEvent};
 use servoplot::machine::{Machine, PlanEnd};
+use servoplot::motion::interp::Shape;
+use servoplot::motion::job::{Control, Feed, Job};
+use servoplot::panel::keypad::{Key, KeyEvent};
+use servoplot::panel::screen::{self, Live};
 use servoplot::settings::Settings;
 use servoplot::tasks::panel::Panel;
-use servoplot::ui::screen::{self, Live};
 
 /// Times each operation runs: enough to reach every branch the state can take (an empty and a
 /// full job queue, a menu on several screens).
@@ -37,7 +37,11 @@ pub fn run() {
     let (motion, host) = (handles.motion, handles.host);
     let panel = Panel::new();
     // A line out and the line back: each starts where the other ends.
-    let line = |from: Point, to: Point| match servoplot::drawing::from_shape(Shape::Straight { to }, from, &settings) {
+    let line = |from: Point, to: Point| match servoplot::motion::drawing::from_shape(
+        Shape::Straight { to },
+        from,
+        &settings,
+    ) {
         Ok(drawing) => Job::draw(drawing, Feed::MmPerMin(1_000.0)),
         Err(_) => panic!("drawing refused"),
     };

@@ -12,14 +12,14 @@ use core::pin::pin;
 use core::task::{Context, Poll, RawWaker, RawWakerVTable, Waker};
 
 use critical_section::Mutex;
-use servoplot::interp::Curve;
-use servoplot::job::Job;
+use servoplot::motion::interp::Curve;
+use servoplot::motion::job::Job;
 
 /// Step ticks a microsecond of the clock.
 const TICKS_PER_US: u64 = servoplot::geom::TICKS_PER_US as u64;
 use servoplot::machine::Machine;
-use servoplot::planner::{Limits, PLANNER_SEGMENTS, Planner};
-use servoplot::pulse::StepQueue;
+use servoplot::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use servoplot::motion::pulse::StepQueue;
 use servoplot::settings::Settings;
 use servoplot::status::RunState;
 

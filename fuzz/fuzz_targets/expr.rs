@@ -9,7 +9,9 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use servoplot::expr::{self, EXPR_MAX_MAGNITUDE, EXPR_MAX_OPS, EvalError, Expr, MAX_EXPR_LEN_CHARS, ParseErrorKind};
+use servoplot::motion::expr::{
+    self, EXPR_MAX_MAGNITUDE, EXPR_MAX_OPS, EvalError, Expr, MAX_EXPR_LEN_CHARS, ParseErrorKind,
+};
 
 /// x values every expression is evaluated at (millimetres on the curve), besides the input's own.
 const XS: [f32; 7] = [0.0, 1.0, -1.0, 0.5, 3.25, 100.0, -250.0];

@@ -8,7 +8,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use servoplot::protocol::framing::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
+use servoplot::host::framing::{LINE_MAX_BYTES, LineAssembler, LineEvent, Realtime, realtime};
 
 /// A line event, owned, to compare runs.
 #[derive(Debug, PartialEq)]

@@ -20,11 +20,11 @@
 
 use libfuzzer_sys::fuzz_target;
 use servoplot::geom::Point;
-use servoplot::protocol::GrblError;
-use servoplot::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
-use servoplot::protocol::gcode::{Command, GcodeState, Pending, Report};
-use servoplot::protocol::report::{REPORT_LINE_MAX_BYTES, Reply};
-use servoplot::protocol::startup::StartupLines;
+use servoplot::host::GrblError;
+use servoplot::host::framing::{LineAssembler, LineEvent, Realtime, realtime};
+use servoplot::host::gcode::{Command, GcodeState, Pending, Report};
+use servoplot::host::report::{REPORT_LINE_MAX_BYTES, Reply};
+use servoplot::host::startup::StartupLines;
 use servoplot::settings::Settings;
 use servoplot::status::RunState;
 

@@ -17,7 +17,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 
-use crate::inputs::Trip;
+use crate::machine_io::inputs::Trip;
 
 /// What the homing task writes, and its mailboxes (see the module documentation).
 pub(super) struct HomingSide {

@@ -6,7 +6,7 @@ use core::sync::atomic::Ordering;
 
 use super::Machine;
 use crate::geom::Point;
-use crate::inputs::Trip;
+use crate::machine_io::inputs::Trip;
 use crate::status::{MotionFault, RunState};
 
 writer_handle!(

@@ -12,8 +12,8 @@ use core::sync::atomic::{AtomicBool, AtomicU16, AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 
-use crate::overrides::Overrides;
-use crate::pen::PenDepth;
+use crate::machine_io::pen::PenDepth;
+use crate::motion::overrides::Overrides;
 
 /// What the host link writes (see the module documentation).
 pub(super) struct HostSide {

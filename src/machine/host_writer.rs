@@ -5,8 +5,8 @@
 use core::sync::atomic::Ordering;
 
 use super::Machine;
-use crate::overrides::{OverrideCommand, Overrides};
-use crate::pen::{Pen, PenDepth};
+use crate::machine_io::pen::{Pen, PenDepth};
+use crate::motion::overrides::{OverrideCommand, Overrides};
 use crate::status::{MotionFault, RunState};
 
 writer_handle!(

@@ -15,7 +15,7 @@ use core::task::Poll;
 use super::motion_writer::MotionWriter;
 use super::plan_end::{PlanEnd, PlanState, Stale};
 use super::{Machine, Refused};
-use crate::job::Job;
+use crate::motion::job::Job;
 
 impl Machine {
     fn plan<R>(&self, f: impl FnOnce(&mut PlanState) -> R) -> R {
@@ -123,11 +123,11 @@ impl MotionWriter<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::drawing::{self, Request};
     use crate::geom::{Point, Step, StepCmd};
-    use crate::job::Feed;
     use crate::machine::JOB_QUEUE_LEN;
     use crate::machine::PulseWriter;
+    use crate::motion::drawing::{self, Request};
+    use crate::motion::job::Feed;
 
     /// The motion task's handle, for the motion task's part.
     fn motion(machine: &Machine) -> MotionWriter<'_> {

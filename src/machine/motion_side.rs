@@ -30,8 +30,8 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 
 use super::path_steps::PathSteps;
-use crate::interp::ShapeKind;
-use crate::planner::PLANNER_SEGMENTS;
+use crate::motion::interp::ShapeKind;
+use crate::motion::planner::PLANNER_SEGMENTS;
 use crate::status::{MotionFault, RunState};
 
 /// The run states as the machine stores them.

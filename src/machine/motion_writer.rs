@@ -5,10 +5,10 @@
 
 use super::Machine;
 use crate::geom::TICK_HZ;
-use crate::inputs::Trip;
-use crate::interp::ShapeKind;
-use crate::job::Control;
-use crate::pen::Pen;
+use crate::machine_io::inputs::Trip;
+use crate::machine_io::pen::Pen;
+use crate::motion::interp::ShapeKind;
+use crate::motion::job::Control;
 use crate::status::{MotionFault, RunState};
 
 writer_handle!(

@@ -5,7 +5,7 @@
 use core::sync::atomic::{AtomicU8, Ordering};
 
 use crate::geom::Axis;
-use crate::inputs::Trip;
+use crate::machine_io::inputs::Trip;
 
 /// The pulses stopped, emitting all they had.
 const STOPPED: u8 = 1 << 0;

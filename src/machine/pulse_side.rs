@@ -4,7 +4,7 @@
 //! step emitted last, the underruns and missed updates, whether the step timer runs, and the
 //! news not yet delivered.
 //!
-//! One writer: the pulse interrupt (the pulse engine, [`crate::pulse`]). Readers: every task,
+//! One writer: the pulse interrupt (the pulse engine, [`crate::motion::pulse`]). Readers: every task,
 //! through the narrow reads on [`Machine`](super::Machine) (the position, the queued work, the
 //! speed, the status, the watchdog's look), and the news interrupt, which takes the news.
 //!
@@ -19,7 +19,7 @@ use core::sync::atomic::{AtomicBool, AtomicI32, AtomicU32, Ordering};
 
 use super::pulse_news::{News, PulseNews};
 use crate::geom::StepCmd;
-use crate::inputs::Trip;
+use crate::machine_io::inputs::Trip;
 
 /// What the pulse interrupt writes (see the module documentation); its writes are called only
 /// through [`PulseWriter`](super::PulseWriter).

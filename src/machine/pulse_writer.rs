@@ -3,7 +3,7 @@
 
 use super::Machine;
 use crate::geom::StepCmd;
-use crate::inputs::Trip;
+use crate::machine_io::inputs::Trip;
 
 writer_handle!(
     /// The pulse interrupt's handle: the writes of the pulses' part of the machine. Reads go
@@ -42,7 +42,7 @@ impl PulseWriter<'_> {
     }
 
     /// The step timer's interrupt came a whole period late or later: the timer repeated a
-    /// period the engine then counted (see [`crate::pulse`]).
+    /// period the engine then counted (see [`crate::motion::pulse`]).
     pub fn count_missed_update(self) {
         self.machine.pulse_side.count_missed_update();
     }

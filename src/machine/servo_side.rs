@@ -11,8 +11,8 @@
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
-use crate::inputs::InputLevels;
-use crate::pen::PenOrder;
+use crate::machine_io::inputs::InputLevels;
+use crate::machine_io::pen::PenOrder;
 
 /// What the servo task writes (see the module documentation).
 pub(super) struct ServoSide {

@@ -4,8 +4,8 @@
 use core::sync::atomic::Ordering;
 
 use super::Machine;
-use crate::inputs::InputLevels;
-use crate::pen::PenOrder;
+use crate::machine_io::inputs::InputLevels;
+use crate::machine_io::pen::PenOrder;
 
 writer_handle!(
     /// The servo task's handle: the input levels, the drivers' readiness and the pen's settling.

@@ -20,12 +20,12 @@ use std::string::String;
 
 use embassy_time::{Duration, Instant, Timer};
 
-use crate::drawing::{Drawing, Slice};
 use crate::geom::TICK_HZ;
-use crate::interp::Method;
-use crate::interp::{Shape, ShapeKind};
 use crate::machine::Machine;
-use crate::planner::Emitted;
+use crate::motion::drawing::{Drawing, Slice};
+use crate::motion::interp::Method;
+use crate::motion::interp::{Shape, ShapeKind};
+use crate::motion::planner::Emitted;
 use crate::tasks::motion::WorkTime;
 use crate::tasks::slices::BetweenSlices;
 

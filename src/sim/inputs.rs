@@ -24,7 +24,7 @@ use std::string::String;
 use std::vec::Vec;
 
 use crate::geom::Axis;
-use crate::inputs::{
+use crate::machine_io::inputs::{
     DRIVER_ALARM_X, DRIVER_ALARM_Y, ESTOP, InputLevels, LIMIT_X_MAX, LIMIT_X_MIN, LIMIT_Y_MAX, LIMIT_Y_MIN, LIMITS,
 };
 use crate::settings::Settings;
@@ -35,7 +35,7 @@ use crate::sim::pins::PulseTrace;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct InputEvent {
     pub t_us: u64,
-    /// The input (one bit, as in [`crate::inputs`]).
+    /// The input (one bit, as in [`crate::machine_io::inputs`]).
     pub input: u8,
     /// Raised (a switch forced pressed, an alarm, the e-stop pressed) or let go.
     pub on: bool,

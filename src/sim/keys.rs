@@ -270,7 +270,7 @@ mod tests {
 
     #[test]
     fn two_keys_of_one_row_read_as_both_with_open_drain_columns_and_short_push_pull_ones() {
-        use crate::keypad::{Key, KeyEvent, KeypadDecoder};
+        use crate::panel::keypad::{Key, KeyEvent, KeypadDecoder};
         clock::reset();
         // Keys 1 (row 0, column 0) and 2 (row 0, column 1) held together.
         let both = KeyScript { events: std::vec![(0, 0b11)] };

@@ -19,8 +19,8 @@ use std::vec::Vec;
 
 use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 
+use crate::panel::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 use crate::tasks::lcd::st7920::{ST7920_CLEAR_US, ST7920_WRITE_US};
-use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 
 /// The simulated board's LCD link clock: the F407 board's (SPI2 on APB1's 42 MHz, divided by 64).
 pub const SIM_LCD_SPI_HZ: u32 = 656_250;

@@ -40,10 +40,10 @@ use std::vec::Vec;
 use embassy_futures::join::{join, join5};
 
 use crate::geom::{Axis, Point};
-use crate::interp::Curve;
 use crate::machine::Machine;
-use crate::planner::{Limits, PLANNER_SEGMENTS, Planner};
-use crate::pulse::{PulseEngine, StepQueue};
+use crate::motion::interp::Curve;
+use crate::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
+use crate::motion::pulse::{PulseEngine, StepQueue};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
 use crate::tasks::{self, lcd::St7920Lcd, panel::Panel};

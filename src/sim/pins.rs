@@ -252,7 +252,7 @@ impl embedded_hal::pwm::ErrorType for SimPen {
 
 impl embedded_hal::pwm::SetDutyCycle for SimPen {
     fn max_duty_cycle(&self) -> u16 {
-        crate::pen::PEN_SERVO_PERIOD_US as u16
+        crate::machine_io::pen::PEN_SERVO_PERIOD_US as u16
     }
 
     fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {

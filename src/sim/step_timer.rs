@@ -19,9 +19,9 @@ use embassy_sync::signal::Signal;
 use embassy_time::{Instant, Timer};
 
 use crate::geom::{Axis, TICKS_PER_US};
-use crate::inputs::InputLevels;
 use crate::machine::PulseWriter;
-use crate::pulse::{PulseEngine, StepTimer};
+use crate::machine_io::inputs::InputLevels;
+use crate::motion::pulse::{PulseEngine, StepTimer};
 use crate::sim::clock;
 use crate::sim::inputs::SimInputs;
 use crate::sim::pins::TracePin;

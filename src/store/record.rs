@@ -6,8 +6,8 @@
 //! (the setting numbers, the counts of offsets and blocks, [`RECORD_FORMAT`]): a record written
 //! by a firmware with other settings does not read back as this one's.
 
-use crate::protocol::gcode::{KEPT_OFFSETS, Offsets};
-use crate::protocol::startup::{STARTUP_LINE_MAX_BYTES, STARTUP_LINES, StartupLine, StartupLines, ascii_line};
+use crate::host::gcode::{KEPT_OFFSETS, Offsets};
+use crate::host::startup::{STARTUP_LINE_MAX_BYTES, STARTUP_LINES, StartupLine, StartupLines, ascii_line};
 use crate::settings::{SETTING_INFO, Settings};
 
 /// Bumped whenever the layout changes in a way the tag would not see.

@@ -6,7 +6,7 @@ use std::vec::Vec;
 use embedded_storage::nor_flash::NorFlash;
 
 use super::*;
-use crate::protocol::startup::StartupLine;
+use crate::host::startup::StartupLine;
 use crate::settings::Settings;
 use crate::sim::flash::SimFlash;
 

@@ -1,4 +1,4 @@
-//! The homing task: runs the homing cycle ([`crate::homing`]) when `$H` or the keypad asks for
+//! The homing task: runs the homing cycle ([`crate::machine_io::homing`]) when `$H` or the keypad asks for
 //! one. It hands each move to the motion task as a job, waits until the machine has stopped,
 //! and checks what the move had to do: an approach stops at its switch, a pull-off leaves it
 //! released. The cycle ends at rest with machine zero set, or in an alarm that says what failed.
@@ -6,10 +6,10 @@
 use embassy_time::{Duration, Timer};
 
 use crate::geom::{Axis, Point};
-use crate::homing::{HOMING_ORDER, HomingFail, Phase, homed_steps, homing_move, towards_max};
-use crate::inputs::{InputSetup, Trip};
-use crate::job::Job;
 use crate::machine::{HomingWriter, MotionFault, PlanEnd};
+use crate::machine_io::homing::{HOMING_ORDER, HomingFail, Phase, homed_steps, homing_move, towards_max};
+use crate::machine_io::inputs::{InputSetup, Trip};
+use crate::motion::job::Job;
 use crate::status::RunState;
 use crate::tasks::servo::SERVO_ENABLE_POLL_MS;
 
@@ -61,7 +61,7 @@ async fn until_stopped(machine: HomingWriter<'_>) {
     }
 }
 
-/// Every move of every axis, then machine zero; see [`crate::homing`]. `Err(None)` when a trip
+/// Every move of every axis, then machine zero; see [`crate::machine_io::homing`]. `Err(None)` when a trip
 /// raised an alarm of its own.
 async fn cycle(machine: HomingWriter<'_>) -> Result<(), Option<HomingFail>> {
     let settings = machine.settings();

@@ -8,15 +8,15 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Ticker, Timer};
 use embedded_hal::digital::{InputPin, OutputPin};
 
-use crate::drawing::BUILD_SLICE_STEPS;
-use crate::job::{Control, Job};
-use crate::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
 use crate::machine::{Machine, PlanEnd};
-use crate::pen;
+use crate::machine_io::pen;
+use crate::motion::drawing::BUILD_SLICE_STEPS;
+use crate::motion::job::{Control, Job};
+use crate::panel::MenuAction;
+use crate::panel::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
+use crate::panel::menu::{Building, UiError};
 use crate::tasks::panel::Panel;
 use crate::tasks::slices::BetweenSlices;
-use crate::ui::MenuAction;
-use crate::ui::menu::{Building, UiError};
 
 /// Time for a row input to settle after its column is driven low.
 pub const KEYPAD_SETTLE_US: u64 = 10;

@@ -7,7 +7,7 @@
 //! in the [`Panel`] the keypad task changes: only while a frame is worked out and drawn into the
 //! picture, never while the task waits or sends.
 //! While a run is under way the task reads the pen's position every `PREVIEW_SAMPLE_MS` into
-//! the run's [`Trail`](crate::ui::trail::Trail): the path of the steps emitted, read from the position the pulse engine
+//! the run's [`Trail`](crate::panel::trail::Trail): the path of the steps emitted, read from the position the pulse engine
 //! counts, which costs the motion and the pulses nothing.
 
 pub mod st7920;
@@ -19,10 +19,10 @@ use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::pixelcolor::BinaryColor;
 
 use crate::machine::Machine;
-use crate::pen::PenLift;
+use crate::machine_io::pen::PenLift;
+use crate::panel::run::RunPath;
+use crate::panel::screen::{self, Live};
 use crate::tasks::panel::Panel;
-use crate::ui::run::RunPath;
-use crate::ui::screen::{self, Live};
 
 pub use st7920::St7920Lcd;
 

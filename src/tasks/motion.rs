@@ -2,9 +2,9 @@
 //! planner, and feeds them to the pulse engine through the step queue.
 //!
 //! It decides nothing. Each job arrives with its curve built and checked (`drawing::build`);
-//! how fast each step goes is the planner's ([`crate::planner::Planner`]); the run state it
+//! how fast each step goes is the planner's ([`crate::motion::planner::Planner`]); the run state it
 //! reports, where the pen goes and when, which job waits, the alarms, when the step queue rests
-//! and what to wait for next are the supervisor's ([`crate::supervisor::Supervisor`]), which it
+//! and what to wait for next are the supervisor's ([`crate::motion::supervisor::Supervisor`]), which it
 //! tells what happened and whose answers it carries out.
 //!
 //! Each time it runs it takes a trip, controls and jobs, then fills the step queue in one tight
@@ -21,18 +21,18 @@ use embassy_futures::select::{Either, select};
 use embassy_futures::yield_now;
 use embassy_time::{Duration, Timer};
 
-use crate::drawing::Drawing;
 use crate::geom::TICKS_PER_US;
-use crate::inputs::Trip;
-use crate::interp::Curve;
-use crate::job::{Control, Job, JobKind};
 use crate::machine::{MotionWriter, STEP_QUEUE_MAX_TICKS};
-use crate::overrides::Overrides;
-use crate::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner};
-use crate::pulse::{STEP_QUEUE_LEN, StepProducer};
+use crate::machine_io::inputs::Trip;
+use crate::motion::drawing::Drawing;
+use crate::motion::interp::Curve;
+use crate::motion::job::{Control, Job, JobKind};
+use crate::motion::overrides::Overrides;
+use crate::motion::planner::{Emitted, Limits, PLANNER_SEGMENTS, Planner};
+use crate::motion::pulse::{STEP_QUEUE_LEN, StepProducer};
+use crate::motion::supervisor::{AtRest, FillEnd, Filled, JobOrder, Next, StartReady, Supervisor, Take, Tripped};
 use crate::settings::Settings;
 use crate::status::RunState;
-use crate::supervisor::{AtRest, FillEnd, Filled, JobOrder, Next, StartReady, Supervisor, Take, Tripped};
 
 /// The step queue holds at least this many steps, however long: the pulse engine holds two (the
 /// period counting and the one preloaded after it), so a third is there for the next update
@@ -275,7 +275,7 @@ async fn stand_held(machine: MotionWriter<'_>, planner: &Planner<Curve, PLANNER_
     wait_for_work(machine, planner).await;
 }
 
-/// An input tripped the machine (see [`crate::inputs`]): once the pulse engine has halted,
+/// An input tripped the machine (see [`crate::machine_io::inputs`]): once the pulse engine has halted,
 /// drops everything planned and queued without braking (the pulses already stopped), takes the
 /// position from the pulses emitted, and does what the supervisor says: raises the alarm
 /// (motion is refused until `$X`), or hands a limit switch a homing approach ran into to the

@@ -12,7 +12,7 @@ use core::cell::RefCell;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 
-use crate::ui::Menu;
+use crate::panel::Menu;
 
 /// The keypad menu and its change signal; see the module documentation.
 pub struct Panel {
@@ -63,7 +63,7 @@ impl Panel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::keypad::{Key, KeyEvent};
+    use crate::panel::keypad::{Key, KeyEvent};
     use crate::settings::Settings;
     use crate::status::Status;
     use core::pin::pin;

@@ -17,14 +17,14 @@
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
 //!
 //! Where a line is parsed from, and what each command of it waits for, is refused on and answers,
-//! are [`crate::protocol::guards`]'s rules: the line loop waits, acts and answers as they say.
+//! are [`crate::host::guards`]'s rules: the line loop waits, acts and answers as they say.
 //!
 //! Status reports carry the work offset (`|WCO:`, the active work coordinate system plus G92, as
 //! the parser has it after its last line) and the overrides in force (`|Ov:`) when
-//! [`crate::protocol::refresh`] says, as GRBL's do, so a sender shows work positions and
+//! [`crate::host::refresh`] says, as GRBL's do, so a sender shows work positions and
 //! overrides.
 //!
-//! A line's curve is built a slice at a time ([`crate::drawing::Builder`]), the other tasks and
+//! A line's curve is built a slice at a time ([`crate::motion::drawing::Builder`]), the other tasks and
 //! the links' receivers running between slices, so a `?` is answered and the watchdog fed while
 //! a long curve is built; the line is kept by the parser, and its jobs queued, only once its
 //! curve is built. A reset on the line's link meanwhile abandons it, unanswered.
@@ -64,20 +64,20 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
-use crate::drawing::BUILD_SLICE_STEPS;
-use crate::inputs::Trip;
-use crate::job::{Control, Job};
+use crate::host::framing::{LineAssembler, LineEvent, Realtime, realtime};
+use crate::host::gcode::{Offsets, Pending};
+use crate::host::guards::{self, Answer, LineStart, Refusal, Reported, Wait};
+use crate::host::refresh::Refresh;
+use crate::host::report::{Reply, StatusFields};
+use crate::host::startup::{STARTUP_LINES, StartupLines};
+use crate::host::{Command, GcodeState, GrblError, Report};
 use crate::machine::{HostWriter, Machine, MotionFault, PlanEnd, Stale};
-use crate::overrides::Overrides;
-use crate::pen::{Pen, PenDepth};
-use crate::planner::PLANNER_SEGMENTS;
-use crate::protocol::framing::{LineAssembler, LineEvent, Realtime, realtime};
-use crate::protocol::gcode::{Offsets, Pending};
-use crate::protocol::guards::{self, Answer, LineStart, Refusal, Reported, Wait};
-use crate::protocol::refresh::Refresh;
-use crate::protocol::report::{Reply, StatusFields};
-use crate::protocol::startup::{STARTUP_LINES, StartupLines};
-use crate::protocol::{Command, GcodeState, GrblError, Report};
+use crate::machine_io::inputs::Trip;
+use crate::machine_io::pen::{Pen, PenDepth};
+use crate::motion::drawing::BUILD_SLICE_STEPS;
+use crate::motion::job::{Control, Job};
+use crate::motion::overrides::Overrides;
+use crate::motion::planner::PLANNER_SEGMENTS;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::store::{Record, Store, StoreError};

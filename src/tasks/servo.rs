@@ -11,10 +11,10 @@
 //! It drives the pen servo's PWM to where the machine wants the pen (when `$213` names a pen
 //! lift) and tells the machine once it has had its settle time (`$212`).
 //!
-//! It lights the run LED and sounds the buzzer as [`crate::signals`] says.
+//! It lights the run LED and sounds the buzzer as [`crate::machine_io::signals`] says.
 //!
 //! It also feeds the board's independent watchdog, while the pulse engine and the motion task
-//! make progress (see [`crate::watchdog`]); once they do not, it stops, and the watchdog resets
+//! make progress (see [`crate::machine_io::watchdog`]); once they do not, it stops, and the watchdog resets
 //! the board.
 
 use core::sync::atomic::{Ordering, fence};
@@ -24,13 +24,13 @@ use embedded_hal::digital::{OutputPin, PinState};
 use embedded_hal::pwm::SetDutyCycle;
 
 use crate::geom::TICKS_PER_US;
-use crate::inputs::{Debounce, InputLevels, InputSetup};
 use crate::machine::ServoWriter;
-use crate::pen::{PEN_SERVO_PERIOD_US, PenServo};
+use crate::machine_io::inputs::{Debounce, InputLevels, InputSetup};
+use crate::machine_io::pen::{PEN_SERVO_PERIOD_US, PenServo};
+use crate::machine_io::signals::Signals;
+use crate::machine_io::son::ServoEnable;
+use crate::machine_io::watchdog::{Look, Progress};
 use crate::settings::Settings;
-use crate::signals::Signals;
-use crate::son::ServoEnable;
-use crate::watchdog::{Look, Progress};
 
 /// How often the task reads the inputs and sets SON: well within a person's reach of the axes
 /// after `$SLP`, and an e-stop pressed at rest is an alarm within this (plus the debounce).

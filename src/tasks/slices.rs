@@ -1,5 +1,5 @@
 //! Long work in slices: a drawing is built by walking its curve a slice at a time
-//! ([`crate::drawing::Builder`]), and between two slices the task that builds it lets the other
+//! ([`crate::motion::drawing::Builder`]), and between two slices the task that builds it lets the other
 //! tasks run. [`BetweenSlices`] is that pause. On the board the slice has taken its real time,
 //! and the pause is a yield to the executor ([`Yield`]); the simulator's virtual time stands
 //! still while code runs, and its model of the board's processor spends the slice's time there,
@@ -7,7 +7,7 @@
 
 use core::future::Future;
 
-use crate::drawing::Slice;
+use crate::motion::drawing::Slice;
 
 /// The pause between two slices of a build; see the module documentation.
 pub trait BetweenSlices {

@@ -75,7 +75,7 @@ pub fn glyphs() -> Vec<(char, [[bool; 5]; 7])> {
 /// pixel in from the left of a cell two columns (10 pixels) wide.
 pub fn chinese_glyphs() -> Vec<(char, [[bool; 10]; 7])> {
     let font = FontRenderer::new::<u8g2_font_boutique_bitmap_7x7_t_gb2312>();
-    servoplot::ui::texts::HANZI
+    servoplot::panel::texts::HANZI
         .chars()
         .map(|c| {
             let mut canvas = Canvas([[false; W]; H]);

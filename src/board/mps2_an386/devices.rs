@@ -10,7 +10,7 @@ use embedded_hal::digital::{ErrorType, InputPin, OutputPin};
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_hal::spi::{Operation, SpiDevice};
 use embedded_storage::nor_flash::{ErrorType as FlashErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
-use servoplot::pen::PEN_SERVO_PERIOD_US;
+use servoplot::machine_io::pen::PEN_SERVO_PERIOD_US;
 use servoplot::store::{STORE_FLASH_RANGE, STORE_SECTOR_BYTES};
 
 /// A pin of the board the model has nothing behind: as an output it drives nothing; as an

@@ -31,11 +31,11 @@ use cortex_m::peripheral::NVIC;
 use defmt_semihosting as _;
 use embassy_executor::{SendSpawner, Spawner};
 use embassy_time::Delay;
-use servoplot::inputs::InputLevels;
 use servoplot::machine::PulseWriter;
-use servoplot::pulse::StepConsumer;
+use servoplot::machine_io::inputs::InputLevels;
+use servoplot::machine_io::watchdog::WATCHDOG_TIMEOUT_MS;
+use servoplot::motion::pulse::StepConsumer;
 use servoplot::tasks::lcd::St7920Lcd;
-use servoplot::watchdog::WATCHDOG_TIMEOUT_MS;
 
 use crate::firmware::executor::{self, Irq};
 use crate::firmware::priority;
@@ -142,7 +142,7 @@ pub fn start_motion_executor() -> SendSpawner {
 
 /// Every machine input's level: all idle.
 pub fn read_inputs() -> InputLevels {
-    servoplot::inputs::LIMITS
+    servoplot::machine_io::inputs::LIMITS
 }
 
 /// Logs the pulses the step timer has emitted, per axis and direction.

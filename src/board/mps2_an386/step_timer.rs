@@ -16,9 +16,9 @@ use core::sync::atomic::{AtomicBool, AtomicPtr, AtomicU32, Ordering};
 
 use cortex_m::peripheral::NVIC;
 use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
-use servoplot::inputs::{InputLevels, LIMITS};
 use servoplot::machine::{Machine, PulseWriter};
-use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
+use servoplot::machine_io::inputs::{InputLevels, LIMITS};
+use servoplot::motion::pulse::{PulseEngine, StepConsumer, StepTimer};
 
 use super::clock::CLOCKS_PER_US;
 use super::regs::{self, *};

@@ -1,6 +1,6 @@
 //! The machine's input pins: the four limit switches, the two drivers' alarm outputs and the
 //! emergency stop, all on port E with pull-ups, so that one read of the port gives every level
-//! (the pulse engine reads them at every period). What the levels mean is `servoplot::inputs`'s.
+//! (the pulse engine reads them at every period). What the levels mean is `servoplot::machine_io::inputs`'s.
 //!
 //! | input            | pin  | bit                 |
 //! |------------------|------|---------------------|
@@ -13,7 +13,7 @@ use embassy_stm32::Peri;
 use embassy_stm32::gpio::{Input, Pull};
 use embassy_stm32::pac;
 use embassy_stm32::peripherals::{PE4, PE5, PE6, PE7, PE8, PE14, PE15};
-use servoplot::inputs::{ESTOP, InputLevels};
+use servoplot::machine_io::inputs::{ESTOP, InputLevels};
 
 /// PE4..PE8 are bits 0..4 of the levels, PE14 and PE15 bits 5 and 6.
 const LOW_PINS_SHIFT: u32 = 4;

@@ -1,4 +1,4 @@
-//! The independent watchdog (IWDG), set to the prescaler and reload `servoplot::watchdog`
+//! The independent watchdog (IWDG), set to the prescaler and reload `servoplot::machine_io::watchdog`
 //! chose for a timeout of 3.0 s to 8.3 s over the LSI's 17-47 kHz.
 //!
 //! embassy-stm32's `IndependentWatchdog` sizes the reload for an LSI of exactly 32 kHz, which
@@ -14,7 +14,7 @@ use embassy_stm32::Peri;
 use embassy_stm32::pac;
 use embassy_stm32::pac::iwdg::vals::{Key, Pr};
 use embassy_stm32::peripherals::IWDG;
-use servoplot::watchdog::{WATCHDOG_PRESCALER, WATCHDOG_RELOAD};
+use servoplot::machine_io::watchdog::{WATCHDOG_PRESCALER, WATCHDOG_RELOAD};
 
 /// IWDG_PR's code for the prescaler (RM0090 §21.4.2: 4 is /64).
 const PRESCALER_CODE: Pr = Pr::DIVIDE_BY64;
@@ -26,7 +26,7 @@ pub struct Watchdog {
 }
 
 impl Watchdog {
-    /// Starts the watchdog with `servoplot::watchdog`'s timeout; it runs until the next reset.
+    /// Starts the watchdog with `servoplot::machine_io::watchdog`'s timeout; it runs until the next reset.
     pub fn start(iwdg: Peri<'static, IWDG>) -> Self {
         let regs = pac::IWDG;
         regs.kr().write(|w| w.set_key(Key::START));

@@ -8,7 +8,7 @@ use embassy_stm32::timer::low_level::{OutputCompareMode, Timer};
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Channel};
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use servoplot::pen::PEN_SERVO_PERIOD_US;
+use servoplot::machine_io::pen::PEN_SERVO_PERIOD_US;
 
 /// The counter's rate: one count per microsecond, so the duty cycle is the pulse in µs.
 const PEN_TICK_HZ: u32 = 1_000_000;

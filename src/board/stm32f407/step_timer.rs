@@ -22,9 +22,9 @@ use static_cell::StaticCell;
 
 use super::inputs::InputPins;
 use servoplot::geom::{Axis, TICK_HZ, TICKS_PER_US};
-use servoplot::inputs::InputLevels;
 use servoplot::machine::{Machine, PulseWriter};
-use servoplot::pulse::{PulseEngine, StepConsumer, StepTimer};
+use servoplot::machine_io::inputs::InputLevels;
+use servoplot::motion::pulse::{PulseEngine, StepConsumer, StepTimer};
 
 /// The channels driving X and Y PULS.
 const PULS_CHANNELS: [Channel; 2] = [Channel::Ch1, Channel::Ch2];

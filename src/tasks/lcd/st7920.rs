@@ -30,7 +30,7 @@ use embedded_hal::digital::OutputPin;
 use embedded_hal::spi::{Operation, SpiDevice};
 
 use super::Lcd;
-use crate::ui::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
+use crate::panel::layout::{SCREEN_HEIGHT_PX, SCREEN_WIDTH_PX};
 
 /// The shortest time from one write to the next, µs: an instruction's or a data write's
 /// execution time (the datasheet's instruction table, f_OSC = 540 kHz).

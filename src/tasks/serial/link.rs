@@ -18,7 +18,7 @@ use embedded_io_async::Write;
 use heapless::String;
 
 use super::dropped::Dropped;
-use crate::protocol::report::{self, Reply};
+use crate::host::report::{self, Reply};
 
 /// Bytes between a link's receiver and the line loop. GRBL senders keep at most 128 unanswered
 /// bytes in flight, so this never fills for them; it also holds a terminal paste of about 50
