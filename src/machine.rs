@@ -8,8 +8,7 @@
 //! - the pulse interrupt ([`PulseWriter`], [`pulse_side`]): the pulses emitted, the emitted
 //!   totals, the last interval, underruns, missed updates, the step timer running, its news;
 //! - the motion task ([`MotionWriter`], [`motion_side`]): what it queued and planned, the job
-//!   it draws, the fault and the run state (with documented exceptions: `$X`, the reset after
-//!   `$SLP`, and a homing cycle's start and failure);
+//!   it draws, and the motion's state (idle, running, held, jogging);
 //! - the host link ([`HostWriter`], [`host_side`]): the overrides, the work offset, check mode,
 //!   sleep, the pen's depth;
 //! - the servo task ([`ServoWriter`], [`servo_side`]): the input levels, the drivers'
@@ -25,7 +24,9 @@
 //! ([`request_homing`](Machine::request_homing); the homing task), the settings
 //! ([`update_settings`](Machine::update_settings); the host link keeps them in flash) and the
 //! trips ([`trip`](Machine::trip); the motion task raises the alarm, `$X` or the homing task
-//! clears it); the switch a homing approach stopped at has one poster, the motion task, and the
+//! clears it). The alarm is a latch over the motion's state ([`alarm`]): raised by whoever finds
+//! a fault (the motion task, the homing task, the host link's wake after `$SLP`), through their
+//! handles, and cleared only by an unlock (`$X`, a homing cycle's start); the switch a homing approach stopped at has one poster, the motion task, and the
 //! homing task takes it. The pen's orders have two writers, both at rest: the motion task (a keypad
 //! drawing's pen lift) and the host link (`M3`, `M5`), each a single read-modify-write of one
 //! word ([`PenOrder`]); the servo task says when the pen has settled.
@@ -37,7 +38,7 @@
 //! wake at most the tasks that wait there:
 //! - `control`: the control requested and not yet taken (1 byte);
 //! - the host link's work offset, two `f32`;
-//! - the motion's fault, an `Option<MotionFault>`; `trip` and the homing's switch found, an
+//! - the alarm's fault, an `Option<MotionFault>`; `trip` and the homing's switch found, an
 //!   `Option<Trip>`;
 //! - the signals `control_requested`, `changed`, `pulses_done`, the homing request,
 //!   `settings_changed` and `faults`: the waiting task's waker, or what was signalled (`()`, a
@@ -80,6 +81,7 @@ macro_rules! writer_handle {
     };
 }
 
+mod alarm;
 mod handles;
 mod homing_side;
 mod homing_writer;
@@ -114,6 +116,7 @@ use crate::motion::job::{Control, Job};
 use crate::settings::Settings;
 pub use crate::status::MotionFault;
 use crate::status::{RunState, Status};
+use alarm::Alarm;
 pub use handles::Handles;
 use homing_side::HomingSide;
 pub use homing_writer::HomingWriter;
@@ -183,6 +186,8 @@ pub struct Machine {
     servo_side: ServoSide,
     /// What the homing task writes ([`HomingWriter`]), and its mailboxes.
     homing_side: HomingSide,
+    /// The alarm latch and the last fault, raised and cleared by their posters (see [`alarm`]).
+    alarm: Alarm,
     /// The writers' handles were handed out ([`handles`](Self::handles)).
     handed_out: AtomicBool,
     /// Jobs handed over, each with the plan's end it was planned from (a mailbox: anyone
@@ -230,10 +235,11 @@ impl Machine {
         let locked = settings.homing;
         Machine {
             pulse_side: PulseSide::new(),
-            motion_side: MotionSide::new(if locked { RunState::Alarm } else { RunState::Idle }),
+            motion_side: MotionSide::new(),
             host_side: HostSide::new(),
             servo_side: ServoSide::new(),
             homing_side: HomingSide::new(),
+            alarm: Alarm::new(locked),
             handed_out: AtomicBool::new(false),
             jobs: JobQueue::new(),
             plan: Mutex::new(Cell::new(PlanState::at(Point::ORIGIN))),
@@ -382,10 +388,20 @@ impl Machine {
     /// Leaves the alarm, and lets pulses out again after a trip (handled by the motion task by
     /// now: the machine has stopped). For `$X` and a homing cycle's start.
     fn unlock(&self) {
-        if self.run_state() == RunState::Alarm {
-            self.set_run_state(RunState::Idle);
+        if self.alarm.clear() {
+            self.changed.signal(());
         }
         self.halted.store(false, Ordering::Release);
+    }
+
+    /// Raises the alarm, for `fault` if one is given; a fault goes to the host link too. For the
+    /// alarm's posters (see [`alarm`]).
+    fn raise_alarm(&self, fault: Option<MotionFault>) {
+        self.alarm.raise(fault);
+        if let Some(f) = fault {
+            self.faults.signal(f);
+        }
+        self.changed.signal(());
     }
 
     /// A snapshot for displays and reports.

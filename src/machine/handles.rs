@@ -86,4 +86,33 @@ mod tests {
         handles.host.set_work_offset_mm([2.0, 3.0]);
         assert_eq!(machine.work_offset_mm(), [2.0, 3.0]);
     }
+
+    #[test]
+    fn an_alarm_stays_over_the_motion_until_unlock_and_its_fault_until_the_next_job() {
+        use crate::motion::interp::CurveError;
+        use crate::status::{MotionFault, RunState};
+        let machine = Machine::new(Settings::default());
+        let handles = machine.handles().unwrap();
+        handles.motion.set_run_state(RunState::Run);
+        let fault = MotionFault::Curve(CurveError::Travel);
+        handles.motion.raise_alarm(fault);
+        assert_eq!(machine.run_state(), RunState::Alarm);
+        // The motion brakes and rests under the alarm: the alarm stays.
+        handles.motion.set_run_state(RunState::Idle);
+        assert_eq!((machine.state(), machine.fault()), (RunState::Alarm, Some(fault)));
+        handles.host.unlock();
+        assert_eq!((machine.state(), machine.fault()), (RunState::Idle, Some(fault)), "the fault is still shown");
+        handles.motion.forget_fault();
+        assert_eq!(machine.fault(), None, "a new job starts");
+    }
+
+    #[test]
+    fn a_machine_that_must_be_homed_starts_in_the_alarm() {
+        use crate::status::RunState;
+        let machine = Machine::new(Settings { homing: true, ..Settings::default() });
+        let handles = machine.handles().unwrap();
+        assert_eq!(machine.state(), RunState::Alarm);
+        handles.homing.unlock();
+        assert_eq!(machine.state(), RunState::Idle);
+    }
 }

@@ -7,7 +7,7 @@ use core::sync::atomic::Ordering;
 use super::Machine;
 use crate::geom::Point;
 use crate::machine_io::inputs::Trip;
-use crate::status::{MotionFault, RunState};
+use crate::status::MotionFault;
 
 writer_handle!(
     /// The homing task's handle: machine zero, the end of a cycle, and the switch an approach
@@ -48,18 +48,16 @@ impl HomingWriter<'_> {
         found
     }
 
-    /// A cycle starts from rest: it leaves an alarm, as `$X` does (see
-    /// [`motion_side`](super::motion_side) for why the run state has this second writer).
+    /// A cycle starts from rest: it leaves an alarm, as `$X` does (one of the
+    /// [`alarm`](super::alarm)'s posters).
     pub fn unlock(self) {
         self.machine.unlock();
     }
 
-    /// The cycle failed for `fault`, its moves ended: an alarm (see
-    /// [`motion_side`](super::motion_side) for why the run state and the fault have this
-    /// second writer).
+    /// The cycle failed for `fault`, its moves ended: an alarm (one of the
+    /// [`alarm`](super::alarm)'s posters).
     pub fn fail(self, fault: MotionFault) {
-        self.machine.set_run_state(RunState::Alarm);
-        self.machine.set_fault(Some(fault));
+        self.machine.raise_alarm(Some(fault));
     }
 }
 
@@ -71,7 +69,7 @@ impl Machine {
     }
 
     /// Asks the homing task for a cycle; false if one runs already. The state is
-    /// [`RunState::Home`] from now until it ends. A request anyone may post (the host link's
+    /// [`RunState::Home`](crate::status::RunState::Home) from now until it ends. A request anyone may post (the host link's
     /// `$H`, the keypad's menu); the homing task takes it.
     pub fn request_homing(&self) -> bool {
         if !self.homing_side.request() {

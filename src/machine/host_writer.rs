@@ -7,7 +7,7 @@ use core::sync::atomic::Ordering;
 use super::Machine;
 use crate::machine_io::pen::{Pen, PenDepth};
 use crate::motion::overrides::{OverrideCommand, Overrides};
-use crate::status::{MotionFault, RunState};
+use crate::status::MotionFault;
 
 writer_handle!(
     /// The host link's handle: the overrides, the work offset, check mode, sleep, the pen's
@@ -54,18 +54,16 @@ impl HostWriter<'_> {
     }
 
     /// A reset after `$SLP`: the servos come back on and the machine is in alarm, since the free
-    /// axes may have been moved (see [`motion_side`](super::motion_side) for why the run state
-    /// has this second writer). Nothing when not asleep.
+    /// axes may have been moved (one of the [`alarm`](super::alarm)'s posters). Nothing when not
+    /// asleep.
     pub fn wake(self) {
         if self.machine.host_side.set_asleep(false) {
-            self.machine.set_run_state(RunState::Alarm);
-            self.machine.changed.signal(());
+            self.machine.raise_alarm(None);
         }
     }
 
     /// `$X`: leaves the alarm, and lets pulses out again after a trip (handled by the motion
-    /// task by now: the machine has stopped). See [`motion_side`](super::motion_side) for why
-    /// the run state has this second writer.
+    /// task by now: the machine has stopped). One of the [`alarm`](super::alarm)'s posters.
     pub fn unlock(self) {
         self.machine.unlock();
     }

@@ -1,45 +1,29 @@
 //! The part of the machine the motion task writes, through its handle
 //! ([`MotionWriter`](super::MotionWriter)): the step commands and motion time queued for the
 //! pulse engine so far, how far the queued steps advance along the ideal curve, whether the
-//! planner holds anything and how much room it has, the kind of the job taken last, the fault
-//! that ended the last job, and the run state.
+//! planner holds anything and how much room it has, the kind of the job taken last, and the
+//! motion's state (idle, running, held, jogging).
 //!
-//! One writer: the motion task ([`crate::tasks::motion`]), with exceptions kept on purpose for
-//! the run state and the fault, each write one store of a whole value (an atomic, or the fault
-//! under its critical section; a reader sees one state or the other, never a mix):
-//! - the homing task raises the alarm and its fault when a cycle fails
-//!   ([`HomingWriter::fail`](super::HomingWriter::fail)), and leaves an alarm as `$X` does when a
-//!   cycle starts from rest ([`HomingWriter::unlock`](super::HomingWriter::unlock)). As requests
-//!   the motion task took later, the cycle would end, and be reported over, before its alarm
-//!   was raised;
-//! - the host link leaves an alarm on `$X` ([`HostWriter::unlock`](super::HostWriter::unlock))
-//!   and enters one on the reset after `$SLP` ([`HostWriter::wake`](super::HostWriter::wake)),
-//!   both at rest. As requests, `$X` would answer `ok` before the state it reports had changed,
-//!   and the line after it would be judged in the alarm.
-//!
-//! The motion task writes the run state only as it takes a job, a control or a trip, or as the
-//! motion it runs ends.
+//! One writer: the motion task ([`crate::tasks::motion`]). It writes the motion's state only as
+//! it takes a job, a control or a trip, or as the motion it runs ends. An alarm is not a state
+//! of the motion but a latch over it ([`alarm`](super::alarm)): the motion goes on being what it
+//! is (an abort brakes, then rests) while the machine reports the alarm.
 //!
 //! Readers: every task, through the narrow reads on [`Machine`](super::Machine) (the state, the
 //! status, the queued work, the speed, the planner's room).
 
-use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
-
-use embassy_sync::blocking_mutex::Mutex;
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 
 use super::path_steps::PathSteps;
 use crate::motion::interp::ShapeKind;
 use crate::motion::planner::PLANNER_SEGMENTS;
-use crate::status::{MotionFault, RunState};
+use crate::status::RunState;
 
 /// The run states as the machine stores them.
 const STATE_IDLE: u8 = 0;
 const STATE_RUN: u8 = 1;
 const STATE_HOLD: u8 = 2;
 const STATE_JOG: u8 = 3;
-const STATE_ALARM: u8 = 4;
 
 /// What the motion task writes (see the module documentation).
 pub(super) struct MotionSide {
@@ -56,15 +40,13 @@ pub(super) struct MotionSide {
     plan_free: AtomicU8,
     /// The kind of the job taken last (`ShapeKind` as its index + 1, 0 for none).
     drawing: AtomicU8,
-    /// The fault that ended the last job early, if any.
-    fault: Mutex<CriticalSectionRawMutex, Cell<Option<MotionFault>>>,
-    /// The run state, as one of the `STATE_` values.
+    /// The motion's state, as one of the `STATE_` values.
     state: AtomicU8,
 }
 
 impl MotionSide {
-    /// Nothing queued or planned, in `state`.
-    pub(super) const fn new(state: RunState) -> Self {
+    /// Nothing queued or planned, idle.
+    pub(super) const fn new() -> Self {
         MotionSide {
             queued_steps: AtomicU32::new(0),
             queued_ticks: AtomicU32::new(0),
@@ -72,8 +54,7 @@ impl MotionSide {
             plan_empty: AtomicBool::new(true),
             plan_free: AtomicU8::new(PLANNER_SEGMENTS as u8),
             drawing: AtomicU8::new(0),
-            fault: Mutex::new(Cell::new(None)),
-            state: AtomicU8::new(state_code(state)),
+            state: AtomicU8::new(STATE_IDLE),
         }
     }
 
@@ -127,26 +108,17 @@ impl MotionSide {
         self.drawing.store(code, Ordering::Relaxed);
     }
 
-    pub(super) fn fault(&self) -> Option<MotionFault> {
-        self.fault.lock(|f| f.get())
-    }
-
-    pub(super) fn set_fault(&self, fault: Option<MotionFault>) {
-        self.fault.lock(|f| f.set(fault));
-    }
-
     pub(super) fn run_state(&self) -> RunState {
         match self.state.load(Ordering::Relaxed) {
             STATE_RUN => RunState::Run,
             STATE_HOLD => RunState::Hold,
             STATE_JOG => RunState::Jog,
-            STATE_ALARM => RunState::Alarm,
             _ => RunState::Idle,
         }
     }
 
-    /// Sets the run state; true if it changed. Check mode, sleep and homing are not run states
-    /// (they are kept where they are set) and store as idle.
+    /// Sets the motion's state; true if it changed. Check mode, sleep, homing and the alarm are
+    /// not states of the motion (they are kept where they are set) and store as idle.
     pub(super) fn set_run_state(&self, state: RunState) -> bool {
         let v = state_code(state);
         self.state.swap(v, Ordering::Relaxed) != v
@@ -155,10 +127,9 @@ impl MotionSide {
 
 const fn state_code(state: RunState) -> u8 {
     match state {
-        RunState::Idle | RunState::Check | RunState::Sleep | RunState::Home => STATE_IDLE,
+        RunState::Idle | RunState::Check | RunState::Sleep | RunState::Home | RunState::Alarm => STATE_IDLE,
         RunState::Run => STATE_RUN,
         RunState::Hold => STATE_HOLD,
         RunState::Jog => STATE_JOG,
-        RunState::Alarm => STATE_ALARM,
     }
 }

@@ -46,15 +46,24 @@ impl MotionWriter<'_> {
         self.machine.motion_side.set_plan_free(free);
     }
 
-    /// The fault that ended the last job early, or none for a job started.
-    pub fn set_fault(self, fault: Option<MotionFault>) {
-        self.machine.set_fault(fault);
+    /// A job started: the fault that ended the last one is history.
+    pub fn forget_fault(self) {
+        self.machine.alarm.forget_fault();
+        self.machine.changed.signal(());
     }
 
-    /// Sets the motion's state. Check mode is not one: see
-    /// [`HostWriter::set_check_mode`](super::HostWriter::set_check_mode).
+    /// A curve stopped part way, or a trip: the alarm, for `fault`.
+    pub fn raise_alarm(self, fault: MotionFault) {
+        self.machine.raise_alarm(Some(fault));
+    }
+
+    /// Sets the motion's state: idle, running, held or jogging. Check mode and the alarm are
+    /// not states of the motion: see [`HostWriter::set_check_mode`](super::HostWriter::set_check_mode)
+    /// and [`alarm`](super::alarm).
     pub fn set_run_state(self, state: RunState) {
-        self.machine.set_run_state(state);
+        if self.machine.motion_side.set_run_state(state) {
+            self.machine.changed.signal(());
+        }
     }
 
     /// Sends the pen to `pen`, only at rest; the pen settles before anything moves (see
@@ -136,32 +145,16 @@ impl Machine {
         self.motion_side.drawing()
     }
 
-    /// The motion's state: idle, running, held, jogging or in an alarm (see
-    /// [`state`](Self::state) for the state to report).
+    /// The run state: in an alarm while the alarm is raised ([`alarm`](super::alarm)), else the
+    /// motion's: idle, running, held or jogging (see [`state`](Self::state) for the state to
+    /// report).
     pub fn run_state(&self) -> RunState {
-        self.motion_side.run_state()
+        if self.alarm.latched() { RunState::Alarm } else { self.motion_side.run_state() }
     }
 
-    /// The fault that ended the last job early, if any.
+    /// The fault that raised the last alarm, until the next job starts.
     pub fn fault(&self) -> Option<MotionFault> {
-        self.motion_side.fault()
-    }
-
-    /// Sets the fault; a fault goes to the host link too. For the fault's writers (see
-    /// [`motion_side`](super::motion_side)).
-    pub(super) fn set_fault(&self, fault: Option<MotionFault>) {
-        self.motion_side.set_fault(fault);
-        if let Some(f) = fault {
-            self.faults.signal(f);
-        }
-        self.changed.signal(());
-    }
-
-    /// Sets the run state. For the run state's writers (see [`motion_side`](super::motion_side)).
-    pub(super) fn set_run_state(&self, state: RunState) {
-        if self.motion_side.set_run_state(state) {
-            self.changed.signal(());
-        }
+        self.alarm.fault()
     }
 
     /// True when nothing is queued, planned or moving, held or not: the position is final.

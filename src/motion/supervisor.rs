@@ -3,9 +3,9 @@
 //! says on the machine, the planner and the step queue.
 //!
 //! It owns these rules:
-//! - the run state reported: `Run` while a drawing or a homing move is queued, `Jog` for a jog,
-//!   `Hold` once a hold stands, `Idle` at rest, and an alarm kept until `$X` (nothing the motion
-//!   does clears it);
+//! - the motion's state: `Run` while a drawing or a homing move is queued, `Jog` for a jog,
+//!   `Hold` once a hold stands, `Idle` at rest (an alarm is a latch over it, raised here for a
+//!   curve or a trip, and kept by the machine until `$X`: [`crate::machine`]);
 //! - the pen at rest: a job that needs the pen elsewhere is held back until the motion before it
 //!   has been emitted, then the pen goes there; a keypad drawing lifts the pen where a program's
 //!   end leaves it once it rests, unless a job is queued behind it (the pen rules themselves are
@@ -104,8 +104,8 @@ pub struct Then {
 pub enum AtRest {
     /// A job was held back for this rest: take it now.
     TakeHeld,
-    /// Send the pen to `pen` if `Some`, publish `publish` if `Some`, and wait for work.
-    Wait { pen: Option<Pen>, publish: Option<RunState> },
+    /// Send the pen to `pen` if `Some`, publish `publish`, and wait for work.
+    Wait { pen: Option<Pen>, publish: RunState },
 }
 
 /// What a trip does once the pulses have stopped and everything planned was dropped.
@@ -173,16 +173,17 @@ impl Supervisor {
         Take::Plan { pen }
     }
 
-    /// A fill ended at `end`; `queued` when it queued steps, the run state being `state`.
-    pub fn filled(&self, end: FillEnd, queued: bool, state: RunState) -> Filled {
+    /// A fill ended at `end`; `queued` when it queued steps.
+    pub fn filled(&self, end: FillEnd, queued: bool) -> Filled {
+        let publish = queued.then_some(self.moving);
         match end {
             // A curve stopped part way (the travel guard at the edge, or a curve failing where
             // the builder's trace did not): a defect upstream, since the builder refuses both.
             // Stop there, drop what was planned after it (it was planned from a point the pen
             // never reached, and its lines were answered `ok`) and raise an alarm at once, as
             // GRBL does.
-            FillEnd::CurveFailed(e) => Filled { publish: Some(RunState::Alarm), alarm: Some(MotionFault::Curve(e)) },
-            _ => Filled { publish: (queued && state != RunState::Alarm).then_some(self.moving), alarm: None },
+            FillEnd::CurveFailed(e) => Filled { publish, alarm: Some(MotionFault::Curve(e)) },
+            _ => Filled { publish, alarm: None },
         }
     }
 
@@ -208,18 +209,13 @@ impl Supervisor {
         Then { rest, plan_empty, next }
     }
 
-    /// Everything planned has been emitted: a job `held` back or not, `queued_jobs` waiting,
-    /// the run state being `state`.
-    pub fn at_rest(&mut self, held: bool, queued_jobs: usize, state: RunState, settings: &Settings) -> AtRest {
+    /// Everything planned has been emitted: a job `held` back or not, `queued_jobs` waiting.
+    pub fn at_rest(&mut self, held: bool, queued_jobs: usize, settings: &Settings) -> AtRest {
         if held {
             return AtRest::TakeHeld;
         }
         let raise = core::mem::take(&mut self.raise_at_rest) && queued_jobs == 0;
-        AtRest::Wait {
-            pen: raise.then(|| pen::at_program_end(settings)).flatten(),
-            // An alarm stays until `$X`.
-            publish: (state != RunState::Alarm).then_some(RunState::Idle),
-        }
+        AtRest::Wait { pen: raise.then(|| pen::at_program_end(settings)).flatten(), publish: RunState::Idle }
     }
 
     /// `trip` stopped the machine; `homing_switch` when it is the switch a homing approach
@@ -244,9 +240,9 @@ mod tests {
         Settings { pen_lift: 1, ..Settings::default() }
     }
 
-    /// The run state published once a fill queued steps while in `state`.
-    fn moving(s: &Supervisor, state: RunState) -> Option<RunState> {
-        s.filled(FillEnd::QueueFull, true, state).publish
+    /// The motion's state published once a fill queued steps.
+    fn moving(s: &Supervisor) -> Option<RunState> {
+        s.filled(FillEnd::QueueFull, true).publish
     }
 
     #[test]
@@ -257,7 +253,7 @@ mod tests {
         // The drawing's last steps are queued: the plan is not empty while a job waits.
         let then = s.then(FillEnd::PlanEmpty, PlannerState::Idle, true, true, false);
         assert_eq!(then, Then { rest: true, plan_empty: Some(false), next: Next::Rest });
-        assert_eq!(s.at_rest(true, 0, RunState::Run, &pen_lift()), AtRest::TakeHeld);
+        assert_eq!(s.at_rest(true, 0, &pen_lift()), AtRest::TakeHeld);
         assert_eq!(s.take(PEN_DOWN, Pen::Up, true), Take::Plan { pen: Some(Pen::Down) });
     }
 
@@ -271,49 +267,37 @@ mod tests {
     #[test]
     fn a_jog_reports_jog_and_a_drawing_or_homing_move_run() {
         let mut s = Supervisor::new();
-        assert_eq!(moving(&s, RunState::Idle), Some(RunState::Run), "before any job");
+        assert_eq!(moving(&s), Some(RunState::Run), "before any job");
         s.take(JOG, Pen::Up, true);
-        assert_eq!(moving(&s, RunState::Idle), Some(RunState::Jog));
+        assert_eq!(moving(&s), Some(RunState::Jog));
         s.take(HOME, Pen::Up, true);
-        assert_eq!(moving(&s, RunState::Jog), Some(RunState::Run));
+        assert_eq!(moving(&s), Some(RunState::Run));
         s.take(DRAW, Pen::Up, true);
-        assert_eq!(moving(&s, RunState::Idle), Some(RunState::Run));
-        assert_eq!(s.filled(FillEnd::PlanEmpty, false, RunState::Run).publish, None, "nothing queued: as it was");
-    }
-
-    #[test]
-    fn an_alarm_stays_until_unlock_and_a_finished_job_does_not_clear_it() {
-        let mut s = Supervisor::new();
-        s.take(DRAW, Pen::Up, true);
-        assert_eq!(moving(&s, RunState::Alarm), None, "moving in an alarm reports the alarm");
-        let rest = s.at_rest(false, 0, RunState::Alarm, &pen_lift());
-        assert_eq!(rest, AtRest::Wait { pen: None, publish: None }, "at rest the alarm stays");
-        // `$X` leaves the alarm: the next rest is idle.
-        let rest = s.at_rest(false, 0, RunState::Run, &pen_lift());
-        assert_eq!(rest, AtRest::Wait { pen: None, publish: Some(RunState::Idle) });
+        assert_eq!(moving(&s), Some(RunState::Run));
+        assert_eq!(s.filled(FillEnd::PlanEmpty, false).publish, None, "nothing queued: as it was");
     }
 
     #[test]
     fn a_keypad_drawing_raises_the_pen_at_rest_unless_a_job_is_queued_behind_it() {
         let mut s = Supervisor::new();
         assert_eq!(s.take(KEYPAD, Pen::Up, true), Take::Plan { pen: Some(Pen::Down) });
-        let rest = s.at_rest(false, 0, RunState::Run, &pen_lift());
-        assert_eq!(rest, AtRest::Wait { pen: Some(Pen::Up), publish: Some(RunState::Idle) });
-        let again = s.at_rest(false, 0, RunState::Idle, &pen_lift());
-        assert_eq!(again, AtRest::Wait { pen: None, publish: Some(RunState::Idle) }, "once");
+        let rest = s.at_rest(false, 0, &pen_lift());
+        assert_eq!(rest, AtRest::Wait { pen: Some(Pen::Up), publish: RunState::Idle });
+        let again = s.at_rest(false, 0, &pen_lift());
+        assert_eq!(again, AtRest::Wait { pen: None, publish: RunState::Idle }, "once");
 
         s.take(KEYPAD, Pen::Up, true);
-        let rest = s.at_rest(false, 1, RunState::Run, &pen_lift());
-        assert_eq!(rest, AtRest::Wait { pen: None, publish: Some(RunState::Idle) }, "a job behind it");
+        let rest = s.at_rest(false, 1, &pen_lift());
+        assert_eq!(rest, AtRest::Wait { pen: None, publish: RunState::Idle }, "a job behind it");
 
         s.take(KEYPAD, Pen::Up, true);
         s.take(DRAW, Pen::Down, false);
-        let rest = s.at_rest(false, 0, RunState::Run, &pen_lift());
-        assert_eq!(rest, AtRest::Wait { pen: None, publish: Some(RunState::Idle) }, "a host job followed it");
+        let rest = s.at_rest(false, 0, &pen_lift());
+        assert_eq!(rest, AtRest::Wait { pen: None, publish: RunState::Idle }, "a host job followed it");
 
         s.take(KEYPAD, Pen::Up, true);
-        let rest = s.at_rest(false, 0, RunState::Run, &Settings::default());
-        assert_eq!(rest, AtRest::Wait { pen: None, publish: Some(RunState::Idle) }, "no pen lift");
+        let rest = s.at_rest(false, 0, &Settings::default());
+        assert_eq!(rest, AtRest::Wait { pen: None, publish: RunState::Idle }, "no pen lift");
     }
 
     #[test]
@@ -321,15 +305,15 @@ mod tests {
         let mut s = Supervisor::new();
         s.take(DRAW, Pen::Up, true);
         let failed = FillEnd::CurveFailed(CurveError::Travel);
-        let filled = s.filled(failed, true, RunState::Run);
+        let filled = s.filled(failed, true);
         let alarm = Some(MotionFault::Curve(CurveError::Travel));
-        assert_eq!(filled, Filled { publish: Some(RunState::Alarm), alarm });
+        assert_eq!(filled, Filled { publish: Some(RunState::Run), alarm }, "the motion brakes under the alarm");
         // Braking after the abort: no rest yet, the task looks again.
         let then = s.then(failed, PlannerState::Aborting, false, false, false);
         assert_eq!(then, Then { rest: false, plan_empty: Some(false), next: Next::Retry });
         let stopped = s.then(failed, PlannerState::Idle, true, false, false);
         assert_eq!(stopped, Then { rest: true, plan_empty: Some(true), next: Next::Rest });
-        assert_eq!(s.filled(FillEnd::PlanEmpty, true, RunState::Run).alarm, None, "a curve that ends raises nothing");
+        assert_eq!(s.filled(FillEnd::PlanEmpty, true).alarm, None, "a curve that ends raises nothing");
     }
 
     #[test]

@@ -133,7 +133,7 @@ pub async fn run(
         let steps_before = queued.steps;
         let end = fill(machine, planner, &mut steps, &mut queued, &mut work).await;
         let queued_more = queued.steps != steps_before;
-        let filled = supervisor.filled(end, queued_more, machine.run_state());
+        let filled = supervisor.filled(end, queued_more);
         carry_out(machine, planner, filled, queued_more, &mut held);
         let then = supervisor.then(end, planner.state(), planner.is_idle(), held.is_some(), queued.resting);
         if then.rest {
@@ -224,7 +224,7 @@ fn carry_out(
     }
     if let Some(fault) = filled.alarm {
         error!("curve stopped part way: {:?}", fault);
-        machine.set_fault(Some(fault));
+        machine.raise_alarm(fault);
         abort(machine, planner, held);
     }
 }
@@ -254,16 +254,14 @@ async fn rest(
         info!("at rest at ({}, {}) steps", at.x, at.y);
     }
     let settings = machine.settings();
-    match supervisor.at_rest(held, machine.queued_jobs(), machine.run_state(), &settings) {
+    match supervisor.at_rest(held, machine.queued_jobs(), &settings) {
         // The held job moves the pen and goes on.
         AtRest::TakeHeld => {}
         AtRest::Wait { pen, publish } => {
             if let Some(pen) = pen {
                 machine.set_pen(pen);
             }
-            if let Some(state) = publish {
-                machine.set_run_state(state);
-            }
+            machine.set_run_state(publish);
             wait_for_work(machine, planner).await;
         }
     }
@@ -305,8 +303,9 @@ async fn halted(
             machine.found_switch(trip);
         }
         Tripped::Alarm(fault) => {
-            machine.set_run_state(RunState::Alarm);
-            machine.set_fault(Some(fault));
+            // The pulses stopped at once: the motion rests, under the alarm.
+            machine.set_run_state(RunState::Idle);
+            machine.raise_alarm(fault);
             machine.abort_plan();
         }
     }
@@ -369,7 +368,7 @@ fn plan(machine: MotionWriter<'_>, planner: &mut Planner<Curve, PLANNER_SEGMENTS
     let end = job.drawing.end();
     info!("job planned to ({}, {}) steps", end.x, end.y);
     machine.set_drawing(job.drawing.kind());
-    machine.set_fault(None);
+    machine.forget_fault();
     let curve = match job.kind {
         // Built without the travel check: see `Job::homing_move`.
         JobKind::Home => job.drawing.into_curve(),
