@@ -263,7 +263,7 @@ impl ProgramCheck {
         self.trail.map()
     }
 
-    /// How the picture maps the travel.
+    /// How the picture maps the travel (the travel of the settings the check started with).
     pub fn scale(&self) -> &MapScale {
         &self.scale
     }
@@ -305,9 +305,9 @@ impl ProgramCheck {
             }
             Command::SetSetting { id, value } => {
                 // Checked by the parser against these very settings: it applies.
+                // The picture keeps the travel it started with: its pixels are set already.
                 if self.settings.set(id, value).is_ok() {
                     planner.set_limits(Limits::from_settings(&self.settings));
-                    self.scale = MapScale::for_travel(&self.settings);
                 }
             }
             // An M0 pause waits for the user, a report answers at once: no time of the plot's.

@@ -6,31 +6,29 @@ use embedded_graphics::geometry::{OriginDimensions, Point as ScreenPoint, Size};
 use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::prelude::DrawTarget;
 
-use super::check::{CheckPlanner, ProgramCheck, Progress, Refusal, Summary};
+use super::check::{CheckPlanner, PLAN_SLICE_STEPS, ProgramCheck, Progress, Refusal, Summary};
 use super::preview::{self, MapScale, PREVIEW_HEIGHT_PX, PREVIEW_WIDTH_PX, PlotProgress};
 use crate::geom::Point;
 use crate::host::{GcodeState, GrblError, report};
 use crate::machine_io::pen::Pen;
+use crate::motion::drawing::BUILD_SLICE_STEPS;
+use crate::motion::interp::Method;
 use crate::motion::planner::Limits;
 use crate::settings::Settings;
 
 /// Checks `program` with `settings` from machine zero, the pen up; the outcome, the summary,
-/// the check (for its picture) and the most calls one line took.
+/// the check (for its picture) and the calls of `work` it took.
 fn check(program: &str, settings: &Settings) -> (Progress, Summary, Box<ProgramCheck>, usize) {
     let mut planner: Box<CheckPlanner> = Box::new(CheckPlanner::new(Limits::from_settings(settings)));
     let mut check = Box::new(ProgramCheck::new(GcodeState::new(), settings, Pen::Up));
     check.start(GcodeState::new(), settings, Pen::Up, &mut planner);
-    let mut most_calls = 0;
+    let mut calls = 0;
     let mut run = |check: &mut ProgramCheck| {
-        let mut calls = 0;
         loop {
             calls += 1;
             match check.work(&mut planner) {
                 Progress::Working => {}
-                done => {
-                    most_calls = most_calls.max(calls);
-                    return done;
-                }
+                done => return done,
             }
         }
     };
@@ -38,13 +36,13 @@ fn check(program: &str, settings: &Settings) -> (Progress, Summary, Box<ProgramC
         assert!(check.push_line(line));
         if let Progress::Refused(r) = run(&mut check) {
             let summary = check.summary();
-            return (Progress::Refused(r), summary, check, most_calls);
+            return (Progress::Refused(r), summary, check, calls);
         }
     }
     assert!(check.end());
     let done = run(&mut check);
     let summary = check.summary();
-    (done, summary, check, most_calls)
+    (done, summary, check, calls)
 }
 
 fn pen_lift() -> Settings {
@@ -131,10 +129,14 @@ fn the_plot_time_adds_dwells_and_pen_settles_to_the_planners_steps() {
 
 #[test]
 fn a_long_curve_is_checked_a_bounded_slice_at_a_time() {
-    // A circle of 50 mm radius: 40,000 steps, far more than one call walks or plans.
-    let (done, summary, _, calls) = check("$O R50 F3000\n", &Settings::default());
+    // A circle of 50 mm radius: 40,000 steps one axis at a time (eight times the radius in
+    // steps), far more than one call walks or plans.
+    let settings = Settings { method: Method::Classic, ..Settings::default() };
+    let (done, summary, _, calls) = check("$O R50 F3000\n", &settings);
     assert_eq!(done, Progress::Done);
-    assert!(calls > 10, "{calls} calls");
+    let steps = 8 * 50 * settings.steps_per_mm[0] as usize;
+    let slices = steps / BUILD_SLICE_STEPS as usize + steps / PLAN_SLICE_STEPS;
+    assert!(calls >= slices, "{calls} calls for {slices} slices' worth");
     assert!(summary.plot_time_us > 6_000_000, "{} µs", summary.plot_time_us);
 }
 
