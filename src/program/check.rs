@@ -21,10 +21,11 @@
 //! many as it has steps over [`PLAN_SLICE_STEPS`]; the line's text is needed only by
 //! `push_line`. Nothing here waits, reads a card or moves anything.
 //!
-//! Commands of the host's session have no place in a program and are refused with `error:8`
-//! (the machine is not at rest while a program runs): `$C`, `$H`, `$RST=`, `$J=` by the parser
-//! itself, `$X`, `$SLP`, `$Nn=` and `$I=` here. A setting (`$nnn=`) applies to the lines after
-//! it, as it will when the program runs.
+//! Commands of the host's session have no place in a program and are refused as the parser
+//! refuses them while a program runs (`$C`, `$RST=`, `$J=`: `error:8`; `$H`: `error:5` without
+//! homing switches, else 8), or here with `error:8` (`$X`, `$SLP`, `$Nn=`, `$I=`: the machine is
+//! not at rest while a program runs). A setting (`$nnn=`) applies to the lines after it, as it
+//! will when the program runs.
 
 use crate::geom::{Axis, Point, StepCmd, TICK_HZ};
 use crate::host::gcode::Pending;

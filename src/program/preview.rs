@@ -241,3 +241,37 @@ pub fn draw<D: DrawTarget<Color = BinaryColor>>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wide_travel_fills_the_width_and_is_centred_in_the_height() {
+        // 400 x 100 mm: 121 pixels wide, so 30 high (aspect kept), a row above and below.
+        let settings = Settings { max_travel_mm: [200.0, 50.0], ..Settings::default() };
+        let scale = MapScale::for_travel(&settings);
+        assert_eq!(scale.outline(), ((0, 0), (121, 30)));
+        let spm = settings.steps_per_mm;
+        let at = |x: f32, y: f32| Point::new((x * spm[0]) as i32, (y * spm[1]) as i32);
+        assert_eq!(scale.pixel(at(-200.0, 50.0)), (0, 0), "top left of the travel");
+        assert_eq!(scale.pixel(at(200.0, -50.0)), (121, 30), "bottom right");
+        assert_eq!(scale.pixel(at(500.0, -500.0)), (121, 31), "beyond the picture: clamped to it");
+    }
+
+    #[test]
+    fn a_line_sets_every_pixel_between_its_ends_and_no_other() {
+        let lit = |map: &StrokeMap| -> std::vec::Vec<Pixel8> {
+            let all = (0..PREVIEW_HEIGHT_PX).flat_map(|y| (0..PREVIEW_WIDTH_PX).map(move |x| (x, y)));
+            all.filter(|&p| map.get(p)).collect()
+        };
+        let mut map = StrokeMap::new();
+        map.line((2, 3), (10, 7));
+        assert_eq!(lit(&map).len(), 9, "one pixel per column: {:?}", lit(&map));
+        assert!(map.get((2, 3)) && map.get((10, 7)) && map.get((6, 5)));
+        map.set((200, 200));
+        assert_eq!(lit(&map).len(), 9, "a pixel off the picture is ignored");
+        map.clear();
+        assert!(map.is_empty());
+    }
+}

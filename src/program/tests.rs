@@ -261,9 +261,9 @@ fn during_a_plot_the_drawn_part_is_solid_the_rest_dotted_and_the_pen_marked() {
     let top: Vec<bool> = (53..=68).map(|x| screen.at(x, 8)).collect();
     assert!(top.iter().step_by(2).all(|p| !*p) || top.iter().skip(1).step_by(2).all(|p| !*p), "dotted: {top:?}");
     assert!(top.iter().any(|p| *p), "but shown");
-    // The pen at (100, 0) mm: pixel (68, 16)(rounded), a hollow square around it.
-    let (px, py) = progress.pen().expect("pen seen");
-    let (px, py) = (i32::from(px), i32::from(py));
+    // The pen at (100, 0) mm: pixel (60.5 + 7.75, 15.5) rounded, a hollow square around it.
+    assert_eq!(progress.pen(), Some((68, 16)));
+    let (px, py) = (68, 16);
     assert!(!screen.at(px, py), "the mark's middle is dark");
     for (dx, dy) in [(-1, -1), (1, -1), (-1, 1), (1, 1), (-1, 0), (0, 1)] {
         assert!(screen.at(px + dx, py + dy), "mark pixel ({dx}, {dy})");
