@@ -94,12 +94,13 @@ fn polyline_file() -> String {
     out
 }
 
-/// A file of arcs: a chain of quarter and half arcs of different radii both ways, full
-/// circles, an R-word arc and lines between.
+/// A file of arcs: a chain of half circles of different radii turning both ways (a scalloped
+/// line), full circles, an R-word arc and lines between.
 fn arc_file() -> String {
-    let mut out = String::from("G21\nG90\nG0 X-80 Y0\nF2400\n");
-    let mut x = -80.0;
-    for (i, r) in [5.0, 10.0, 3.0, 8.0, 12.0, 6.0].into_iter().enumerate() {
+    let mut out = String::from("G21\nG90\nG0 X-150 Y0\nF2400\n");
+    let mut x = -150.0;
+    let radii = [5.0, 10.0, 3.0, 8.0, 12.0, 6.0, 1.5, 4.0];
+    for (i, r) in radii.iter().chain(&radii).chain(&radii).map(|r| r / 2.0).enumerate() {
         let g = if i % 2 == 0 { "G2" } else { "G3" };
         writeln!(out, "{g} X{:.3} Y0 I{r:.3} J0", x + 2.0 * r).unwrap();
         x += 2.0 * r;
