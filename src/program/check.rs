@@ -17,9 +17,11 @@
 //! [`ProgramCheck::work`] does one bounded piece: a slice of the builder's walk
 //! ([`BUILD_SLICE_STEPS`] steps' worth, as the host link builds a line), the line's commit, or
 //! at most [`PLAN_SLICE_STEPS`] step commands of the planner; and returns, so the caller may
-//! yield between calls. A line takes as many calls as its curve has slices, and its motion as
-//! many as it has steps over [`PLAN_SLICE_STEPS`]; the line's text is needed only by
-//! `push_line`. Nothing here waits, reads a card or moves anything.
+//! yield between calls. A line of `n` steps takes about `n / BUILD_SLICE_STEPS` calls to walk
+//! (a curve; a straight line none) and `n / PLAN_SLICE_STEPS` to time, each call within a few
+//! milliseconds of the F407: a circle of 100 mm diameter (40,000 steps at the defaults) about
+//! 65 calls. The line's text is needed only by `push_line`. Nothing here waits, reads a card or
+//! moves anything.
 //!
 //! Commands of the host's session have no place in a program and are refused as the parser
 //! refuses them while a program runs (`$C`, `$RST=`, `$J=`: `error:8`; `$H`: `error:5` without
@@ -46,8 +48,9 @@ pub type CheckPlanner = Planner<Curve, PLANNER_SEGMENTS>;
 
 /// Step commands one [`ProgramCheck::work`] takes from the planner at most. The planner's work
 /// per step is within the motion's budget (at most 400 instructions per step, the dearest curve,
-/// see the README's cost table) and the picture's a few more, so a call takes at most about
-/// 2.5 ms of the F407: well within the 10 ms any task may hold the processor.
+/// see the README's cost table) and the picture's a few dozen more (a pixel per step), so a
+/// call should take at most about 2.5 ms of the F407 (an estimate from those budgets, not yet
+/// counted on the model board): well within the 10 ms any task may hold the processor.
 pub const PLAN_SLICE_STEPS: usize = 1024;
 
 /// Step commands taken from the planner at a time, within a call.
