@@ -24,6 +24,7 @@ pub mod machine_io;
 pub mod math;
 pub mod motion;
 pub mod panel;
+pub mod program;
 pub mod settings;
 pub mod status;
 pub mod store;

@@ -218,6 +218,12 @@ impl Pending {
         }
     }
 
+    /// The line's commands once it is [committed](GcodeState::commit), those not yet taken: a
+    /// caller that takes them a few at a time comes back for the rest here.
+    pub fn commands(&mut self) -> &mut Commands {
+        &mut self.commands
+    }
+
     /// True when the line asks nothing of the machine (it only changes modes).
     pub fn is_empty(&self) -> bool {
         self.curve.is_none() && self.commands.is_empty()
