@@ -13,6 +13,7 @@
 //! interrupt level, polled whenever they are woken; the others in thread mode, polled only
 //! while no work charged there (a slice of a build, see [`cpu::ThreadLevel`]) holds it.
 
+pub mod card;
 pub mod cli;
 pub mod clock;
 pub mod cpu;
