@@ -2,6 +2,7 @@
 //! crate, as a [`Card`]; and a card formatted without a partition table (as `mkfs.fat -C`
 //! makes an image, and some cards come) seen as one with a single partition.
 
+use core::cell::Cell;
 use core::ops::ControlFlow;
 
 use embedded_sdmmc::{
@@ -42,23 +43,33 @@ fn is_boot_sector(block: &Block) -> bool {
 }
 
 /// A card's blocks as a partitioned card's: one without a partition table is shown a made-up
-/// block 0 with one FAT partition, its own blocks after it.
+/// block 0 with one FAT partition, its own blocks after it. Which one a card is, is learnt each
+/// time block 0 is read (every volume is opened by reading it), so a card changed in the slot
+/// is seen as it is.
 pub struct Partitioned<D> {
     inner: D,
-    /// The made-up block 0, if the card has no partition table.
-    table: Option<Block>,
+    /// The card has no partition table: its own block 0 is the FAT's boot sector.
+    bare: Cell<bool>,
 }
 
 impl<D: BlockDevice> Partitioned<D> {
-    /// Looks at the card's block 0 (a card that cannot be read is taken as it is: opening its
-    /// volume says why).
     pub fn new(inner: D) -> Self {
-        let mut first = [Block::new()];
-        let table = match inner.read(&mut first, BlockIdx(0)) {
-            Ok(()) if is_boot_sector(&first[0]) => inner.num_blocks().ok().map(|n| table_for(&first[0], n)),
-            _ => None,
-        };
-        Partitioned { inner, table }
+        Partitioned { inner, bare: Cell::new(false) }
+    }
+
+    /// The card's own blocks.
+    pub fn inner_mut(&mut self) -> &mut D {
+        &mut self.inner
+    }
+
+    /// Block 0 as seen: the card's own, or the table made up for a card without one.
+    fn read_first(&self, first: &mut Block) -> Result<(), D::Error> {
+        self.inner.read(core::slice::from_mut(first), BlockIdx(0))?;
+        self.bare.set(is_boot_sector(first));
+        if self.bare.get() {
+            *first = table_for(first, self.inner.num_blocks()?);
+        }
+        Ok(())
     }
 }
 
@@ -81,31 +92,33 @@ impl<D: BlockDevice> BlockDevice for Partitioned<D> {
     type Error = D::Error;
 
     fn read(&self, blocks: &mut [Block], start: BlockIdx) -> Result<(), Self::Error> {
-        let Some(table) = &self.table else {
-            return self.inner.read(blocks, start);
-        };
         match (start.0, blocks) {
             (0, [first, rest @ ..]) => {
-                *first = table.clone();
-                if rest.is_empty() { Ok(()) } else { self.inner.read(rest, BlockIdx(0)) }
+                self.read_first(first)?;
+                match (rest.is_empty(), self.bare.get()) {
+                    (true, _) => Ok(()),
+                    (false, true) => self.inner.read(rest, BlockIdx(0)),
+                    (false, false) => self.inner.read(rest, BlockIdx(1)),
+                }
             }
-            (n, blocks) => self.inner.read(blocks, BlockIdx(n - 1)),
+            (n, blocks) if self.bare.get() => self.inner.read(blocks, BlockIdx(n - 1)),
+            (_, blocks) => self.inner.read(blocks, start),
         }
     }
 
     fn write(&self, blocks: &[Block], start: BlockIdx) -> Result<(), Self::Error> {
-        match (&self.table, start.0, blocks) {
-            (None, _, _) => self.inner.write(blocks, start),
+        match (self.bare.get(), start.0, blocks) {
+            (false, _, _) => self.inner.write(blocks, start),
             // The made-up table is never written.
-            (Some(_), 0, [_]) => Ok(()),
-            (Some(_), 0, [_, rest @ ..]) => self.inner.write(rest, BlockIdx(0)),
-            (Some(_), n, blocks) => self.inner.write(blocks, BlockIdx(n - 1)),
+            (true, 0, [_]) => Ok(()),
+            (true, 0, [_, rest @ ..]) => self.inner.write(rest, BlockIdx(0)),
+            (true, n, blocks) => self.inner.write(blocks, BlockIdx(n - 1)),
         }
     }
 
     fn num_blocks(&self) -> Result<BlockCount, Self::Error> {
         let n = self.inner.num_blocks()?;
-        Ok(if self.table.is_some() { BlockCount(n.0 + 1) } else { n })
+        Ok(if self.bare.get() { BlockCount(n.0 + 1) } else { n })
     }
 }
 
@@ -143,6 +156,12 @@ impl<D: BlockDevice> FatCard<D> {
                 Err(card_error(e))
             }
         }
+    }
+
+    /// Reaches the card's own blocks through `f` (to change how they are read: a board's SPI
+    /// clock).
+    pub fn with_blocks<R>(&self, f: impl FnOnce(&mut D) -> R) -> R {
+        self.volumes.device(|blocks| f(blocks.inner_mut()))
     }
 
     fn close_root(&self, volume: RawVolume, dir: RawDirectory) {

@@ -71,7 +71,7 @@ impl CardLines {
 
     /// The file's next line, reading `card` as needed. A last line without a line end is a
     /// line too.
-    pub fn next<'s>(&'s mut self, card: &mut impl Card) -> Result<CardLine<'s>, CardError> {
+    pub fn next<'s>(&'s mut self, card: &mut dyn Card) -> Result<CardLine<'s>, CardError> {
         loop {
             let Some(byte) = self.next_byte(card)? else {
                 if self.ended {
@@ -111,7 +111,7 @@ impl CardLines {
     }
 
     /// The file's next byte, `None` at its end.
-    fn next_byte(&mut self, card: &mut impl Card) -> Result<Option<u8>, CardError> {
+    fn next_byte(&mut self, card: &mut dyn Card) -> Result<Option<u8>, CardError> {
         if self.at == self.filled {
             if self.ended {
                 return Ok(None);

@@ -151,6 +151,20 @@ mod tests {
     }
 
     #[test]
+    fn a_card_with_a_partition_table_reads_the_same() {
+        let bare = image_of(&[("plot.nc", b"G0 X1\nG1 Y2\n")]).unwrap();
+        let mut image = std::vec![0u8; BLOCK_BYTES];
+        let entry = &mut image[446..462];
+        entry[4] = 0x0E;
+        entry[8..12].copy_from_slice(&1u32.to_le_bytes());
+        entry[12..16].copy_from_slice(&((bare.len() / BLOCK_BYTES) as u32).to_le_bytes());
+        image[510..512].copy_from_slice(&[0x55, 0xAA]);
+        image.extend_from_slice(&bare);
+        let mut card = FatCard::new(ImageBlocks::new(image));
+        assert_eq!(lines_of(&mut card, 0), ["G0X1", "G1Y2"]);
+    }
+
+    #[test]
     fn a_card_that_is_not_fat_says_so() {
         let mut card = FatCard::new(ImageBlocks::new(std::vec![0x5Au8; 64 * BLOCK_BYTES]));
         assert_eq!(card.files(), Err(CardError::NotFat));
