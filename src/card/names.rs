@@ -4,10 +4,11 @@
 use heapless::{String, Vec};
 
 /// Files the card's list holds: beyond this many G-code files, the first ones in name order
-/// are listed.
-pub const CARD_FILES_MAX: usize = 32;
-/// Longest file name kept, in bytes (a long name beyond it is shown by its 8.3 name).
-pub const CARD_NAME_MAX_BYTES: usize = 48;
+/// are listed. The list lives in the menu (about 1.3 KB on the board).
+pub const CARD_FILES_MAX: usize = 24;
+/// Longest file name kept, in bytes: more than the LCD's line shows (a long name beyond it is
+/// shown by its 8.3 name).
+pub const CARD_NAME_MAX_BYTES: usize = 32;
 /// A short (8.3) name as `NAME.EXT`: 12 bytes.
 pub const CARD_SHORT_NAME_MAX_BYTES: usize = 12;
 
