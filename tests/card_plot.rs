@@ -136,3 +136,25 @@ fn d_aborts_a_card_plot_keeping_the_position_and_sending_nothing_more() {
     assert_eq!(Some(&report.position), drawn.last(), "the position is where the pen stopped");
     assert!(shown(&report, "Aborted") || shown(&report, "aborted"), "the abort is said");
 }
+
+#[test]
+fn a_reset_on_the_host_link_ends_a_card_plot() {
+    let chosen = drawing();
+    let serial = SimSerial::with_input(b"").with_byte_at(4_000_000, 0x18);
+    let keys = KeyScript::parse(&format!("{TO_CARD} #")).unwrap();
+    let card = Some(card(&[("plot.gcode", chosen.as_bytes())]));
+    let report = sim::run(SimConfig { keys, serial, card, ..SimConfig::default() });
+    let wire = sim::run_serial(&chosen).path();
+    let drawn = report.path();
+    assert!(drawn.len() > 10 && drawn.len() < wire.len(), "stopped part way: {} of {}", drawn.len(), wire.len());
+    assert_eq!(drawn[..], wire[..drawn.len()], "what was drawn is the file's start");
+    assert_eq!(report.answers().matches("Grbl 1.1").count(), 2, "the reset's banner: {}", report.answers());
+}
+
+#[test]
+fn the_card_mode_speaks_chinese_too() {
+    // 0 switches the language (the cursor then on it, the tenth mode): B # enters the card mode.
+    let report = run_keys_with(None, "0 wait:300 B #");
+    assert!(shown(&report, "存储卡"), "the title");
+    assert!(shown(&report, "无卡"), "no card");
+}
