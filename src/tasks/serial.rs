@@ -16,6 +16,10 @@
 //! link sent before it, resets the parser and greets that link with the banner; the other links
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
 //!
+//! A file plotted from the card (chosen on the keypad) is the line loop's third line source: its
+//! lines go through the same parser, each answered to the plot; while it runs, the links' lines
+//! are refused (see `card_plot`).
+//!
 //! Where a line is parsed from, and what each command of it waits for, is refused on and answers,
 //! are [`crate::host::guards`]'s rules: the line loop waits, acts and answers as they say.
 //!
