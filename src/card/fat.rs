@@ -6,8 +6,8 @@ use core::cell::Cell;
 use core::ops::ControlFlow;
 
 use embedded_sdmmc::{
-    Block, BlockCount, BlockDevice, BlockIdx, Error, LfnBuffer, Mode, RawDirectory, RawFile, RawVolume, TimeSource,
-    Timestamp, VolumeIdx, VolumeManager,
+    Block, BlockCount, BlockDevice, BlockIdx, Error, LfnBuffer, Mode, RawDirectory, RawFile, RawVolume, ShortFileName,
+    TimeSource, Timestamp, VolumeIdx, VolumeManager,
 };
 use heapless::String;
 
@@ -188,9 +188,7 @@ impl<D: BlockDevice> Card for FatCard<D> {
         let mut long = LfnBuffer::new(&mut storage);
         let listed = self.volumes.iterate_dir_lfn(dir, &mut long, |entry, long| {
             if !entry.attributes.is_directory() && !entry.attributes.is_volume() {
-                let mut short = String::<CARD_SHORT_NAME_MAX_BYTES>::new();
-                let _ = core::fmt::write(&mut short, format_args!("{}", entry.name));
-                files.offer(&short, long, entry.size);
+                files.offer(&short_name(&entry.name), long, entry.size);
             }
             ControlFlow::Continue(())
         });
@@ -230,4 +228,18 @@ impl<D: BlockDevice> Card for FatCard<D> {
             self.close_root(volume, dir);
         }
     }
+}
+
+/// An 8.3 name as text, `BASE.EXT`: its bytes as they are (ISO-8859-1), written without core's
+/// formatting (whose padding code the image does without).
+fn short_name(name: &ShortFileName) -> String<CARD_SHORT_NAME_MAX_BYTES> {
+    let mut short = String::new();
+    let dot: &[u8] = if name.extension().is_empty() { b"" } else { b"." };
+    for &b in name.base_name().iter().chain(dot).chain(name.extension()) {
+        // 8 + 1 + 3 ASCII bytes fit; a byte beyond ASCII takes two and may not.
+        if short.push(char::from(b)).is_err() {
+            break;
+        }
+    }
+    short
 }
