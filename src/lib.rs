@@ -14,6 +14,7 @@ extern crate std;
 #[macro_use]
 mod fmt;
 
+pub mod card;
 #[cfg(target_os = "none")]
 pub mod critical;
 pub mod decimal;

@@ -107,7 +107,8 @@ fn key_0_switches_the_screen_to_chinese_and_a_power_cycle_keeps_it() {
     let (_, last) = first.frames.last().unwrap();
     let lines: Vec<String> = (0..4).map(|line| text(last, line, 24)).collect();
     assert_eq!(lines[0], "SERVOPLOT           空闲");
-    assert_eq!(lines[2..], [" 9 速度预设", ">0 语言 Language"]);
+    // The card mode follows the tenth, without a digit.
+    assert_eq!(lines[2..], [">0 语言 Language", "   存储卡文件"]);
 
     // The next power-up greets in Chinese, and the host link reads and sets the language (once
     // the splash is up: the LCD controller takes 90 ms to start).

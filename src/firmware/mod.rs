@@ -22,6 +22,7 @@ use core::pin::Pin;
 use defmt::info;
 use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
 use embassy_time::{Duration, Timer};
+use servoplot::card::CardSlot;
 use servoplot::machine::{HomingWriter, HostWriter, Machine, MotionWriter, ServoWriter};
 use servoplot::machine_io::health::{self, Health};
 use servoplot::motion::interp::Curve;
@@ -47,16 +48,18 @@ static MACHINE: StaticCell<Machine> = StaticCell::new();
 static STEP_QUEUE: ConstStaticCell<StepQueue> = ConstStaticCell::new(StepQueue::new());
 static PLANNER: StaticCell<Planner<Curve, PLANNER_SEGMENTS>> = StaticCell::new();
 static STORE: StaticCell<Store<board::Flash>> = StaticCell::new();
-/// The host link's future, 15 KB (its links' pipes and answers, the parser and the drawing it
+/// The host link's future, 17 KB (its links' pipes and answers, the parser and the drawing it
 /// builds): built in its slot, not on the stack (see `slot`).
 static HOST_LINK: FutureSlot<HOST_LINK_FUTURE_BYTES> = FutureSlot::new();
 /// The host links' ends.
 type Links = ((board::HostRx, board::HostTx), (board::LinkRx, board::LinkTx));
 static LINKS: StaticCell<Links> = StaticCell::new();
 /// Room for it, bytes: a build fails should it outgrow this.
-const HOST_LINK_FUTURE_BYTES: usize = 16 * 1024;
+const HOST_LINK_FUTURE_BYTES: usize = 18 * 1024;
 /// The keypad menu, shared by the keypad and LCD tasks (both in thread mode).
 static PANEL: StaticCell<Panel> = StaticCell::new();
+/// The board's card slot, shared by the keypad and host link tasks (both in thread mode).
+static CARD_SLOT: StaticCell<CardSlot<'static>> = StaticCell::new();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -94,7 +97,8 @@ fn start(spawner: Spawner) {
     motion_spawner.spawn(timed(motion(handles.motion, planner, steps), "motion", Executor::Interrupt));
 
     let panel: &'static Panel = PANEL.init_with(Panel::new);
-    spawner.spawn(timed(keypad(machine, panel, board.columns, board.rows), "keypad", Executor::ThreadMode));
+    let card: &'static CardSlot<'static> = CARD_SLOT.init(CardSlot::new(board.card));
+    spawner.spawn(timed(keypad(machine, panel, card, board.columns, board.rows), "keypad", Executor::ThreadMode));
     spawner.spawn(timed(
         servo(handles.servo, board.son, board.pen, board.lights, board.watchdog),
         "servo",
@@ -102,7 +106,7 @@ fn start(spawner: Spawner) {
     ));
     spawner.spawn(timed(homing(handles.homing), "homing", Executor::ThreadMode));
     let links = LINKS.init((board.host, board.second_link));
-    let host_link = HOST_LINK.place(|| host_link(handles.host, store, loaded, links));
+    let host_link = HOST_LINK.place(|| host_link(handles.host, store, loaded, links, card));
     let Some(host_link) = host_link else { defmt::panic!("the host link's future placed twice") };
     spawner.spawn(timed(serial(host_link), "serial", Executor::ThreadMode));
     spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd", Executor::ThreadMode));
@@ -154,10 +158,11 @@ async fn motion(
 async fn keypad(
     machine: &'static Machine,
     panel: &'static Panel,
+    card: &'static CardSlot<'static>,
     columns: [board::Column; 4],
     rows: [board::Row; 4],
 ) -> ! {
-    tasks::keypad::run(machine, panel, columns, rows, tasks::slices::Yield).await
+    tasks::keypad::run(machine, panel, card, columns, rows, tasks::slices::Yield).await
 }
 
 /// The host link's future, on the two links' ends (by reference: what the future holds at first
@@ -167,11 +172,13 @@ fn host_link(
     store: &'static mut Store<board::Flash>,
     loaded: Result<(), StoreError>,
     links: &'static mut Links,
+    card: &'static CardSlot<'static>,
 ) -> impl Future<Output = Infallible> + 'static {
     let ((host_rx, host_tx), (link_rx, link_tx)) = links;
     #[allow(unreachable_code)]
     async move {
-        tasks::serial::run(machine, store, loaded, (host_rx, host_tx), (link_rx, link_tx), tasks::slices::Yield).await
+        let (host, link) = ((host_rx, host_tx), (link_rx, link_tx));
+        tasks::serial::run(machine, store, loaded, host, link, card, tasks::slices::Yield).await
     }
 }
 

@@ -241,6 +241,8 @@ pub struct StatusFields {
     /// Planner segments free and receive-window bytes free, for `|Bf:` (shown when `$10` has
     /// bit 1 set).
     pub buffer: (u8, u16),
+    /// The line of the card file being plotted, for `|Ln:` (`None`: no card plot runs).
+    pub card_line: Option<u32>,
 }
 
 /// The status report for `?`, as GRBL 1.1 writes it:
@@ -270,6 +272,10 @@ pub fn status(out: &mut impl Write, status: &Status, settings: &Settings, fields
     units.xyz(out, [x, y])?;
     if settings.status_report_mask & 2 != 0 {
         write!(out, "|Bf:{},{}", Int::from(fields.buffer.0), Int::from(fields.buffer.1))?;
+    }
+    if let Some(line) = fields.card_line {
+        // GRBL's line number field: here the card file's line being carried out.
+        write!(out, "|Ln:{}", Int::from(line))?;
     }
     out.write_str("|FS:")?;
     units.rate(out, fields.speed_mm_per_min)?;
@@ -526,6 +532,13 @@ mod tests {
     }
 
     #[test]
+    fn a_card_plot_reports_its_line() {
+        let fields = StatusFields { card_line: Some(300), ..at(0.0) };
+        let report = text(|o| status(o, &st(RunState::Run, 0, 0), &Settings::default(), &fields));
+        assert_eq!(report, "<Run|MPos:0.000,0.000,0.000|Ln:300|FS:0,0>\r\n");
+    }
+
+    #[test]
     fn positions_use_each_axis_steps_per_mm_and_never_show_minus_zero() {
         let mut s = Settings::default();
         s.set(100, 80.0).unwrap();
@@ -549,6 +562,7 @@ mod tests {
             wco: true,
             overrides: Some([200, 100, 200]),
             buffer: (255, 65_535),
+            card_line: Some(u32::MAX),
         };
         let late = Status { underruns: u32::MAX, ..st(RunState::Hold, -50_000, -50_000) };
         let line = text(|o| status(o, &late, &s, &longest));

@@ -44,6 +44,7 @@
 //! The forms of the drawing modes (their fields, the ranges and checks of what is typed, and
 //! the job built from it) are [`Form`] and [`Field`]; this module routes the keys to them.
 
+use crate::card::{CardError, CardFile, CardFiles, CardProgress, CardStop};
 use crate::geom::Step;
 use crate::motion::job::Control;
 use crate::panel::keypad::{Key, KeyEvent};
@@ -54,6 +55,7 @@ use crate::status::{RunState, Status};
 
 mod action;
 mod building;
+mod card_list;
 mod error;
 mod form;
 mod list;
@@ -65,6 +67,7 @@ mod tests;
 pub use crate::unit::Unit;
 pub use action::MenuAction;
 pub use building::Building;
+pub use card_list::CardList;
 pub use error::UiError;
 pub use form::{
     ARC_START_RANGE_DEG, ARC_SWEEP_RANGE_DEG, CIRCLE_RADIUS_RANGE_MM, ELLIPSE_SEMI_AXIS_RANGE_MM, FORM_MAX_FIELDS,
@@ -123,6 +126,8 @@ pub enum Screen {
     Settings(SettingPage),
     /// The speed presets, the cursor on one.
     Presets(SpeedPreset),
+    /// The card's G-code files, the cursor on one.
+    Card(CardList),
 }
 
 /// The keypad menu; see the module documentation.
@@ -136,6 +141,8 @@ pub struct Menu {
     /// The run in progress or just ended, if any.
     run: Option<Run>,
     run_page: RunPage,
+    /// How far the card plot has come.
+    card_progress: CardProgress,
 }
 
 impl Default for Menu {
@@ -154,6 +161,7 @@ impl Menu {
             jog: None,
             run: None,
             run_page: RunPage::Numbers,
+            card_progress: CardProgress::None,
         }
     }
 
@@ -209,6 +217,39 @@ impl Menu {
         {
             page.show(set);
         }
+    }
+
+    /// The card read for the card mode ([`MenuAction::ReadCard`]): its files, or why none.
+    pub fn card_read(&mut self, files: Result<CardFiles, CardError>) {
+        if let Screen::Card(list) = &mut self.screen {
+            list.read(files);
+        }
+    }
+
+    /// The file under the card mode's cursor: the one [`MenuAction::PlotCard`] plots.
+    pub fn card_choice(&self) -> Option<CardFile> {
+        match &self.screen {
+            Screen::Card(list) => list.files()?.get(list.at()).cloned(),
+            _ => None,
+        }
+    }
+
+    /// Follows the card plot between keys: its progress, and why it stopped early (said until
+    /// the next key). Returns true when what the screen shows changed.
+    pub fn observe_card(&mut self, progress: CardProgress, stop: Option<CardStop>) -> bool {
+        let changed = progress != self.card_progress || stop.is_some();
+        self.card_progress = progress;
+        match stop {
+            Some(CardStop::Refused { line, error }) => self.message = Some(UiError::CardLine { line, error }),
+            Some(CardStop::Card(e)) => self.message = Some(UiError::Card(e)),
+            None => {}
+        }
+        changed
+    }
+
+    /// How far the card plot has come.
+    pub fn card_progress(&self) -> CardProgress {
+        self.card_progress
     }
 
     /// True while the menu waits for a drawing it asked to be built: the form's (its last `#`)
@@ -288,7 +329,7 @@ impl Menu {
 
     /// True while a run is under way (a keypad drawing confirmed counts from then on).
     fn running(&self) -> bool {
-        self.run.as_ref().is_some_and(|r| r.ended_ms.is_none())
+        self.run.as_ref().is_some_and(|r| r.ended_ms.is_none()) || self.card_progress != CardProgress::None
     }
 
     /// True while the machine's motion takes the keypad: only `C`, `D` and `#` act. A jog counts
@@ -332,7 +373,7 @@ impl Menu {
             return false;
         }
         match &self.screen {
-            Screen::Splash | Screen::Modes | Screen::Presets(_) => matches!(key, Key::A | Key::B),
+            Screen::Splash | Screen::Modes | Screen::Presets(_) | Screen::Card(_) => matches!(key, Key::A | Key::B),
             Screen::Settings(page) if page.edit().is_some() => key == Key::B,
             Screen::Settings(_) => matches!(key, Key::A | Key::B),
             Screen::Form(form) => match form.field() {
@@ -428,6 +469,10 @@ impl Menu {
                 Key::Hash => form.start(status, settings).map(MenuAction::Build),
                 _ => Ok(MenuAction::None),
             },
+            Screen::Card(list) => Ok(match list.press(key) {
+                Some(_) => MenuAction::PlotCard,
+                None => MenuAction::None,
+            }),
         };
         result.unwrap_or_else(|e| {
             self.message = Some(e);
@@ -436,7 +481,7 @@ impl Menu {
     }
 
     /// The mode list: a digit enters its mode at once.
-    const _EVERY_DIGIT_HAS_A_MODE: () = assert!(Mode::ALL.len() == 10);
+    const _EVERY_DIGIT_HAS_A_MODE: () = assert!(Mode::ALL.len() >= 10);
     fn press_modes(&mut self, key: Key, settings: &Settings) -> Result<MenuAction, UiError> {
         self.screen = Screen::Modes;
         let at = list::moved(self.selected.index(), Mode::ALL.len(), key);
@@ -464,6 +509,10 @@ impl Menu {
             Mode::Language => {
                 let value = f32::from(settings.language.other() as u8);
                 return Ok(MenuAction::SetSetting { id: LANGUAGE_SETTING, value });
+            }
+            Mode::Card => {
+                self.screen = Screen::Card(CardList::reading());
+                return Ok(MenuAction::ReadCard);
             }
             _ => Screen::Form(Form::new(mode)),
         };

@@ -50,11 +50,15 @@ use crate::settings::presets::SpeedPreset;
 use crate::status::{MotionFault, RunState, Status};
 use crate::text::{Padded, Text};
 
+mod card;
 mod lines;
 mod run;
 
 use lines::{Cut, position_line, state_name};
 pub use lines::{Live, PreviewBox, ScreenView, TextLine};
+
+/// The digits of the mode list's first ten modes, in order.
+const DIGITS: &str = "1234567890";
 
 /// How long the splash stays at power-up, unless a key is pressed first.
 pub const SPLASH_MS: u32 = 2_000;
@@ -102,7 +106,7 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
     let mut title_text: String<SCREEN_COLUMNS> = String::new();
     let _ = match menu.screen() {
         Screen::Splash | Screen::Modes => Cut(&mut title_text).write_str("SERVOPLOT"),
-        Screen::Jog | Screen::Presets(_) | Screen::Preview { .. } => {
+        Screen::Jog | Screen::Presets(_) | Screen::Preview { .. } | Screen::Card(_) => {
             write!(Cut(&mut title_text), "{}", say(menu.selected().title()))
         }
         Screen::Settings(page) => write!(
@@ -133,7 +137,8 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             for (line, i) in [l2, l3].into_iter().zip(first..) {
                 let mode = Mode::ALL[i];
                 let marker = Text(if mode == menu.selected() { ">" } else { " " });
-                let digit = Int::from((i + 1) % 10);
+                // Only the first ten have a digit.
+                let digit = Text(DIGITS.get(i..=i).unwrap_or(" "));
                 *line = TextLine::new(format_args!("{marker}{digit} {}", say(mode.label())), false);
             }
         }
@@ -214,6 +219,10 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
             }
         }
         Screen::Preview { .. } => {}
+        Screen::Card(list) => {
+            let [files, keys] = card::card_lines(list, language);
+            (*l2, *l3) = (files, keys);
+        }
     }
 
     // The settings stay in view while the machine works (their keys wait for it).
@@ -334,6 +343,10 @@ impl fmt::Display for ErrorText {
             UiError::Clash { with, .. } => return write!(f, "{} ${}", say(Msg::ErrClash), Int::from(with)),
             UiError::StrandsPen { .. } => Msg::ErrStrands,
             UiError::UndefinedAtStart(e) => return write!(f, "{} {}", say(Msg::ErrAtX0), say(Msg::from(e))),
+            UiError::Card(e) => card::card_error_text(e),
+            UiError::CardLine { line, error } => {
+                return write!(f, "{} {}: error:{}", say(Msg::CardLine), Int::from(line), Int::from(error.code()));
+            }
         };
         write!(f, "{}", say(msg))
     }

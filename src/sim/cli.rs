@@ -32,7 +32,8 @@ const LCD_PNG_MAX_FRAMES: usize = 300;
 
 const USAGE: &str = "\
 usage: servoplot [--serial FILE|- | --pty] [--keys FILE] [--keys-text SCRIPT] [--cpu f407]
-                 [--flash FILE] [--switches MM] [--events FILE] [--out DIR]
+                 [--flash FILE] [--switches MM] [--events FILE] [--sd IMAGE | --sd-dir DIR]
+                 [--out DIR]
 
 Runs the plotter firmware on a simulated board. With no --serial, --pty or --keys it draws the
 built-in demo. Serial answers go to standard output; the pen path (rebuilt from the emitted
@@ -60,6 +61,10 @@ defaults to `out`).
   --events FILE   input events at set times, one per line: `<ms> on|off <input>`, the input
                   one of x- x+ y- y+ (a switch stuck pressed, or let go), alarm-x alarm-y (a
                   driver's alarm output, watched with $207=1) or estop (watched with $208=1)
+  --sd IMAGE      a microSD card in the slot: IMAGE is a FAT16 or FAT32 image (e.g.
+                  `mkfs.fat -F 16 -C card.img 16384` then `mcopy -i card.img plot.gcode ::`);
+                  the keypad's card mode lists its G-code files and plots the one chosen
+  --sd-dir DIR    the same with a card made from the files in DIR
   --out DIR       where the pictures go
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
@@ -112,6 +117,7 @@ struct Args {
     flash: Option<PathBuf>,
     switches: Option<Switches>,
     events: InputScript,
+    card: Option<sim::card::SimCard>,
     out: PathBuf,
 }
 
@@ -124,6 +130,7 @@ fn parse_args() -> Result<Args, String> {
         flash: None,
         switches: None,
         events: InputScript::default(),
+        card: None,
         out: PathBuf::from("out"),
     };
     let mut it = std::env::args().skip(1);
@@ -154,6 +161,8 @@ fn parse_args() -> Result<Args, String> {
                 let text = std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?;
                 args.events = InputScript::parse(&text).map_err(|e| format!("{path}: {e}"))?;
             }
+            "--sd" => args.card = Some(sim::card::card_from_image(Path::new(&value()?))?),
+            "--sd-dir" => args.card = Some(sim::card::card_from_dir(Path::new(&value()?))?),
             "--out" => args.out = PathBuf::from(value()?),
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
@@ -209,6 +218,7 @@ pub fn main() -> ExitCode {
         cpu: args.cpu,
         switches: args.switches,
         events: args.events,
+        card: args.card,
         stop: live.then(sim::stop::on_ctrl_c),
         ..SimConfig::default()
     });

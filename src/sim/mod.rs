@@ -13,6 +13,7 @@
 //! interrupt level, polled whenever they are woken; the others in thread mode, polled only
 //! while no work charged there (a slice of a build, see [`cpu::ThreadLevel`]) holds it.
 
+pub mod card;
 pub mod cli;
 pub mod clock;
 pub mod cpu;
@@ -39,6 +40,7 @@ use std::vec::Vec;
 
 use embassy_futures::join::{join, join5};
 
+use crate::card::CardSlot;
 use crate::geom::{Axis, Point};
 use crate::machine::Machine;
 use crate::motion::interp::Curve;
@@ -100,6 +102,8 @@ pub struct SimConfig {
     pub late_interrupt: Option<LateInterrupt>,
     /// Once set, the run ends at the next instant every task waits (Ctrl-C in a live session).
     pub stop: Option<&'static AtomicBool>,
+    /// The card in the slot; none if `None`.
+    pub card: Option<card::SimCard>,
 }
 
 /// What a simulation produced.
@@ -208,6 +212,11 @@ pub fn run(config: SimConfig) -> SimReport {
     let machine = Machine::new(store.kept().settings);
     let Some(handles) = machine.handles() else { unreachable!("a new machine has its handles") };
     let panel = Panel::new();
+    let (mut sim_card, mut no_slot) = (config.card, crate::card::NoSlot);
+    let slot = CardSlot::new(match &mut sim_card {
+        Some(card) => card,
+        None => &mut no_slot,
+    });
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
     let mut step_queue = StepQueue::new();
     // On the heap: the host's stack need not hold its 50 KB.
@@ -252,13 +261,14 @@ pub fn run(config: SimConfig) -> SimReport {
     // Thread mode: polled only while no work charged there takes it (see `cpu::ThreadLevel`).
     let thread = ThreadLevel::default();
     let threads = join5(
-        tasks::keypad::run(&machine, &panel, columns, rows, SimSlices::new(cpu.clone(), &machine, &thread)),
+        tasks::keypad::run(&machine, &panel, &slot, columns, rows, SimSlices::new(cpu.clone(), &machine, &thread)),
         tasks::serial::run(
             handles.host,
             &mut store,
             loaded,
             (serial.clone(), serial.clone()),
             (usb.clone(), usb.clone()),
+            &slot,
             SimSlices::new(cpu, &machine, &thread),
         ),
         tasks::lcd::run(&machine, &panel, lcd),

@@ -8,13 +8,14 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Ticker, Timer};
 use embedded_hal::digital::{InputPin, OutputPin};
 
+use crate::card::{CardProgress, CardSlot};
 use crate::machine::{Machine, PlanEnd};
 use crate::machine_io::pen;
 use crate::motion::drawing::BUILD_SLICE_STEPS;
 use crate::motion::job::{Control, Job};
 use crate::panel::MenuAction;
 use crate::panel::keypad::{KEYPAD_SCAN_PERIOD_MS, KeypadDecoder};
-use crate::panel::menu::{Building, UiError};
+use crate::panel::menu::{Building, Menu, UiError};
 use crate::tasks::panel::Panel;
 use crate::tasks::slices::BetweenSlices;
 
@@ -28,6 +29,7 @@ pub const KEYPAD_SETTLE_US: u64 = 10;
 pub async fn run<C: OutputPin, R: InputPin>(
     machine: &Machine,
     panel: &Panel,
+    card: &CardSlot<'_>,
     mut columns: [C; 4],
     mut rows: [R; 4],
     mut between: impl BetweenSlices,
@@ -61,11 +63,33 @@ pub async fn run<C: OutputPin, R: InputPin>(
             let status = machine.status();
             let settings = machine.settings();
             let action = panel.update(|menu| menu.handle(event, &status, &settings));
-            act(machine, panel, action, &mut building, &mut from);
+            match action {
+                MenuAction::ReadCard => panel.update(|menu| menu.card_read(card.files())),
+                MenuAction::PlotCard => plot_card(machine, panel, card),
+                action => {
+                    if action == MenuAction::Control(Control::Abort) {
+                        card.abort();
+                    }
+                    act(machine, panel, action, &mut building, &mut from)
+                }
+            }
         }
-        // The run screen follows the machine between keys.
+        // The run screen follows the machine and the card plot between keys.
         let status = machine.status();
         panel.update_if(|menu| menu.observe(&status, now_ms));
+        let (progress, stop) = (card.progress(), card.take_stop());
+        panel.update_if(|menu| menu.observe_card(progress, stop));
+    }
+}
+
+/// Asks the serial task to plot the card file the menu chose, if the machine is free for it.
+fn plot_card(machine: &Machine, panel: &Panel, card: &CardSlot<'_>) {
+    if !machine.at_rest() || card.progress() != CardProgress::None {
+        return refuse(panel, UiError::Busy);
+    }
+    if let Some(file) = panel.read(Menu::card_choice) {
+        info!("card: plotting {}", file.name.as_str());
+        card.request_plot(file);
     }
 }
 
@@ -148,6 +172,8 @@ fn act(
         }
         MenuAction::SetSetting { id, value } => change_settings(machine, panel, &[(id, value)]),
         MenuAction::Preset(preset) => change_settings(machine, panel, &preset.changes()),
+        // The card's, carried out by the loop, which holds the card.
+        MenuAction::ReadCard | MenuAction::PlotCard => {}
     }
 }
 

@@ -16,6 +16,10 @@
 //! link sent before it, resets the parser and greets that link with the banner; the other links
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
 //!
+//! A file plotted from the card (chosen on the keypad) is the line loop's third line source: its
+//! lines go through the same parser, each answered to the plot; while it runs, the links' lines
+//! are refused (see `card_plot`).
+//!
 //! Where a line is parsed from, and what each command of it waits for, is refused on and answers,
 //! are [`crate::host::guards`]'s rules: the line loop waits, acts and answers as they say.
 //!
@@ -52,18 +56,20 @@
 //! host was sending when it closed the port; an opening greets the link with the banner, as a
 //! reset does, and resets nothing: a sender that opens the port learns the version at once.
 
+mod card_plot;
 mod dropped;
 mod link;
 
-use core::cell::RefCell;
+use core::cell::{Cell, RefCell};
 use core::future::Future;
 
 use embassy_futures::join::{join, join3};
-use embassy_futures::select::{Either, select, select_array};
+use embassy_futures::select::{Either3, select3};
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
+use crate::card::{CardFile, CardSlot};
 use crate::host::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::host::gcode::{Offsets, Pending};
 use crate::host::guards::{self, Answer, LineStart, Refusal, Reported, Wait};
@@ -82,7 +88,8 @@ use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
-use link::{CLOSED_MARK, Intake, Link, RESET_MARK, write_answers};
+use card_plot::{CardPlot, CardStep, HOST_LINE_DURING_CARD_PLOT, Unread};
+use link::{CLOSED_MARK, Intake, Link, RESET_MARK, intakes, write_answers};
 pub use link::{
     Flow, SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
     SERIAL_RX_WINDOW_BYTES,
@@ -112,17 +119,25 @@ struct Host<'m> {
     /// The startup blocks, run after every reset.
     startup: RefCell<StartupLines>,
     links: [Link; SERIAL_LINKS],
+    /// Where the card plot's lines are answered (see `card_plot`).
+    card: Link,
+    /// The line of the card plot being carried out (0 before its first), while one runs.
+    card_line: Cell<Option<u32>>,
+    /// A reset came on a host link: the card plot stops before its next line.
+    card_abort: Cell<bool>,
 }
 
 /// Speaks GRBL on two host links forever, each given as its receiving and its sending end,
 /// keeping what a power cycle keeps in `store` (the board's, in static storage); `loaded` says
-/// whether power-on read it back. `between` is the pause between two slices of a build.
+/// whether power-on read it back; plots the files the keypad chooses from `card`. `between` is
+/// the pause between two slices of a build.
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     machine: HostWriter<'_>,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
     first: (R1, W1),
     second: (R2, W2),
+    card: &CardSlot<'_>,
     between: impl BetweenSlices,
 ) -> ! {
     let host = Host {
@@ -130,6 +145,9 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
         refresh: RefCell::new(Refresh::new()),
         startup: RefCell::new(store.kept().startup.clone()),
         links: [Link::new(), Link::new()],
+        card: Link::new(),
+        card_line: Cell::new(None),
+        card_abort: Cell::new(false),
     };
     for (link, flow) in host.links.iter().zip(LINK_FLOWS) {
         link.set_flow(flow);
@@ -140,8 +158,12 @@ pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     }
     let [a, b] = &host.links;
     join(
-        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host, store, loaded, between)),
-        join3(write_answers(a, first.1), write_answers(b, second.1), faults(&host)),
+        join3(receive(&host, a, first.0), receive(&host, b, second.0), lines(&host, store, loaded, card, between)),
+        join3(
+            write_answers(a, first.1),
+            write_answers(b, second.1),
+            join(faults(&host), write_answers(&host.card, Unread)),
+        ),
     )
     .await;
     unreachable!("the serial loops never end")
@@ -164,6 +186,7 @@ impl Host<'_> {
             wco: occasional.wco,
             overrides: occasional.overrides.then_some(overrides),
             buffer: (machine.plan_free_segments(), link.rx_window_free() as u16),
+            card_line: self.card_line.get(),
         };
         link.send(Reply::Status(&status, &settings, &fields)).await;
     }
@@ -184,6 +207,7 @@ impl Host<'_> {
                     machine.request(Control::Abort);
                     // As in GRBL, a reset brings every override back to 100 %.
                     machine.set_overrides(Overrides::NONE);
+                    self.card_abort.set(self.card_line.get().is_some());
                     // Like GRBL, everything the link received before the reset is dropped: the
                     // line loop discards its bytes up to the reset and resets the parser there.
                     link.reset_received().await;
@@ -354,6 +378,7 @@ async fn lines<F: NorFlash>(
     host: &Host<'_>,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
+    card: &CardSlot<'_>,
     between: impl BetweenSlices,
 ) -> ! {
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
@@ -370,25 +395,27 @@ async fn lines<F: NorFlash>(
     // The link looked at first: the other after each turn, so a link streaming without pause
     // never holds the other up.
     let mut first = 0;
+    let mut plot: Option<CardPlot> = None;
     loop {
-        let [buf0, buf1] = &mut bufs;
-        let [link0, link1] = &host.links;
-        let intakes = async {
-            if first == 0 {
-                select_array([link0.intake(buf0), link1.intake(buf1)]).await
-            } else {
-                let (intake, i) = select_array([link1.intake(buf1), link0.intake(buf0)]).await;
-                (intake, 1 - i)
-            }
-        };
-        let (intake, k) = match select(intakes, host.machine.settings_changed()).await {
-            Either::First(intake) => intake,
-            Either::Second(()) => {
-                // Changed on the keypad (a line's changes are kept before its answer).
-                parser.keep_changed(&links).await;
-                continue;
-            }
-        };
+        let card_turn = card_turn(host, card, plot.as_ref());
+        let (intake, k) =
+            match select3(intakes(&host.links, &mut bufs, first), host.machine.settings_changed(), card_turn).await {
+                Either3::First(intake) => intake,
+                Either3::Second(()) => {
+                    // Changed on the keypad (a line's changes are kept before its answer).
+                    parser.keep_changed(&links).await;
+                    continue;
+                }
+                Either3::Third(Some(file)) => {
+                    plot = CardPlot::start(card, &file).await;
+                    parser.card_started(plot.is_some());
+                    continue;
+                }
+                Either3::Third(None) => {
+                    parser.card_turn(card, &mut plot).await;
+                    continue;
+                }
+            };
         first = 1 - k;
         let (link, assembler) = (&host.links[k], &mut assemblers[k]);
         match intake {
@@ -406,6 +433,18 @@ async fn lines<F: NorFlash>(
             }
         }
     }
+}
+
+/// The card's turn in the line loop: the file the keypad chooses (`Some`) while no plot runs;
+/// the plot's next line (`None`) at once while it has lines to send, or once the machine rests
+/// after its last (the plot lasts until then).
+async fn card_turn(host: &Host<'_>, card: &CardSlot<'_>, plot: Option<&CardPlot>) -> Option<CardFile> {
+    match plot {
+        Some(p) if p.sent_all() => drop(host.machine_at_rest().await),
+        Some(_) => {}
+        None => return Some(card.plot_requested().await),
+    }
+    None
 }
 
 /// The one parser every link's lines go through, and where the plan ended when it took the line
@@ -440,6 +479,10 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         }
         let result = match assembler.push(byte) {
             None => return,
+            // A card plot runs: the host's lines wait for its end.
+            Some(LineEvent::Line(_)) if self.host.card_line.get().is_some() => {
+                Err(Unfinished::Error(HOST_LINE_DURING_CARD_PLOT))
+            }
             Some(LineEvent::Line(line)) => match self.line(link, line).await {
                 Ok(()) => self.keep(link).await,
                 refused => refused,
@@ -644,6 +687,61 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Report::StartupLines => Reply::StartupLines(&startup),
         };
         link.send(reply).await;
+    }
+
+    /// A card plot started (if `started`): it plans from where the plan ends now, and host
+    /// lines are refused until it ends.
+    fn card_started(&mut self, started: bool) {
+        if started {
+            self.plan = self.host.machine.plan_end();
+            self.host.card_abort.set(false);
+            self.host.card_line.set(Some(0));
+        }
+    }
+
+    /// Carries out the card plot's next line, as a line of a host link, and hands the plot its
+    /// answer; an abort since the line before ends the plot. True while the plot goes on.
+    async fn card_step(&mut self, slot: &CardSlot<'_>, plot: &mut CardPlot) -> bool {
+        let host = self.host;
+        let aborted = slot.take_abort() | host.card_abort.take() || host.machine.plan_end() != self.plan;
+        let (number, result) = match plot.next(slot) {
+            CardStep::Line { number, text } if !aborted => {
+                host.card_line.set(Some(number));
+                match self.line(&host.card, text).await {
+                    Ok(()) => (number, self.keep(&host.card).await),
+                    refused => (number, refused),
+                }
+            }
+            CardStep::Refused { number, error } if !aborted => (number, Err(Unfinished::Error(error))),
+            CardStep::SentAll => return true,
+            _ => return self.card_end(slot),
+        };
+        if core::mem::take(&mut self.restart_after_answer) {
+            self.restart(&host.card).await;
+        }
+        let refused = match result {
+            Ok(()) => None,
+            // Not refused by an abort that came while it waited: that ends the plot silently.
+            Err(Unfinished::Error(e)) if host.machine.plan_end() == self.plan || self.plan.is_none() => Some(e),
+            Err(_) => return self.card_end(slot),
+        };
+        plot.answered(slot, number, refused) || self.card_end(slot)
+    }
+
+    /// The card plot's turn in the line loop: its next line; `plot` is `None` once it is over.
+    async fn card_turn(&mut self, slot: &CardSlot<'_>, plot: &mut Option<CardPlot>) {
+        if let Some(p) = plot
+            && !self.card_step(slot, p).await
+        {
+            *plot = None;
+        }
+    }
+
+    /// The card plot is over: host lines are taken again. False: the plot does not go on.
+    fn card_end(&mut self, slot: &CardSlot<'_>) -> bool {
+        CardPlot::end(slot);
+        self.host.card_line.set(None);
+        false
     }
 
     /// Hands a job, planned from where the plan ended as the line was taken, to the motion

@@ -68,6 +68,8 @@ pub type HostTx = uart::UartTx;
 pub type LinkRx = uart::UartRx;
 pub type LinkTx = uart::UartTx;
 pub type Lcd = St7920Lcd<devices::LcdBus, devices::NoPin, Delay>;
+/// The model has no card slot: the card mode says "No card".
+pub type Card = servoplot::card::NoSlot;
 pub type Watchdog = clock::Watchdog;
 
 /// Everything the firmware's tasks drive, set up and idle.
@@ -83,6 +85,7 @@ pub struct Board {
     pub host: (HostRx, HostTx),
     pub second_link: (LinkRx, LinkTx),
     pub lcd: Lcd,
+    pub card: &'static mut Card,
 }
 
 /// At reset: the step timer stopped.
@@ -120,6 +123,10 @@ pub fn init(_spawner: Spawner) -> Board {
         host: uart::open(&uart::UART0_PORT, priority::HOST_LINK),
         second_link: uart::open(&uart::UART1_PORT, priority::HOST_LINK),
         lcd: St7920Lcd::new(devices::LcdBus, devices::NoPin, devices::NoPin, Delay, devices::LCD_SPI_HZ),
+        card: {
+            static CARD: static_cell::StaticCell<Card> = static_cell::StaticCell::new();
+            CARD.init(servoplot::card::NoSlot)
+        },
     }
 }
 

@@ -28,7 +28,11 @@
 //! | USB DM / DP         | PA11 / PA12 | OTG FS, a host link's CDC-ACM serial port   |
 //! | USB VBUS            | PA9  | OTG FS VBUS sensing, from the USB connector's VBUS |
 //! | USB host power off  | PC0  | high: the Discovery board's STMPS2141 VBUS switch (enable active low) stays off |
+//! | card SCK / MISO / MOSI | PB3 / PB4 / PB5 | SPI3, to the microSD socket (see `card`) |
+//! | card CS             | PD6  | the card's chip select, active low             |
+//! | card detect         | PD7  | input with pull-up, the socket's switch to GND: low while a card is in |
 
+mod card;
 mod chip;
 mod flash;
 mod inputs;
@@ -128,6 +132,9 @@ pub type LinkTx = usb::UsbTx;
 pub type Lcd =
     St7920Lcd<ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, NoCs, SpiDelay>, Pin<'static>, Delay>;
 
+/// The microSD card's slot, on SPI3.
+pub type Card = card::SpiCard;
+
 /// Everything the firmware's tasks drive, set up and idle.
 pub struct Board {
     pub step_timer: Tim1StepTimer,
@@ -142,6 +149,8 @@ pub struct Board {
     pub host: (HostRx, HostTx),
     pub second_link: (LinkRx, LinkTx),
     pub lcd: Lcd,
+    /// In static storage, built in place (its block buffer is 512 bytes).
+    pub card: &'static mut Card,
 }
 
 /// The LCD driver drives CS itself (active high); the SPI device's own CS is this no-op.
@@ -278,6 +287,14 @@ pub fn init(spawner: Spawner) -> Board {
     let lcd_rst = Pin::new(p.PB11, Level::High, Speed::Low);
     let lcd = St7920Lcd::new(spi_dev, lcd_rst, lcd_cs, Delay, LCD_SPI_HZ);
 
+    // The card: brought up at its slow clock when first looked at (see `card`).
+    let card_config = card::spi_config(APB1_HZ / card::CARD_INIT_SPI_DIVIDER);
+    let card_bus = Spi::new_blocking(p.SPI3, p.PB3, p.PB5, p.PB4, card_config);
+    let card_cs = Pin::new(p.PD6, Level::High, Speed::VeryHigh);
+    let card_spi = defmt::unwrap!(ExclusiveDevice::new(card_bus, card_cs, Delay));
+    static CARD: StaticCell<Card> = StaticCell::new();
+    let card = card::SpiCard::place(CARD.uninit(), card_spi, Input::new(p.PD7, Pull::Up), APB1_HZ);
+
     Board {
         step_timer,
         son,
@@ -290,6 +307,7 @@ pub fn init(spawner: Spawner) -> Board {
         host: (rx, tx),
         second_link: usb,
         lcd,
+        card,
     }
 }
 

@@ -37,4 +37,8 @@ pub enum MenuAction {
     },
     /// Write a speed preset into the settings.
     Preset(SpeedPreset),
+    /// Read the card's G-code files and hand them to [`Menu::card_read`](super::Menu::card_read).
+    ReadCard,
+    /// Plot the card file under the cursor ([`Menu::card_choice`](super::Menu::card_choice)).
+    PlotCard,
 }

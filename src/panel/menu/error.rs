@@ -1,5 +1,7 @@
 //! Why the menu refused a key or a job: the [`UiError`] it shows until the next key.
 
+use crate::card::CardError;
+use crate::host::GrblError;
 use crate::motion::drawing::DrawError;
 use crate::motion::expr::{EvalError, ParseError};
 use crate::panel::entry::EntryError;
@@ -48,6 +50,13 @@ pub enum UiError {
     /// Setting `$set` would leave the pen outside the travel: nothing changed.
     StrandsPen {
         set: u16,
+    },
+    /// The card gave no files, or failed while a file was read: nothing moves (more).
+    Card(CardError),
+    /// Line `line` of the card file was refused with `error`: the plot stopped there.
+    CardLine {
+        line: u32,
+        error: GrblError,
     },
 }
 

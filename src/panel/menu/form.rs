@@ -149,7 +149,7 @@ impl Mode {
             Mode::Ellipse => ELLIPSE_FIELDS,
             Mode::Sine => SINE_FIELDS,
             Mode::Function => FUNCTION_FIELDS,
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => &[],
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language | Mode::Card => &[],
         }
     }
 }
@@ -362,7 +362,9 @@ impl Form {
                 expr.eval(x0_mm).map_err(UiError::UndefinedAtStart)?;
                 Request::Function { expr, x0_mm, x1_mm }
             }
-            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language => return Err(UiError::Empty),
+            Mode::Jog | Mode::Settings | Mode::Presets | Mode::Home | Mode::Language | Mode::Card => {
+                return Err(UiError::Empty);
+            }
         })
     }
 

@@ -20,11 +20,14 @@ pub enum Mode {
     Home,
     /// Switches the LCD's language (`$216`) at once.
     Language,
+    /// Lists the card's G-code files and plots the one chosen.
+    Card,
 }
 
 impl Mode {
-    /// Every mode, in menu order: `1` picks the first, `0` the tenth.
-    pub const ALL: [Mode; 10] = [
+    /// Every mode, in menu order: `1` picks the first, `0` the tenth; the ones after the tenth
+    /// only with `A`/`B` and `#`.
+    pub const ALL: [Mode; 11] = [
         Mode::Jog,
         Mode::Line,
         Mode::Circle,
@@ -35,6 +38,7 @@ impl Mode {
         Mode::Home,
         Mode::Presets,
         Mode::Language,
+        Mode::Card,
     ];
 
     /// Screen title.
@@ -50,6 +54,7 @@ impl Mode {
             Mode::Presets => Msg::TitlePresets,
             Mode::Home => Msg::TitleHome,
             Mode::Language => Msg::TitleLanguage,
+            Mode::Card => Msg::TitleCard,
         }
     }
 
@@ -66,6 +71,7 @@ impl Mode {
             Mode::Presets => Msg::LabelPresets,
             Mode::Home => Msg::LabelHome,
             Mode::Language => Msg::LabelLanguage,
+            Mode::Card => Msg::LabelCard,
         }
     }
 

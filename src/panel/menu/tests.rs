@@ -262,8 +262,8 @@ fn mode_list_by_digit_and_by_navigation() {
     for _ in 0..20 {
         m.handle(KeyEvent::Repeat(Key::B), &idle(), &s);
     }
-    assert_eq!(m.selected(), Mode::Language, "stops at the bottom, no wrap");
-    for _ in 0..4 {
+    assert_eq!(m.selected(), Mode::Card, "stops at the bottom, no wrap");
+    for _ in 0..5 {
         m.handle(KeyEvent::Press(Key::A), &idle(), &s);
     }
     m.handle(KeyEvent::Press(Key::Hash), &idle(), &s);
@@ -612,4 +612,33 @@ fn the_readme_lists_every_form_field_as_the_forms_have_it() {
         }
     }
     assert_eq!(at, rows.len(), "no rows for fields the forms lack");
+}
+
+#[test]
+fn the_card_mode_reads_the_card_lists_its_files_and_plots_the_one_chosen() {
+    use crate::card::{CardError, CardFiles, CardProgress};
+    let mut m = Menu::new();
+    let s = Settings::default();
+    for _ in 0..10 {
+        m.handle(KeyEvent::Press(Key::B), &idle(), &s);
+    }
+    assert_eq!(m.selected(), Mode::Card, "the eleventh mode, reached with B");
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::ReadCard);
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::None, "nothing read yet");
+    let mut files = CardFiles::new();
+    files.offer("B.NC", None, 10);
+    files.offer("A.GCODE", None, 20);
+    m.card_read(Ok(files));
+    assert_eq!(m.handle(KeyEvent::Press(Key::B), &idle(), &s), MenuAction::None);
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::PlotCard);
+    assert_eq!(m.card_choice().map(|f| f.short), Some("B.NC".try_into().unwrap()));
+    // While it plots, the keys act on the plot only.
+    assert!(m.observe_card(CardProgress::Plotting { done: 0, total: 5 }, None));
+    assert!(m.is_busy(&idle()));
+    assert_eq!(m.handle(KeyEvent::Press(Key::D), &idle(), &s), MenuAction::Control(Control::Abort));
+    // A card that gives no files says why; `#` then does nothing.
+    m.observe_card(CardProgress::None, None);
+    type_keys(&mut m, "D", &idle());
+    m.card_read(Err(CardError::NoCard));
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::None);
 }

@@ -26,6 +26,7 @@ use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::primitives::Rectangle;
 
 use super::lines::{Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
+use crate::card::CardProgress;
 use crate::decimal::{Int, write_digits};
 use crate::panel::language::Language;
 use crate::panel::layout::{
@@ -99,9 +100,11 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
         _ => state_name(status),
     });
     let mut gcode: String<JOB_NAME_CHARS> = String::new();
-    let name = match &run.plan {
-        Some(plan) => plan.name.as_str(),
-        None => {
+    let card_file = menu.card_choice().filter(|_| menu.card_progress() != CardProgress::None);
+    let name = match (&run.plan, &card_file) {
+        (Some(plan), _) => plan.name.as_str(),
+        (None, Some(file)) => file.name.as_str(),
+        (None, None) => {
             let _ = write!(gcode, "{}", say(Msg::NameGcode));
             gcode.as_str()
         }
@@ -141,9 +144,14 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
                     let left = run.left_ms(status.emitted_steps, feed, live.now_ms).unwrap_or(0);
                     line(format_args!("{}% {elapsed} {} {}", Int::from(percent), say(Msg::Left), Clock(left)))
                 }
-                (false, None) => {
-                    line(format_args!("{elapsed}  {} {}", Int::from(status.queued_jobs), say(Msg::Queued)))
-                }
+                (false, None) => match menu.card_progress() {
+                    CardProgress::Plotting { done, total } => {
+                        line(format_args!("{elapsed} {} {}/{}", say(Msg::CardLine), Int::from(done), Int::from(total)))
+                    }
+                    CardProgress::None => {
+                        line(format_args!("{elapsed}  {} {}", Int::from(status.queued_jobs), say(Msg::Queued)))
+                    }
+                },
             };
             let speed = if done { 0 } else { (live.speed_mm_per_min + 0.5) as i32 };
             ScreenView {

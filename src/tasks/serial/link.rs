@@ -8,7 +8,7 @@ use core::cell::Cell;
 
 use core::future::Future;
 
-use embassy_futures::select::{Either, select};
+use embassy_futures::select::{Either, select, select_array};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::pipe::Pipe;
@@ -235,6 +235,19 @@ impl Future for Sending<'_> {
 fn too_long(answer: &mut Answer) {
     answer.clear();
     let _ = report::message(answer, "answer too long");
+}
+
+/// The next work of either of two links for the line loop, and which link it is for, `first`
+/// looked at first.
+pub async fn intakes(links: &[Link; 2], bufs: &mut [[u8; SERIAL_CHUNK_BYTES]; 2], first: usize) -> (Intake, usize) {
+    let [buf0, buf1] = bufs;
+    let [link0, link1] = links;
+    if first == 0 {
+        select_array([link0.intake(buf0), link1.intake(buf1)]).await
+    } else {
+        let (intake, i) = select_array([link1.intake(buf1), link0.intake(buf0)]).await;
+        (intake, 1 - i)
+    }
 }
 
 /// Writes the link's answers to its port, each whole, in the order they were sent.
