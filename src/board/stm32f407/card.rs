@@ -13,8 +13,9 @@ use embassy_stm32::gpio::{Input, Output};
 use embassy_stm32::mode::Blocking;
 use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
-use embassy_time::Delay;
 use embedded_hal_bus::spi::ExclusiveDevice;
+
+use super::SpiDelay;
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCard, SdCardError};
 use servoplot::card::fat::FatCard;
 use servoplot::card::{Card, CardError, CardFile, CardFiles};
@@ -26,11 +27,11 @@ pub const CARD_INIT_SPI_DIVIDER: u32 = 128;
 pub const CARD_SPI_DIVIDER: u32 = 2;
 
 /// The card's SPI device: SPI3 with its own chip select.
-pub type CardSpi = ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, Output<'static>, Delay>;
+pub type CardSpi = ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, Output<'static>, SpiDelay>;
 
 /// The card's blocks as the plot reads them: read, never written (nothing on the card is written
 /// yet), so the SD protocol's write commands stay out of the image.
-pub struct ReadOnlySd(SdCard<CardSpi, Delay>);
+pub struct ReadOnlySd(SdCard<CardSpi, SpiDelay>);
 
 impl BlockDevice for ReadOnlySd {
     type Error = SdCardError;
@@ -76,7 +77,7 @@ impl SpiCard {
         detect: Input<'static>,
         bus_hz: u32,
     ) -> &'static mut SpiCard {
-        slot.write(SpiCard { fat: FatCard::new(ReadOnlySd(SdCard::new(spi, Delay))), detect, up: false, bus_hz })
+        slot.write(SpiCard { fat: FatCard::new(ReadOnlySd(SdCard::new(spi, SpiDelay))), detect, up: false, bus_hz })
     }
 
     /// A card is in the slot and up: brought up now if it was just put in.

@@ -169,7 +169,7 @@ impl embedded_hal::digital::OutputPin for NoCs {
     }
 }
 
-/// The SPI device's delays: embassy-time's, the nanoseconds rounded up to whole microseconds
+/// The SPI devices' delays (the LCD's and the card's): embassy-time's, the nanoseconds rounded up to whole microseconds
 /// (the clock's ticks) in 32 bits, as embassy-time rounds them in 64 (which would link the
 /// runtime's 64-bit division, see `servoplot::wide`).
 pub struct SpiDelay;
@@ -291,7 +291,7 @@ pub fn init(spawner: Spawner) -> Board {
     let card_config = card::spi_config(APB1_HZ / card::CARD_INIT_SPI_DIVIDER);
     let card_bus = Spi::new_blocking(p.SPI3, p.PB3, p.PB5, p.PB4, card_config);
     let card_cs = Pin::new(p.PD6, Level::High, Speed::VeryHigh);
-    let card_spi = defmt::unwrap!(ExclusiveDevice::new(card_bus, card_cs, Delay));
+    let card_spi = defmt::unwrap!(ExclusiveDevice::new(card_bus, card_cs, SpiDelay));
     static CARD: StaticCell<Card> = StaticCell::new();
     let card = card::SpiCard::place(CARD.uninit(), card_spi, Input::new(p.PD7, Pull::Up), APB1_HZ);
 
