@@ -15,7 +15,7 @@ use embassy_stm32::spi::{self, Spi};
 use embassy_stm32::time::Hertz;
 use embedded_hal_bus::spi::ExclusiveDevice;
 
-use super::SpiDelay;
+use super::spi_delay::SpiDelay;
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCard, SdCardError};
 use servoplot::card::fat::FatCard;
 use servoplot::card::{Card, CardError, CardFile, CardFiles};

@@ -40,6 +40,7 @@ mod iwdg;
 mod panic;
 mod pen;
 pub mod poll_clock;
+mod spi_delay;
 mod step_timer;
 mod usb;
 
@@ -58,12 +59,12 @@ use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
 use embassy_stm32::{Config, bind_interrupts, interrupt, pac};
 use embassy_time::Delay;
-use embedded_hal::delay::DelayNs;
 use embedded_hal_bus::spi::ExclusiveDevice;
 use servoplot::machine::PulseWriter;
 use servoplot::machine_io::inputs::InputLevels;
 use servoplot::motion::pulse::StepConsumer;
 use servoplot::tasks::lcd::St7920Lcd;
+use spi_delay::SpiDelay;
 use static_cell::StaticCell;
 use step_timer::Tim1StepTimer;
 
@@ -166,23 +167,6 @@ impl embedded_hal::digital::OutputPin for NoCs {
     }
     fn set_high(&mut self) -> Result<(), Infallible> {
         Ok(())
-    }
-}
-
-/// The SPI devices' delays (the LCD's and the card's): embassy-time's, the nanoseconds rounded up to whole microseconds
-/// (the clock's ticks) in 32 bits, as embassy-time rounds them in 64 (which would link the
-/// runtime's 64-bit division, see `servoplot::wide`).
-pub struct SpiDelay;
-
-impl DelayNs for SpiDelay {
-    fn delay_ns(&mut self, ns: u32) {
-        DelayNs::delay_us(&mut Delay, ns.div_ceil(1_000));
-    }
-    fn delay_us(&mut self, us: u32) {
-        DelayNs::delay_us(&mut Delay, us);
-    }
-    fn delay_ms(&mut self, ms: u32) {
-        DelayNs::delay_ms(&mut Delay, ms);
     }
 }
 
