@@ -37,7 +37,7 @@ use crate::motion::drawing::{BUILD_SLICE_STEPS, Bounds};
 use crate::motion::interp::Curve;
 use crate::motion::job::{Job, JobKind};
 use crate::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
-use crate::program::preview::{MapScale, StrokeMap, Trail};
+use crate::program::preview::{MapScale, PenStrokes, StrokeMap};
 use crate::settings::Settings;
 use crate::status::RunState;
 
@@ -135,7 +135,7 @@ pub struct ProgramCheck {
     ticks: u64,
     waits_us: u64,
     scale: MapScale,
-    trail: Trail,
+    trail: PenStrokes,
 }
 
 impl ProgramCheck {
@@ -157,7 +157,7 @@ impl ProgramCheck {
             ticks: 0,
             waits_us: 0,
             scale: MapScale::for_travel(settings),
-            trail: Trail::new(),
+            trail: PenStrokes::new(),
         }
     }
 
@@ -175,7 +175,7 @@ impl ProgramCheck {
         (self.motion, self.strokes) = (None, None);
         (self.ticks, self.waits_us) = (0, 0);
         self.scale = MapScale::for_travel(settings);
-        self.trail = Trail::new();
+        self.trail = PenStrokes::new();
         planner.drop_all();
         planner.set_overrides(Default::default());
         planner.set_limits(Limits::from_settings(settings));

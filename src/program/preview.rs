@@ -14,6 +14,7 @@ use embedded_graphics::Pixel;
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::geometry::Point as ScreenPoint;
 use embedded_graphics::pixelcolor::BinaryColor;
+use embedded_graphics::primitives::{Line, PointsIter};
 
 use crate::geom::Point;
 use crate::settings::Settings;
@@ -116,27 +117,13 @@ impl StrokeMap {
         self.bits.iter().all(|b| *b == 0)
     }
 
-    /// Sets the pixels of the straight line from `a` to `b`, both included (Bresenham's).
+    /// Sets the pixels of the straight line from `a` to `b`, both included (embedded-graphics'
+    /// Bresenham, as the LCD's other pictures draw theirs).
     pub fn line(&mut self, a: Pixel8, b: Pixel8) {
-        let (mut x, mut y) = (i16::from(a.0), i16::from(a.1));
-        let (x1, y1) = (i16::from(b.0), i16::from(b.1));
-        let (dx, dy) = ((x1 - x).abs(), -(y1 - y).abs());
-        let (sx, sy) = (if x < x1 { 1 } else { -1 }, if y < y1 { 1 } else { -1 });
-        let mut err = dx + dy;
-        loop {
-            self.set((x as u8, y as u8));
-            if x == x1 && y == y1 {
-                return;
-            }
-            let e2 = 2 * err;
-            if e2 >= dy {
-                err += dy;
-                x += sx;
-            }
-            if e2 <= dx {
-                err += dx;
-                y += sy;
-            }
+        let px = |(x, y): Pixel8| ScreenPoint::new(i32::from(x), i32::from(y));
+        for p in Line::new(px(a), px(b)).points() {
+            // Both ends lie on the picture, so every point between them does.
+            self.set((p.x as u8, p.y as u8));
         }
     }
 }
@@ -144,14 +131,14 @@ impl StrokeMap {
 /// A pen's trail on a map: each place the pen is seen at joined to the last by a line while it
 /// draws.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Trail {
+pub struct PenStrokes {
     map: StrokeMap,
     last: Option<Pixel8>,
 }
 
-impl Trail {
-    pub const fn new() -> Trail {
-        Trail { map: StrokeMap::new(), last: None }
+impl PenStrokes {
+    pub const fn new() -> PenStrokes {
+        PenStrokes { map: StrokeMap::new(), last: None }
     }
 
     /// The pen is at the pixel `at`, drawing or not since it was last seen.
@@ -182,13 +169,13 @@ impl Trail {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlotProgress {
     scale: MapScale,
-    drawn: Trail,
+    drawn: PenStrokes,
 }
 
 impl PlotProgress {
     /// A plot about to start, on the picture of `scale`.
     pub fn new(scale: MapScale) -> PlotProgress {
-        PlotProgress { scale, drawn: Trail::new() }
+        PlotProgress { scale, drawn: PenStrokes::new() }
     }
 
     /// The pen is at `p` (machine steps), drawing or not since the last reading.
