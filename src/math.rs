@@ -150,6 +150,7 @@ fn cos_poly(r: f32) -> f32 {
 /// sin x (radians). Within 1 ulp for |x| ≤ π/4; for |x| ≤ [`TRIG_ACCURATE_MAX_RAD`] within
 /// 1.6 ulp of the result plus 1e-10 (the reduction's error, which shows only near the zeros),
 /// at most 8e-8; see that constant beyond. NaN for an infinite or NaN x.
+#[inline]
 pub fn sin(x: f32) -> f32 {
     let (r, quadrant) = reduce(x);
     let v = if quadrant & 1 == 0 { sin_poly(r) } else { cos_poly(r) };
@@ -157,6 +158,7 @@ pub fn sin(x: f32) -> f32 {
 }
 
 /// cos x (radians); accuracy as [`sin`].
+#[inline]
 pub fn cos(x: f32) -> f32 {
     let (r, quadrant) = reduce(x);
     let v = if quadrant & 1 == 0 { cos_poly(r) } else { sin_poly(r) };
@@ -205,6 +207,7 @@ pub fn atan(x: f32) -> f32 {
 /// The angle of (x, y) (radians, in [-π, π]): within 2 ulp. Zeros and infinities as IEEE 754
 /// has them, the sign always y's: atan2(±0, +0) = ±0, atan2(±0, -0) = ±π, atan2(±∞, +∞) =
 /// ±π/4, atan2(±∞, -∞) = ±3π/4. NaN if either is NaN.
+#[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     let (a, b) = (x.abs(), y.abs());
     let steep = b > a;

@@ -334,7 +334,9 @@ impl<C: Interpolator, const N: usize> Planner<C, N> {
 
     /// Writes the next step commands into `out`, until it is full, their intervals add up to
     /// `ticks_room` or more, or there is nothing more to emit now: the motion task fills the
-    /// step queue this way, one run at a time in a tight loop.
+    /// step queue this way, one run at a time in a tight loop. Out of line: the motion task and
+    /// a program's check share it (its loop is the cost, not the call, once per batch).
+    #[inline(never)]
     pub fn fill(&mut self, out: &mut [StepCmd], ticks_room: u32) -> Emitted {
         let emitted = self.steps.fill(&mut self.ahead, &self.limits, self.factors, out, ticks_room);
         self.apply_pending_if_idle();

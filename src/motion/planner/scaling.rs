@@ -92,6 +92,7 @@ pub(crate) struct ChunkCaps {
 
 impl ChunkCaps {
     /// The caps of steps within `limit`, asked to go at `requested_mm_per_s` scaled by `scale`.
+    #[inline]
     pub fn new(limits: &Limits, limit: &StepLimit, scale: Scale, requested_mm_per_s: f32, factors: Factors) -> Self {
         let speed = scale.speed(requested_mm_per_s, limit.speed_mm_per_s, factors);
         ChunkCaps {
