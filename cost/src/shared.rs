@@ -67,6 +67,7 @@ pub fn run() {
             speed_mm_per_min: machine.speed_mm_per_min(),
             work_offset_mm: machine.work_offset_mm(),
             drawn: None,
+            picture: None,
         };
         core::hint::black_box(panel.read(|menu| screen::view(menu, &status, &settings, &live)));
         // Inputs and motion task: jobs handed over until the queue is full, one more waiting for

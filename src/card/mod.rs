@@ -14,7 +14,7 @@ pub mod slot;
 
 pub use lines::{CardLine, CardLines};
 pub use names::{CARD_FILES_MAX, CARD_NAME_MAX_BYTES, CardFile, CardFiles, FileName, is_gcode_name};
-pub use slot::{CardProgress, CardSlot, CardStop, NoSlot};
+pub use slot::{CardFacts, CardPicture, CardProgress, CardSlot, CardStop, NoSlot};
 
 /// Why the card gave no files or no bytes. Each says so on the LCD and in a log line; nothing
 /// moves.

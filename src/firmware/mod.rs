@@ -18,6 +18,8 @@ use core::convert::Infallible;
 use core::future::Future;
 use core::mem::MaybeUninit;
 use core::pin::Pin;
+use core::ptr::addr_of_mut;
+use core::sync::atomic::{AtomicBool, Ordering};
 
 use defmt::info;
 use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
@@ -28,10 +30,12 @@ use servoplot::machine_io::health::{self, Health};
 use servoplot::motion::interp::Curve;
 use servoplot::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use servoplot::motion::pulse::{StepProducer, StepQueue};
+use servoplot::program::check::{CheckPlanner, ProgramCheck};
 use servoplot::settings::Settings;
 use servoplot::store::{STORE_FLASH_RANGE, Store, StoreError};
 use servoplot::tasks;
 use servoplot::tasks::panel::Panel;
+use servoplot::tasks::serial::CardRoom;
 use static_cell::{ConstStaticCell, StaticCell};
 
 use crate::board::{self, Board};
@@ -58,8 +62,16 @@ static LINKS: StaticCell<Links> = StaticCell::new();
 const HOST_LINK_FUTURE_BYTES: usize = 18 * 1024;
 /// The keypad menu, shared by the keypad and LCD tasks (both in thread mode).
 static PANEL: StaticCell<Panel> = StaticCell::new();
-/// The board's card slot, shared by the keypad and host link tasks (both in thread mode).
+/// The board's card slot, shared by the keypad, host link and LCD tasks (all in thread mode).
 static CARD_SLOT: StaticCell<CardSlot<'static>> = StaticCell::new();
+/// The card file's check (4 KB) and the planner it times the plot with (50 KB), in the
+/// core-coupled RAM (`.ccmram`, see the board's memory.x): SRAM has no room for a second
+/// planner, and no DMA reaches either. The section is not zeroed at boot, so these are
+/// `MaybeUninit`, built in place once ([`card_room`]).
+#[unsafe(link_section = ".ccmram")]
+static mut CHECK: MaybeUninit<ProgramCheck> = MaybeUninit::uninit();
+#[unsafe(link_section = ".ccmram")]
+static mut CHECK_PLANNER: MaybeUninit<CheckPlanner> = MaybeUninit::uninit();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -109,7 +121,7 @@ fn start(spawner: Spawner) {
     let host_link = HOST_LINK.place(|| host_link(handles.host, store, loaded, links, card));
     let Some(host_link) = host_link else { defmt::panic!("the host link's future placed twice") };
     spawner.spawn(timed(serial(host_link), "serial", Executor::ThreadMode));
-    spawner.spawn(timed(lcd(machine, panel, board.lcd), "lcd", Executor::ThreadMode));
+    spawner.spawn(timed(lcd(machine, panel, card, board.lcd), "lcd", Executor::ThreadMode));
     spawner.spawn(timed(health(), "health", Executor::ThreadMode));
 }
 
@@ -117,6 +129,19 @@ fn start(spawner: Spawner) {
 #[inline(never)]
 fn build_machine(slot: &'static mut MaybeUninit<Machine>, settings: Settings) -> &'static Machine {
     slot.write(Machine::new(settings))
+}
+
+/// The card's slot, with the check of its files and that check's planner, built in place in the
+/// core-coupled RAM, once (on the host link's first poll).
+fn card_room(slot: &'static CardSlot<'static>, settings: &Settings) -> CardRoom<'static, 'static> {
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    if TAKEN.swap(true, Ordering::Relaxed) {
+        defmt::panic!("the card check's room taken twice");
+    }
+    // SAFETY: `TAKEN` lets this run once, so these are the only references to the two statics.
+    let (check, planner) = unsafe { (&mut *addr_of_mut!(CHECK), &mut *addr_of_mut!(CHECK_PLANNER)) };
+    let planner = Planner::init(planner, Limits::from_settings(settings));
+    CardRoom { slot, check: ProgramCheck::init(check, settings), planner }
 }
 
 /// The flash store, opened into `slot` (out of line: its buffers are a temporary of this
@@ -166,7 +191,10 @@ async fn keypad(
 }
 
 /// The host link's future, on the two links' ends (by reference: what the future holds at first
-/// is then a few words, and it is built straight into its slot).
+/// is then a few words, and it is built straight into its slot). The card's check room is made
+/// on its first poll, not handed in: with pointers to the core-coupled RAM among its arguments,
+/// the compiler no longer proved the slot apart from them, and built the 17 KB future on the
+/// stack to copy it (`.ci/run`'s frame check caught it).
 fn host_link(
     machine: HostWriter<'static>,
     store: &'static mut Store<board::Flash>,
@@ -178,6 +206,7 @@ fn host_link(
     #[allow(unreachable_code)]
     async move {
         let (host, link) = ((host_rx, host_tx), (link_rx, link_tx));
+        let card = card_room(card, &machine.settings());
         tasks::serial::run(machine, store, loaded, host, link, card, tasks::slices::Yield).await
     }
 }
@@ -204,8 +233,8 @@ async fn homing(machine: HomingWriter<'static>) -> ! {
 }
 
 #[embassy_executor::task]
-async fn lcd(machine: &'static Machine, panel: &'static Panel, lcd: board::Lcd) -> ! {
-    tasks::lcd::run(machine, panel, lcd).await
+async fn lcd(machine: &'static Machine, panel: &'static Panel, card: &'static CardSlot<'static>, lcd: board::Lcd) -> ! {
+    tasks::lcd::run(machine, panel, card, lcd).await
 }
 
 /// Measures the stack's peak and the longest task poll every [`HEALTH_PERIOD_MS`], publishes

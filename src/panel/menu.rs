@@ -49,9 +49,11 @@ use crate::geom::Step;
 use crate::motion::job::Control;
 use crate::panel::keypad::{Key, KeyEvent};
 use crate::panel::run::{Plan, Run, RunPage};
+use crate::panel::trail::Trail;
 use crate::settings::presets::SpeedPreset;
 use crate::settings::{LANGUAGE_SETTING, Settings};
 use crate::status::{RunState, Status};
+use heapless::String;
 
 mod action;
 mod building;
@@ -234,16 +236,30 @@ impl Menu {
         }
     }
 
-    /// Follows the card plot between keys: its progress, and why it stopped early (said until
-    /// the next key). Returns true when what the screen shows changed.
-    pub fn observe_card(&mut self, progress: CardProgress, stop: Option<CardStop>) -> bool {
+    /// Follows the card's file between keys: its check and plot, and why either stopped early
+    /// (said until the next key); `emitted_steps` is the machine's count. A plot starting from
+    /// its check is a run with the check's plan, so the run screen gives its progress and time
+    /// left. Returns true when what the screen shows changed.
+    pub fn observe_card(&mut self, progress: CardProgress, stop: Option<CardStop>, emitted_steps: u32) -> bool {
         let changed = progress != self.card_progress || stop.is_some();
-        self.card_progress = progress;
-        match stop {
-            Some(CardStop::Refused { line, error }) => self.message = Some(UiError::CardLine { line, error }),
-            Some(CardStop::Card(e)) => self.message = Some(UiError::Card(e)),
-            None => {}
+        if let (CardProgress::Checked(facts), CardProgress::Plotting { .. }) = (self.card_progress, progress) {
+            let mut name = String::new();
+            for c in self.card_choice().iter().flat_map(|f| f.name.chars()) {
+                if name.push(c).is_err() {
+                    break;
+                }
+            }
+            let (steps, estimate_ms) = (facts.steps, facts.plot_time_ms);
+            let plan = Plan { name, path: Trail::default(), steps, estimate_ms, first_step: emitted_steps };
+            self.run = Some(Run { plan: Some(plan), started_ms: None, ended_ms: None });
+            self.run_page = RunPage::Numbers;
         }
+        self.card_progress = progress;
+        self.message = match stop {
+            Some(CardStop::Refused { line, error }) => Some(UiError::CardLine { line, error }),
+            Some(CardStop::Card(e)) => Some(UiError::Card(e)),
+            None => self.message,
+        };
         changed
     }
 
@@ -312,7 +328,9 @@ impl Menu {
             Some(run) if run.ended_ms.is_none() => {
                 if run.started_ms.is_none() {
                     run.started_ms = Some(now_ms);
-                } else if !status.work_left && !drawing {
+                } else if !status.work_left && !drawing && !self.card_progress.plotting() {
+                    // A card plot's run lasts until its last line, through the rests between
+                    // its strokes (a pen lift, a dwell).
                     run.ended_ms = Some(now_ms);
                 } else {
                     return false;
@@ -329,7 +347,7 @@ impl Menu {
 
     /// True while a run is under way (a keypad drawing confirmed counts from then on).
     fn running(&self) -> bool {
-        self.run.as_ref().is_some_and(|r| r.ended_ms.is_none()) || self.card_progress != CardProgress::None
+        self.run.as_ref().is_some_and(|r| r.ended_ms.is_none()) || self.card_progress.plotting()
     }
 
     /// True while the machine's motion takes the keypad: only `C`, `D` and `#` act. A jog counts
@@ -388,6 +406,13 @@ impl Menu {
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
         let shown = self.message.take();
+        // A card file being checked, or shown checked: `#` plots it, `D` leaves it.
+        match (self.card_progress, key) {
+            (CardProgress::Checked(_), Key::Hash) => return MenuAction::CardAnswer(true),
+            (CardProgress::Checking { .. } | CardProgress::Checked(_), Key::D) => return MenuAction::CardAnswer(false),
+            (CardProgress::Checking { .. } | CardProgress::Checked(_), _) => return MenuAction::None,
+            _ => {}
+        }
         if let Some(form) = self.form_mut().filter(|f| f.building) {
             // A drawing is being built: `D` drops it, the rest waits for it.
             if key != Key::D {

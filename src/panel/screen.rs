@@ -30,6 +30,7 @@ use embedded_graphics::pixelcolor::BinaryColor;
 use embedded_graphics::primitives::Rectangle;
 use heapless::String;
 
+use crate::card::{CardPicture, CardProgress};
 use crate::decimal::{Int, Num};
 use crate::geom::Step;
 use crate::machine_io::homing::HomingFail;
@@ -44,6 +45,7 @@ use crate::panel::layout::{SCREEN_COLUMNS, SCREEN_LINE_HEIGHT_PX, SCREEN_LINES, 
 use crate::panel::menu::{Field, Menu, Mode, Screen, UiError};
 use crate::panel::texts::{Msg, SETTING_NAMES, Say};
 use crate::panel::trail::{self, Trail};
+use crate::program::preview;
 use crate::settings::SETTING_INFO;
 use crate::settings::Settings;
 use crate::settings::presets::SpeedPreset;
@@ -54,8 +56,8 @@ mod card;
 mod lines;
 mod run;
 
+pub use lines::{CardMark, Live, PreviewBox, ScreenView, TextLine};
 use lines::{Cut, position_line, state_name};
-pub use lines::{Live, PreviewBox, ScreenView, TextLine};
 
 /// The digits of the mode list's first ten modes, in order.
 const DIGITS: &str = "1234567890";
@@ -70,6 +72,10 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> S
         (Some(r), _) => run::run_view(menu, r, status, settings, live),
         (None, Screen::Splash) if live.now_ms < SPLASH_MS => splash_view(language),
         (None, Screen::Preview { plan, .. }) => run::preview_view(plan, status, language),
+        (None, Screen::Card(_)) if let CardProgress::Checked(facts) = menu.card_progress() => {
+            let name = menu.card_choice().map(|f| f.name);
+            card::checked_view(name.as_ref().map_or("", |n| n.as_str()), &facts, language)
+        }
         (None, _) => menu_view(menu, status, settings, live),
     };
     if let Some(error) = menu.message() {
@@ -220,8 +226,11 @@ fn menu_view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> 
         }
         Screen::Preview { .. } => {}
         Screen::Card(list) => {
-            let [files, keys] = card::card_lines(list, language);
-            (*l2, *l3) = (files, keys);
+            let [said, keys] = match menu.card_progress() {
+                CardProgress::Checking { lines } => card::checking_lines(lines, language),
+                _ => card::card_lines(list, language),
+            };
+            (*l2, *l3) = (said, keys);
         }
     }
 
@@ -262,7 +271,13 @@ const fn preset_name(preset: SpeedPreset) -> Msg {
 
 /// Draws `view` over the whole screen; its preview shows `plan` (the menu's, see
 /// [`Menu::plan`]) and `drawn`.
-pub fn render<D>(view: &ScreenView, plan: Option<&Trail>, drawn: Option<&Trail>, target: &mut D) -> Result<(), D::Error>
+pub fn render<D>(
+    view: &ScreenView,
+    plan: Option<&Trail>,
+    drawn: Option<&Trail>,
+    picture: Option<&CardPicture>,
+    target: &mut D,
+) -> Result<(), D::Error>
 where
     D: DrawTarget<Color = BinaryColor>,
 {
@@ -275,8 +290,14 @@ where
         // The 7-pixel glyphs sit on the line's last row: a row apart from the line above.
         glyphs::draw(target, &line.text, Point::new(SCREEN_MARGIN_PX as i32, top + 1), fg)?;
     }
-    if let Some(p) = &view.preview {
-        trail::draw(target, p.area, plan.filter(|_| p.plan), drawn, p.pen)?;
+    match (&view.preview, picture) {
+        // The picture's pixels are the screen's: the lines above cleared them.
+        (Some(PreviewBox { card: Some(_), .. }), Some(picture)) => {
+            let (strokes, progress) = (&picture.strokes, picture.progress.as_ref());
+            preview::draw(target, Point::zero(), &picture.scale, strokes, progress)?;
+        }
+        (Some(p), _) => trail::draw(target, p.area, plan.filter(|_| p.plan), drawn, p.pen)?,
+        (None, _) => {}
     }
     Ok(())
 }
@@ -286,7 +307,7 @@ pub fn draw<D>(menu: &Menu, status: &Status, settings: &Settings, live: &Live, t
 where
     D: DrawTarget<Color = BinaryColor>,
 {
-    render(&view(menu, status, settings, live), menu.plan().map(|p| &p.path), live.drawn, target)
+    render(&view(menu, status, settings, live), menu.plan().map(|p| &p.path), live.drawn, live.picture, target)
 }
 
 /// A jog direction as `+X`, `-Y`, `+X+Y`, ...

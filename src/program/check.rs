@@ -83,6 +83,9 @@ pub struct Summary {
     /// The plot's time by the planner's model, µs: the step commands' intervals, the pen's
     /// settle times and the dwells. An `M0` pause counts nothing: it waits for the user.
     pub plot_time_us: u64,
+    /// Step commands the plot emits (a diagonal step is one): what the machine's emitted-steps
+    /// count goes up by while it runs.
+    pub steps: u64,
 }
 
 /// What [`ProgramCheck::work`] did.
@@ -133,6 +136,8 @@ pub struct ProgramCheck {
     strokes: Option<Bounds>,
     /// Sums of the plot's time: planner ticks, and waits in µs.
     ticks: u64,
+    /// Step commands emitted so far.
+    steps: u64,
     waits_us: u64,
     scale: MapScale,
     trail: PenStrokes,
@@ -155,10 +160,65 @@ impl ProgramCheck {
             motion: None,
             strokes: None,
             ticks: 0,
+            steps: 0,
             waits_us: 0,
             scale: MapScale::for_travel(settings),
             trail: PenStrokes::new(),
         }
+    }
+
+    /// A check waiting for its first program, built in `slot` where it lies, a field at a time
+    /// (it is 4 KB: the board keeps it in static storage). Then [`start`](Self::start) it.
+    pub fn init<'s>(slot: &'s mut core::mem::MaybeUninit<Self>, settings: &Settings) -> &'s mut Self {
+        use core::ptr::addr_of_mut;
+        let p = slot.as_mut_ptr();
+        let gcode = GcodeState::new();
+        // SAFETY: every field of `*p` is written once below, in place, before the slot is taken
+        // as initialised; `every_field` lists them all, so that a new field cannot be left out
+        // unnoticed.
+        unsafe {
+            addr_of_mut!((*p).settings).write(*settings);
+            addr_of_mut!((*p).gcode).write(gcode);
+            addr_of_mut!((*p).pending).write(Pending::new());
+            addr_of_mut!((*p).stage).write(Stage::Ready);
+            addr_of_mut!((*p).held).write(None);
+            addr_of_mut!((*p).lines).write(0);
+            addr_of_mut!((*p).at).write(gcode.planned_position());
+            addr_of_mut!((*p).pen).write(Pen::Up);
+            addr_of_mut!((*p).settle_due).write(false);
+            addr_of_mut!((*p).motion).write(None);
+            addr_of_mut!((*p).strokes).write(None);
+            addr_of_mut!((*p).ticks).write(0);
+            addr_of_mut!((*p).steps).write(0);
+            addr_of_mut!((*p).waits_us).write(0);
+            addr_of_mut!((*p).scale).write(MapScale::for_travel(settings));
+            addr_of_mut!((*p).trail).write(PenStrokes::new());
+            slot.assume_init_mut()
+        }
+    }
+
+    /// Every field of the check: this pattern stops compiling when one is added, a reminder
+    /// that [`init`](Self::init) must write it too.
+    #[allow(dead_code)]
+    fn every_field(self) {
+        let ProgramCheck {
+            settings: _,
+            gcode: _,
+            pending: _,
+            stage: _,
+            held: _,
+            lines: _,
+            at: _,
+            pen: _,
+            settle_due: _,
+            motion: _,
+            strokes: _,
+            ticks: _,
+            steps: _,
+            waits_us: _,
+            scale: _,
+            trail: _,
+        } = self;
     }
 
     /// Starts the check over, as [`new`](Self::new) sets it up, with `planner` emptied and set
@@ -173,7 +233,7 @@ impl ProgramCheck {
         self.pen = pen;
         self.settle_due = false;
         (self.motion, self.strokes) = (None, None);
-        (self.ticks, self.waits_us) = (0, 0);
+        (self.ticks, self.steps, self.waits_us) = (0, 0, 0);
         self.scale = MapScale::for_travel(settings);
         self.trail = PenStrokes::new();
         planner.drop_all();
@@ -254,7 +314,8 @@ impl ProgramCheck {
     pub fn summary(&self) -> Summary {
         let within_travel = self.motion.is_none_or(|b| b.within_travel(&self.settings));
         let plot_time_us = self.ticks * US_PER_S / u64::from(TICK_HZ) + self.waits_us;
-        Summary { lines: self.lines, motion: self.motion, strokes: self.strokes, within_travel, plot_time_us }
+        let (lines, motion, strokes, steps) = (self.lines, self.motion, self.strokes, self.steps);
+        Summary { lines, motion, strokes, within_travel, plot_time_us, steps }
     }
 
     /// The settings the program leaves (a `$nnn=` line changes them for the lines after it).
@@ -379,6 +440,7 @@ impl ProgramCheck {
                 self.trail.pen_at(self.scale.pixel(self.at), draws);
             }
             taken += emitted.steps;
+            self.steps += emitted.steps as u64;
             if emitted.steps == 0 && emitted.end.is_some() && !planner.is_idle() {
                 // Nothing to emit and not at rest (a hold): never so in a check, but never
                 // loop on it.

@@ -23,6 +23,10 @@ use crate::settings::Settings;
 pub const PREVIEW_WIDTH_PX: u8 = 122;
 pub const PREVIEW_HEIGHT_PX: u8 = 32;
 
+/// The width of the part of the picture the travel is fitted to, pixels: the right of the
+/// screen, text to its left (as a keypad drawing's preview).
+pub const PICTURE_WIDTH_PX: u8 = 40;
+
 /// Bytes of one bitmap of the picture: a bit per pixel.
 pub const STROKE_MAP_BYTES: usize = PREVIEW_WIDTH_PX as usize * PREVIEW_HEIGHT_PX as usize / 8;
 
@@ -30,7 +34,8 @@ pub const STROKE_MAP_BYTES: usize = PREVIEW_WIDTH_PX as usize * PREVIEW_HEIGHT_P
 pub type Pixel8 = (u8, u8);
 
 /// Where the travel lies on the picture: machine steps to pixels, X to the right and Y up, the
-/// travel's rectangle centred, its aspect kept (in millimetres).
+/// travel's rectangle centred in the picture's right [`PICTURE_WIDTH_PX`], its aspect kept (in
+/// millimetres).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MapScale {
     /// Pixels per step, per axis.
@@ -46,10 +51,11 @@ impl MapScale {
     /// The travel of `settings` (`$130`, `$131`, around machine zero), fitted to the picture.
     pub fn for_travel(settings: &Settings) -> MapScale {
         let travel_mm = settings.max_travel_mm.map(|t| 2.0 * t.max(f32::MIN_POSITIVE));
-        let room = [f32::from(PREVIEW_WIDTH_PX - 1), f32::from(PREVIEW_HEIGHT_PX - 1)];
+        let room = [f32::from(PICTURE_WIDTH_PX - 1), f32::from(PREVIEW_HEIGHT_PX - 1)];
+        let beside = [f32::from(PREVIEW_WIDTH_PX - PICTURE_WIDTH_PX), 0.0];
         let px_per_mm = (room[0] / travel_mm[0]).min(room[1] / travel_mm[1]);
         let size = [0, 1].map(|i| crate::math::floor(travel_mm[i] * px_per_mm));
-        let left = [0, 1].map(|i| crate::math::floor((room[i] - size[i]) / 2.0));
+        let left = [0, 1].map(|i| beside[i] + crate::math::floor((room[i] - size[i]) / 2.0));
         let px_per_step = [0, 1].map(|i| px_per_mm / settings.steps_per_mm[i]);
         MapScale {
             px_per_step,
@@ -234,16 +240,26 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_wide_travel_fills_the_width_and_is_centred_in_the_height() {
-        // 400 x 100 mm: 121 pixels wide, so 30 high (aspect kept), a row above and below.
+    fn a_wide_travel_fills_the_pictures_width_and_is_centred_in_the_height() {
+        // 400 x 100 mm in the right 40 pixels: 39 pixels wide, so 9 high (aspect kept), 11 rows
+        // above and 12 below.
         let settings = Settings { max_travel_mm: [200.0, 50.0], ..Settings::default() };
         let scale = MapScale::for_travel(&settings);
-        assert_eq!(scale.outline(), ((0, 0), (121, 30)));
+        assert_eq!(scale.outline(), ((82, 11), (121, 20)));
         let spm = settings.steps_per_mm;
         let at = |x: f32, y: f32| Point::new((x * spm[0]) as i32, (y * spm[1]) as i32);
-        assert_eq!(scale.pixel(at(-200.0, 50.0)), (0, 0), "top left of the travel");
-        assert_eq!(scale.pixel(at(200.0, -50.0)), (121, 30), "bottom right");
+        assert_eq!(scale.pixel(at(-200.0, 50.0)), (82, 11), "top left of the travel");
+        assert_eq!(scale.pixel(at(200.0, -50.0)), (121, 20), "bottom right");
         assert_eq!(scale.pixel(at(500.0, -500.0)), (121, 31), "beyond the picture: clamped to it");
+    }
+
+    #[test]
+    fn a_tall_travel_fills_the_height_and_is_centred_in_the_pictures_width() {
+        // 100 x 200 mm: 31 pixels high, so 15 wide, centred in the right 40.
+        let settings = Settings { max_travel_mm: [50.0, 100.0], ..Settings::default() };
+        let ((x0, y0), (x1, y1)) = MapScale::for_travel(&settings).outline();
+        assert_eq!((y0, y1, x1 - x0), (0, 31, 15));
+        assert_eq!(x0, 82 + 12, "centred in the picture's width");
     }
 
     #[test]

@@ -214,14 +214,15 @@ fn a_square_shows_its_four_edges_inside_the_travels_outline() {
     let (done, _, check, _) = check(SQUARE, &settings);
     assert_eq!(done, Progress::Done);
     let screen = picture(&check, None);
-    // The travel (±200 mm square) is the screen's height, 31 pixels, centred: columns 45 to 76;
-    // its middle, machine zero, is pixel (60.5, 15.5); the square (±100 mm) is half of it.
+    // The travel (±200 mm square) is the screen's height, 31 pixels, centred in the picture's
+    // right 40 columns: columns 86 to 117; its middle, machine zero, is pixel (101.5, 15.5); the
+    // square (±100 mm) is half of it.
     let ((x0, y0), (x1, y1)) = check.scale().outline();
-    assert_eq!(((x0, y0), (x1, y1)), ((45, 0), (76, 31)));
+    assert_eq!(((x0, y0), (x1, y1)), ((86, 0), (117, 31)));
     for x in [x0, x1].map(i32::from) {
         assert!((0..32).all(|y| screen.at(x, y)), "the outline's side at column {x}");
     }
-    let (left, right, top, bottom) = (53, 68, 8, 23);
+    let (left, right, top, bottom) = (94, 109, 8, 23);
     for x in left..=right {
         assert!(screen.at(x, top) && screen.at(x, bottom), "top and bottom edges at column {x}");
     }
@@ -257,13 +258,13 @@ fn during_a_plot_the_drawn_part_is_solid_the_rest_dotted_and_the_pen_marked() {
     progress.pen_at(at(100.0, -100.0), true);
     progress.pen_at(at(100.0, 0.0), true);
     let screen = picture(&check, Some(&progress));
-    assert!((53..=68).all(|x| screen.at(x, 23)), "the bottom edge drawn: solid");
-    let top: Vec<bool> = (53..=68).map(|x| screen.at(x, 8)).collect();
+    assert!((94..=109).all(|x| screen.at(x, 23)), "the bottom edge drawn: solid");
+    let top: Vec<bool> = (94..=109).map(|x| screen.at(x, 8)).collect();
     assert!(top.iter().step_by(2).all(|p| !*p) || top.iter().skip(1).step_by(2).all(|p| !*p), "dotted: {top:?}");
     assert!(top.iter().any(|p| *p), "but shown");
-    // The pen at (100, 0) mm: pixel (60.5 + 7.75, 15.5) rounded, a hollow square around it.
-    assert_eq!(progress.pen(), Some((68, 16)));
-    let (px, py) = (68, 16);
+    // The pen at (100, 0) mm: pixel (101.5 + 7.75, 15.5) rounded, a hollow square around it.
+    assert_eq!(progress.pen(), Some((109, 16)));
+    let (px, py) = (109, 16);
     assert!(!screen.at(px, py), "the mark's middle is dark");
     for (dx, dy) in [(-1, -1), (1, -1), (-1, 1), (1, 1), (-1, 0), (0, 1)] {
         assert!(screen.at(px + dx, py + dy), "mark pixel ({dx}, {dy})");

@@ -42,12 +42,16 @@ use embassy_futures::join::{join, join5};
 
 use crate::card::CardSlot;
 use crate::geom::{Axis, Point};
+use crate::host::GcodeState;
 use crate::machine::Machine;
+use crate::machine_io::pen::Pen;
 use crate::motion::interp::Curve;
 use crate::motion::planner::{Limits, PLANNER_SEGMENTS, Planner};
 use crate::motion::pulse::{PulseEngine, StepQueue};
+use crate::program::check::{CheckPlanner, ProgramCheck};
 use crate::settings::Settings;
 use crate::store::{Record, STORE_SECTORS, Store, StoreError};
+use crate::tasks::serial::CardRoom;
 use crate::tasks::{self, lcd::St7920Lcd, panel::Panel};
 use cpu::{CpuModel, SimCpu, SimSlices, ThreadLevel};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
@@ -222,6 +226,11 @@ pub fn run(config: SimConfig) -> SimReport {
     // On the heap: the host's stack need not hold its 50 KB.
     let mut planner: std::boxed::Box<Planner<Curve, PLANNER_SEGMENTS>> =
         std::boxed::Box::new(Planner::new(Limits::from_settings(&machine.settings())));
+    // The card file's check and its planner, on the heap as well.
+    let mut check_planner: std::boxed::Box<CheckPlanner> =
+        std::boxed::Box::new(Planner::new(Limits::from_settings(&machine.settings())));
+    let mut check = std::boxed::Box::new(ProgramCheck::new(GcodeState::new(), &machine.settings(), Pen::Up));
+    let room = CardRoom { slot: &slot, check: &mut check, planner: &mut check_planner };
     let (steps, step_consumer) = step_queue.split();
     let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
@@ -268,10 +277,10 @@ pub fn run(config: SimConfig) -> SimReport {
             loaded,
             (serial.clone(), serial.clone()),
             (usb.clone(), usb.clone()),
-            &slot,
+            room,
             SimSlices::new(cpu, &machine, &thread),
         ),
-        tasks::lcd::run(&machine, &panel, lcd),
+        tasks::lcd::run(&machine, &panel, &slot, lcd),
         tasks::servo::run(
             handles.servo,
             son.clone(),

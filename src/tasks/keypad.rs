@@ -66,6 +66,12 @@ pub async fn run<C: OutputPin, R: InputPin>(
             match action {
                 MenuAction::ReadCard => panel.update(|menu| menu.card_read(card.files())),
                 MenuAction::PlotCard => plot_card(machine, panel, card),
+                MenuAction::CardAnswer(plot) => {
+                    if !plot {
+                        card.abort();
+                    }
+                    card.answer(plot);
+                }
                 action => {
                     if action == MenuAction::Control(Control::Abort) {
                         card.abort();
@@ -78,17 +84,18 @@ pub async fn run<C: OutputPin, R: InputPin>(
         let status = machine.status();
         panel.update_if(|menu| menu.observe(&status, now_ms));
         let (progress, stop) = (card.progress(), card.take_stop());
-        panel.update_if(|menu| menu.observe_card(progress, stop));
+        panel.update_if(|menu| menu.observe_card(progress, stop, status.emitted_steps));
     }
 }
 
-/// Asks the serial task to plot the card file the menu chose, if the machine is free for it.
+/// Asks the serial task to check the card file the menu chose, and show it to plot, if the
+/// machine is free for it.
 fn plot_card(machine: &Machine, panel: &Panel, card: &CardSlot<'_>) {
     if !machine.at_rest() || card.progress() != CardProgress::None {
         return refuse(panel, UiError::Busy);
     }
     if let Some(file) = panel.read(Menu::card_choice) {
-        info!("card: plotting {}", file.name.as_str());
+        info!("card: chose {}", file.name.as_str());
         card.request_plot(file);
     }
 }
@@ -173,7 +180,7 @@ fn act(
         MenuAction::SetSetting { id, value } => change_settings(machine, panel, &[(id, value)]),
         MenuAction::Preset(preset) => change_settings(machine, panel, &preset.changes()),
         // The card's, carried out by the loop, which holds the card.
-        MenuAction::ReadCard | MenuAction::PlotCard => {}
+        MenuAction::ReadCard | MenuAction::PlotCard | MenuAction::CardAnswer(_) => {}
     }
 }
 

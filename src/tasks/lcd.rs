@@ -18,6 +18,7 @@ use embassy_time::{Duration, Timer};
 use embedded_graphics::draw_target::DrawTarget;
 use embedded_graphics::pixelcolor::BinaryColor;
 
+use crate::card::CardSlot;
 use crate::machine::Machine;
 use crate::machine_io::pen::PenLift;
 use crate::panel::run::RunPath;
@@ -45,7 +46,7 @@ pub trait Lcd: DrawTarget<Color = BinaryColor> {
 }
 
 /// Draws the screen forever.
-pub async fn run<L: Lcd>(machine: &Machine, panel: &Panel, mut lcd: L) -> ! {
+pub async fn run<L: Lcd>(machine: &Machine, panel: &Panel, card: &CardSlot<'_>, mut lcd: L) -> ! {
     while let Some(wait_us) = lcd.start() {
         Timer::after(Duration::from_micros(u64::from(wait_us))).await;
     }
@@ -59,22 +60,31 @@ pub async fn run<L: Lcd>(machine: &Machine, panel: &Panel, mut lcd: L) -> ! {
         let since_frame_ms = now_ms.wrapping_sub(last_frame_ms);
         let frame_due = u64::from(since_frame_ms) >= LCD_FRAME_MIN_MS || shown.is_none();
         // The frame is worked out, and drawn into the picture if it is new and due, in one borrow.
-        let (running, new_frame) = panel.read(|menu| {
-            let running = drawn.follow(menu.run(), status.position, PenLift::of(&settings).draws(machine.pen()));
-            let live = Live {
-                now_ms,
-                speed_mm_per_min: machine.speed_mm_per_min(),
-                work_offset_mm: machine.work_offset_mm(),
-                drawn: Some(&drawn.path),
-            };
-            let view = screen::view(menu, &status, &settings, &live);
-            let new_frame = shown.as_ref() != Some(&view);
-            if new_frame && frame_due {
-                let _ = screen::render(&view, menu.plan().map(|p| &p.path), Some(&drawn.path), &mut lcd);
-                shown = Some(view);
+        let draws = PenLift::of(&settings).draws(machine.pen());
+        // The card file's picture follows the pen, and is read, in this one borrow.
+        let (running, new_frame) = {
+            let mut picture = card.picture_mut();
+            if let Some(progress) = picture.as_mut().and_then(|p| p.progress.as_mut()) {
+                progress.pen_at(status.position, draws);
             }
-            (running, new_frame)
-        });
+            panel.read(|menu| {
+                let running = drawn.follow(menu.run(), status.position, draws);
+                let live = Live {
+                    now_ms,
+                    speed_mm_per_min: machine.speed_mm_per_min(),
+                    work_offset_mm: machine.work_offset_mm(),
+                    drawn: Some(&drawn.path),
+                    picture: picture.as_ref(),
+                };
+                let view = screen::view(menu, &status, &settings, &live);
+                let new_frame = shown.as_ref() != Some(&view);
+                if new_frame && frame_due {
+                    let _ = screen::render(&view, menu.plan().map(|p| &p.path), live.drawn, live.picture, &mut lcd);
+                    shown = Some(view);
+                }
+                (running, new_frame)
+            })
+        };
         let mut wait_ms = if running { PREVIEW_SAMPLE_MS } else { LCD_POLL_MS };
         if new_frame {
             if frame_due {

@@ -16,9 +16,9 @@
 //! link sent before it, resets the parser and greets that link with the banner; the other links
 //! are told. A fourth loop pushes the alarm of a curve that stopped early to every link.
 //!
-//! A file plotted from the card (chosen on the keypad) is the line loop's third line source: its
-//! lines go through the same parser, each answered to the plot; while it runs, the links' lines
-//! are refused (see `card_plot`).
+//! A file from the card (chosen on the keypad) is the line loop's third line source: checked
+//! whole before anything moves, then, once the user says so, its lines go through the same
+//! parser, each answered to the plot; meanwhile the links' lines are refused (see `card_plot`).
 //!
 //! Where a line is parsed from, and what each command of it waits for, is refused on and answers,
 //! are [`crate::host::guards`]'s rules: the line loop waits, acts and answers as they say.
@@ -57,6 +57,7 @@
 //! reset does, and resets nothing: a sender that opens the port learns the version at once.
 
 mod card_plot;
+mod card_turns;
 mod dropped;
 mod link;
 
@@ -69,7 +70,6 @@ use embassy_time::{Duration, Timer};
 use embedded_io_async::{Error as _, ErrorKind, Read, Write};
 use embedded_storage::nor_flash::NorFlash;
 
-use crate::card::{CardFile, CardSlot};
 use crate::host::framing::{LineAssembler, LineEvent, Realtime, realtime};
 use crate::host::gcode::{Offsets, Pending};
 use crate::host::guards::{self, Answer, LineStart, Refusal, Reported, Wait};
@@ -88,7 +88,8 @@ use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::store::{Record, Store, StoreError};
 use crate::tasks::slices::BetweenSlices;
-use card_plot::{CardPlot, CardStep, HOST_LINE_DURING_CARD_PLOT, Unread};
+pub use card_plot::CardRoom;
+use card_plot::{CardSession, HOST_LINE_DURING_CARD_PLOT, Unread};
 use link::{CLOSED_MARK, Intake, Link, RESET_MARK, intakes, write_answers};
 pub use link::{
     Flow, SERIAL_ANSWER_MAX_BYTES, SERIAL_CHUNK_BYTES, SERIAL_OUTBOX_ANSWERS, SERIAL_PIPE_BYTES, SERIAL_PIPE_WAIT_MS,
@@ -121,23 +122,24 @@ struct Host<'m> {
     links: [Link; SERIAL_LINKS],
     /// Where the card plot's lines are answered (see `card_plot`).
     card: Link,
-    /// The line of the card plot being carried out (0 before its first), while one runs.
+    /// The line of the card plot being carried out (0 before its first), while a card file is
+    /// checked or plotted.
     card_line: Cell<Option<u32>>,
-    /// A reset came on a host link: the card plot stops before its next line.
+    /// A reset came on a host link: the card's check or plot stops before its next line.
     card_abort: Cell<bool>,
 }
 
 /// Speaks GRBL on two host links forever, each given as its receiving and its sending end,
 /// keeping what a power cycle keeps in `store` (the board's, in static storage); `loaded` says
-/// whether power-on read it back; plots the files the keypad chooses from `card`. `between` is
-/// the pause between two slices of a build.
+/// whether power-on read it back; checks and plots the files the keypad chooses from `card`'s
+/// slot. `between` is the pause between two slices of a build.
 pub async fn run<R1: Read, W1: Write, R2: Read, W2: Write, F: NorFlash>(
     machine: HostWriter<'_>,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
     first: (R1, W1),
     second: (R2, W2),
-    card: &CardSlot<'_>,
+    card: CardRoom<'_, '_>,
     between: impl BetweenSlices,
 ) -> ! {
     let host = Host {
@@ -378,9 +380,10 @@ async fn lines<F: NorFlash>(
     host: &Host<'_>,
     store: &mut Store<F>,
     loaded: Result<(), StoreError>,
-    card: &CardSlot<'_>,
+    mut room: CardRoom<'_, '_>,
     between: impl BetweenSlices,
 ) -> ! {
+    let card = room.slot;
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
     let mut parser = Parser { host, gcode, store, plan: None, restart_after_answer: false, between };
     let links = [&host.links[0], &host.links[1]];
@@ -395,9 +398,9 @@ async fn lines<F: NorFlash>(
     // The link looked at first: the other after each turn, so a link streaming without pause
     // never holds the other up.
     let mut first = 0;
-    let mut plot: Option<CardPlot> = None;
+    let mut session = CardSession::Idle;
     loop {
-        let card_turn = card_turn(host, card, plot.as_ref());
+        let card_turn = session.turn(host, card);
         let (intake, k) =
             match select3(intakes(&host.links, &mut bufs, first), host.machine.settings_changed(), card_turn).await {
                 Either3::First(intake) => intake,
@@ -406,13 +409,8 @@ async fn lines<F: NorFlash>(
                     parser.keep_changed(&links).await;
                     continue;
                 }
-                Either3::Third(Some(file)) => {
-                    plot = CardPlot::start(card, &file).await;
-                    parser.card_started(plot.is_some());
-                    continue;
-                }
-                Either3::Third(None) => {
-                    parser.card_turn(card, &mut plot).await;
+                Either3::Third(turn) => {
+                    parser.card_turn(turn, card, &mut room, &mut session).await;
                     continue;
                 }
             };
@@ -433,18 +431,6 @@ async fn lines<F: NorFlash>(
             }
         }
     }
-}
-
-/// The card's turn in the line loop: the file the keypad chooses (`Some`) while no plot runs;
-/// the plot's next line (`None`) at once while it has lines to send, or once the machine rests
-/// after its last (the plot lasts until then).
-async fn card_turn(host: &Host<'_>, card: &CardSlot<'_>, plot: Option<&CardPlot>) -> Option<CardFile> {
-    match plot {
-        Some(p) if p.sent_all() => drop(host.machine_at_rest().await),
-        Some(_) => {}
-        None => return Some(card.plot_requested().await),
-    }
-    None
 }
 
 /// The one parser every link's lines go through, and where the plan ended when it took the line
@@ -687,61 +673,6 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Report::StartupLines => Reply::StartupLines(&startup),
         };
         link.send(reply).await;
-    }
-
-    /// A card plot started (if `started`): it plans from where the plan ends now, and host
-    /// lines are refused until it ends.
-    fn card_started(&mut self, started: bool) {
-        if started {
-            self.plan = self.host.machine.plan_end();
-            self.host.card_abort.set(false);
-            self.host.card_line.set(Some(0));
-        }
-    }
-
-    /// Carries out the card plot's next line, as a line of a host link, and hands the plot its
-    /// answer; an abort since the line before ends the plot. True while the plot goes on.
-    async fn card_step(&mut self, slot: &CardSlot<'_>, plot: &mut CardPlot) -> bool {
-        let host = self.host;
-        let aborted = slot.take_abort() | host.card_abort.take() || host.machine.plan_end() != self.plan;
-        let (number, result) = match plot.next(slot) {
-            CardStep::Line { number, text } if !aborted => {
-                host.card_line.set(Some(number));
-                match self.line(&host.card, text).await {
-                    Ok(()) => (number, self.keep(&host.card).await),
-                    refused => (number, refused),
-                }
-            }
-            CardStep::Refused { number, error } if !aborted => (number, Err(Unfinished::Error(error))),
-            CardStep::SentAll => return true,
-            _ => return self.card_end(slot),
-        };
-        if core::mem::take(&mut self.restart_after_answer) {
-            self.restart(&host.card).await;
-        }
-        let refused = match result {
-            Ok(()) => None,
-            // Not refused by an abort that came while it waited: that ends the plot silently.
-            Err(Unfinished::Error(e)) if host.machine.plan_end() == self.plan || self.plan.is_none() => Some(e),
-            Err(_) => return self.card_end(slot),
-        };
-        plot.answered(slot, number, refused) || self.card_end(slot)
-    }
-
-    /// The card plot's turn in the line loop: its next line; `plot` is `None` once it is over.
-    async fn card_turn(&mut self, slot: &CardSlot<'_>, plot: &mut Option<CardPlot>) {
-        if let Some(p) = plot
-            && !self.card_step(slot, p).await
-        {
-            *plot = None;
-        }
-    }
-
-    /// The card plot is over: host lines are taken again. False: the plot does not go on.
-    fn card_end(&mut self, slot: &CardSlot<'_>) -> bool {
-        CardPlot::end(slot);
-        self.host.card_line.set(None);
-        false
     }
 
     /// Hands a job, planned from where the plan ended as the line was taken, to the motion

@@ -39,6 +39,10 @@ pub enum MenuAction {
     Preset(SpeedPreset),
     /// Read the card's G-code files and hand them to [`Menu::card_read`](super::Menu::card_read).
     ReadCard,
-    /// Plot the card file under the cursor ([`Menu::card_choice`](super::Menu::card_choice)).
+    /// Check the card file under the cursor ([`Menu::card_choice`](super::Menu::card_choice))
+    /// and show it, to plot.
     PlotCard,
+    /// The answer to the card file's check: plot it (`true`), or leave it (a check under way
+    /// stops).
+    CardAnswer(bool),
 }

@@ -53,7 +53,8 @@ pub enum UiError {
     },
     /// The card gave no files, or failed while a file was read: nothing moves (more).
     Card(CardError),
-    /// Line `line` of the card file was refused with `error`: the plot stopped there.
+    /// Line `line` of the card file was refused with `error`: by its check (nothing moved), or
+    /// as it ran (the plot stopped there).
     CardLine {
         line: u32,
         error: GrblError,

@@ -616,7 +616,7 @@ fn the_readme_lists_every_form_field_as_the_forms_have_it() {
 
 #[test]
 fn the_card_mode_reads_the_card_lists_its_files_and_plots_the_one_chosen() {
-    use crate::card::{CardError, CardFiles, CardProgress};
+    use crate::card::{CardError, CardFacts, CardFiles, CardProgress};
     let mut m = Menu::new();
     let s = Settings::default();
     for _ in 0..10 {
@@ -632,12 +632,24 @@ fn the_card_mode_reads_the_card_lists_its_files_and_plots_the_one_chosen() {
     assert_eq!(m.handle(KeyEvent::Press(Key::B), &idle(), &s), MenuAction::None);
     assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::PlotCard);
     assert_eq!(m.card_choice().map(|f| f.short), Some("B.NC".try_into().unwrap()));
+    // While it is checked, only `D` acts: it leaves the file.
+    assert!(m.observe_card(CardProgress::Checking { lines: 3 }, None, 0));
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::None);
+    assert_eq!(m.handle(KeyEvent::Press(Key::D), &idle(), &s), MenuAction::CardAnswer(false));
+    // Checked, `#` plots it; the plot is a run with the check's steps and time.
+    let facts = CardFacts { lines: 5, size_mm: [30.0, 20.0], plot_time_ms: 9_000, steps: 4_000 };
+    assert!(m.observe_card(CardProgress::Checked(facts), None, 0));
+    assert_eq!(m.handle(KeyEvent::Press(Key::A), &idle(), &s), MenuAction::None);
+    assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::CardAnswer(true));
+    assert!(m.observe_card(CardProgress::Plotting { done: 0, total: 5 }, None, 100));
+    let plan = m.run().and_then(|r| r.plan.as_ref()).expect("a run with the check's plan");
+    assert_eq!((plan.name.as_str(), plan.steps, plan.estimate_ms, plan.first_step), ("B.NC", 4_000, 9_000, 100));
     // While it plots, the keys act on the plot only.
-    assert!(m.observe_card(CardProgress::Plotting { done: 0, total: 5 }, None));
     assert!(m.is_busy(&idle()));
     assert_eq!(m.handle(KeyEvent::Press(Key::D), &idle(), &s), MenuAction::Control(Control::Abort));
     // A card that gives no files says why; `#` then does nothing.
-    m.observe_card(CardProgress::None, None);
+    m.observe_card(CardProgress::None, None, 0);
+    m.run = None;
     type_keys(&mut m, "D", &idle());
     m.card_read(Err(CardError::NoCard));
     assert_eq!(m.handle(KeyEvent::Press(Key::Hash), &idle(), &s), MenuAction::None);

@@ -1,15 +1,33 @@
-//! The card mode's lines: two of the card's G-code files, the cursor on one, each name cut to
-//! the line; or what the card is doing or why it gave no files.
+//! The card mode's screens: two of the card's G-code files, the cursor on one, each name cut to
+//! the line, or what the card is doing or why it gave no files; the chosen file being checked;
+//! and the file checked, beside its picture:
+//!
+//! ```text
+//! drawing.gcode    ┌──────┐  name (inverted)
+//! 412 lines ~12:34 │ ~~~  │  lines, plot time
+//! 80x60 mm         │  ~~  │  the pen-down strokes' size
+//! # plot  D back   └──────┘  the keys; the travel's outline, the strokes
+//! ```
 
-use crate::card::CardError;
+use embedded_graphics::geometry::{Point, Size};
+use embedded_graphics::primitives::Rectangle;
+
 use crate::card::names::cut_to;
+use crate::card::{CardError, CardFacts};
+use crate::decimal::Int;
 use crate::panel::language::Language;
-use crate::panel::layout::SCREEN_COLUMNS;
+use crate::panel::layout::{SCREEN_CHAR_WIDTH_PX, SCREEN_COLUMNS, SCREEN_HEIGHT_PX, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
 use crate::panel::menu::CardList;
-use crate::panel::texts::Msg;
+use crate::panel::texts::{Msg, Say};
+use crate::program::preview::PICTURE_WIDTH_PX;
 use crate::text::Text;
 
-use super::lines::TextLine;
+use super::lines::{CardMark, PreviewBox, ScreenView, TextLine};
+use super::run::Clock;
+
+/// Columns of text beside the card file's picture.
+const COLUMNS_BESIDE_PICTURE: usize =
+    ((SCREEN_WIDTH_PX - PICTURE_WIDTH_PX as u32 - SCREEN_MARGIN_PX) / SCREEN_CHAR_WIDTH_PX) as usize;
 
 /// What the card says when it gave no files.
 pub const fn card_error_text(e: CardError) -> Msg {
@@ -40,4 +58,44 @@ pub fn card_lines(list: &CardList, language: Language) -> [TextLine; 2] {
         lines[1] = TextLine::say(Msg::KeysCard, language);
     }
     lines
+}
+
+/// The card mode's third and fourth lines while the chosen file is checked, `lines` of it so
+/// far.
+pub fn checking_lines(lines: u32, language: Language) -> [TextLine; 2] {
+    let say = |msg| Say(msg, language);
+    [
+        TextLine::new(format_args!("{} {}", say(Msg::CardChecking), Int::from(lines)), false),
+        TextLine::say(Msg::KeysBack, language),
+    ]
+}
+
+/// The chosen file checked: what the check found, beside the file's picture.
+pub fn checked_view(name: &str, facts: &CardFacts, language: Language) -> ScreenView {
+    let say = |msg| Say(msg, language);
+    let w = COLUMNS_BESIDE_PICTURE;
+    let [width, height] = facts.size_mm.map(|mm| Int::from((mm + 0.5) as i32));
+    let area_x = SCREEN_WIDTH_PX - u32::from(PICTURE_WIDTH_PX);
+    ScreenView {
+        lines: [
+            TextLine::new(format_args!("{}", Text(cut_to(name, w))), true),
+            TextLine::new(
+                format_args!("{} {} ~{}", Int::from(facts.lines), say(Msg::CardLines), Clock(facts.plot_time_ms)),
+                false,
+            ),
+            TextLine::new(format_args!("{width}x{height} mm"), false),
+            TextLine::say(Msg::KeysCardPlot, language),
+        ],
+        preview: Some(PreviewBox {
+            area: Rectangle::new(
+                Point::new(area_x as i32, 0),
+                Size::new(u32::from(PICTURE_WIDTH_PX), SCREEN_HEIGHT_PX),
+            ),
+            plan: false,
+            drawn_points: 0,
+            drawn_last: None,
+            pen: None,
+            card: Some(CardMark { pen: None }),
+        }),
+    }
 }

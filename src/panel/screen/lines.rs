@@ -6,11 +6,13 @@ use core::fmt::{self, Write};
 use embedded_graphics::primitives::Rectangle;
 use heapless::String;
 
+use crate::card::CardPicture;
 use crate::geom::{self, Axis};
 use crate::panel::language::Language;
 use crate::panel::layout::{SCREEN_COLUMNS, SCREEN_LINES};
 use crate::panel::texts::{Msg, Say};
 use crate::panel::trail::Trail;
+use crate::program::preview::Pixel8;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::Padded;
@@ -47,7 +49,8 @@ impl TextLine {
 }
 
 /// Where a path is shown and what it shows: the plan (the preview's, or the run's), the path
-/// drawn so far (as many points, the last one given), and the pen.
+/// drawn so far (as many points, the last one given), and the pen; or, for a card file, its
+/// picture instead.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PreviewBox {
     pub area: Rectangle,
@@ -55,6 +58,15 @@ pub struct PreviewBox {
     pub drawn_points: usize,
     pub drawn_last: Option<geom::Point>,
     pub pen: Option<geom::Point>,
+    /// The card file's picture ([`Live::picture`]) is shown, not the paths.
+    pub card: Option<CardMark>,
+}
+
+/// The card file's picture as shown: where its pen is marked (during a plot), so the view
+/// changes when the pen moves on the picture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CardMark {
+    pub pen: Option<Pixel8>,
 }
 
 /// Everything the screen shows; equal views draw identical frames (for the same plan and path).
@@ -75,11 +87,14 @@ pub struct Live<'a> {
     pub work_offset_mm: [f32; 2],
     /// The path drawn in the current run.
     pub drawn: Option<&'a Trail>,
+    /// The card file's picture, while one is checked or plotted.
+    pub picture: Option<&'a CardPicture>,
 }
 
 impl Live<'_> {
     /// At time zero, at rest, work = machine coordinates, nothing drawn.
-    pub const NONE: Live<'static> = Live { now_ms: 0, speed_mm_per_min: 0.0, work_offset_mm: [0.0; 2], drawn: None };
+    pub const NONE: Live<'static> =
+        Live { now_ms: 0, speed_mm_per_min: 0.0, work_offset_mm: [0.0; 2], drawn: None, picture: None };
 }
 
 /// Writes into a fixed string, silently cutting what does not fit.

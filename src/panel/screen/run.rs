@@ -25,18 +25,20 @@ use heapless::String;
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::primitives::Rectangle;
 
-use super::lines::{Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
+use super::lines::{CardMark, Live, PreviewBox, ScreenView, TextLine, position_in, state_name};
 use crate::card::CardProgress;
 use crate::decimal::{Int, write_digits};
 use crate::panel::language::Language;
 use crate::panel::layout::{
     PREVIEW_BESIDE_WIDTH_PX, PREVIEW_CONFIRM_WIDTH_PX, SCREEN_CHAR_WIDTH_PX, SCREEN_COLUMNS, SCREEN_HEIGHT_PX,
-    SCREEN_MARGIN_PX, SCREEN_WIDTH_PX,
+    SCREEN_LINES, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX,
 };
 use crate::panel::menu::Menu;
 use crate::panel::run::{JOB_NAME_CHARS, Plan, Run, RunPage};
 use crate::panel::texts::{Msg, Say};
 use crate::panel::trail::Trail;
+use crate::program::preview::PICTURE_WIDTH_PX;
+use crate::program::preview::PlotProgress;
 use crate::settings::Settings;
 use crate::status::{RunState, Status};
 use crate::text::Padded;
@@ -56,7 +58,7 @@ fn line(args: fmt::Arguments) -> TextLine {
 }
 
 /// A time as `m:ss` (minutes beyond 59 as they are).
-struct Clock(u32);
+pub(super) struct Clock(pub(super) u32);
 
 impl fmt::Display for Clock {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -82,8 +84,36 @@ pub(super) fn preview_view(plan: &Plan, status: &Status, language: Language) -> 
             drawn_points: 0,
             drawn_last: None,
             pen: Some(status.position),
+            card: None,
         }),
     }
+}
+
+/// Beside a card file's picture: its name, the share drawn, the time left and the line.
+fn card_progress_lines(
+    menu: &Menu,
+    run: &Run,
+    status: &Status,
+    live: &Live,
+    name: &str,
+    language: Language,
+) -> [TextLine; SCREEN_LINES] {
+    let say = |msg| Say(msg, language);
+    let w = columns_beside(u32::from(PICTURE_WIDTH_PX));
+    let percent = run.percent(status.emitted_steps).unwrap_or(0);
+    let left = run.left_ms(status.emitted_steps, status.overrides.feed_percent, live.now_ms).unwrap_or(0);
+    let line_of = match menu.card_progress() {
+        CardProgress::Plotting { done, total } => {
+            line(format_args!("{} {}/{}", say(Msg::CardLine), Int::from(done), Int::from(total)))
+        }
+        _ => TextLine::default(),
+    };
+    [
+        TextLine::new(format_args!("{}", Padded::left(name, w)), true),
+        line(format_args!("{}% {}", Int::from(percent), Clock(run.elapsed_ms(live.now_ms)))),
+        line(format_args!("{} {}", say(Msg::Left), Clock(left))),
+        line_of,
+    ]
 }
 
 /// The run screen, on the menu's page.
@@ -115,11 +145,20 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
         drawn_points: live.drawn.map_or(0, |d| d.points().len()),
         drawn_last: live.drawn.and_then(Trail::last),
         pen: Some(status.position),
+        card: None,
     };
+    // A card file's plot shows its picture on the whole screen's page, its progress beside it.
+    let card = live.picture.map(|p| CardMark { pen: p.progress.as_ref().and_then(PlotProgress::pen) });
     match menu.run_page() {
         RunPage::Preview => ScreenView {
-            lines: Default::default(),
-            preview: Some(preview(Rectangle::new(Point::zero(), Size::new(SCREEN_WIDTH_PX, SCREEN_HEIGHT_PX)))),
+            lines: match card {
+                Some(_) => card_progress_lines(menu, run, status, live, name, language),
+                None => Default::default(),
+            },
+            preview: Some(PreviewBox {
+                card,
+                ..preview(Rectangle::new(Point::zero(), Size::new(SCREEN_WIDTH_PX, SCREEN_HEIGHT_PX)))
+            }),
         },
         RunPage::Machine => {
             let w = SCREEN_COLUMNS - state.columns();
@@ -148,9 +187,7 @@ pub(super) fn run_view(menu: &Menu, run: &Run, status: &Status, settings: &Setti
                     CardProgress::Plotting { done, total } => {
                         line(format_args!("{elapsed} {} {}/{}", say(Msg::CardLine), Int::from(done), Int::from(total)))
                     }
-                    CardProgress::None => {
-                        line(format_args!("{elapsed}  {} {}", Int::from(status.queued_jobs), say(Msg::Queued)))
-                    }
+                    _ => line(format_args!("{elapsed}  {} {}", Int::from(status.queued_jobs), say(Msg::Queued))),
                 },
             };
             let speed = if done { 0 } else { (live.speed_mm_per_min + 0.5) as i32 };
