@@ -49,6 +49,9 @@ pub enum MotionFault {
     Tripped(Trip),
     /// A homing cycle failed.
     Homing(HomingFail),
+    /// The card was removed, or could not be read, while a file of it was plotted: the plot
+    /// stopped on its path and the pen went up.
+    CardLost,
 }
 
 /// A snapshot of the machine for displays and reports.

@@ -4,6 +4,7 @@
 use servoplot::card::fat::FatCard;
 use servoplot::geom::Point;
 use servoplot::sim::card::{ImageBlocks, SimCard, image_of};
+use servoplot::sim::inputs::InputScript;
 use servoplot::sim::keys::KeyScript;
 use servoplot::sim::lcd::Frame;
 use servoplot::sim::serial::SimSerial;
@@ -221,4 +222,31 @@ fn the_run_screen_follows_a_card_plot_through_its_pen_lifts_and_shows_its_pictur
     let (_, frame) = report.frames.iter().find(|(_, f)| lines(f) == page).unwrap();
     let lit = (82..122).flat_map(|x| (0..32).map(move |y| (x, y))).filter(|&(x, y)| frame.pixels[y][x]).count();
     assert!(lit > 100, "the picture is drawn: {lit} pixels");
+}
+
+#[test]
+fn a_card_removed_mid_plot_stops_on_the_path_lifts_the_pen_and_alarms() {
+    // A vpype file, pen lifted by M3/M5; the card pulled 4 s after power-on, mid-plot.
+    let file = polyline_file();
+    let keys = KeyScript::parse(&format!("{TO_CARD} # {PLOT}")).unwrap();
+    let events = InputScript::parse("4000 on card-out").unwrap();
+    let card = Some(card(&[("vpype.gcode", file.as_bytes())]));
+    let report = sim::run(SimConfig { keys, events, card, ..SimConfig::default() });
+    let wire = sim::run_serial(&file).path();
+    let drawn = report.path();
+    assert!(drawn.len() > 100 && drawn.len() < wire.len(), "stopped part way: {} of {}", drawn.len(), wire.len());
+    assert_eq!(drawn[..], wire[..drawn.len()], "every step on the file's path: a stop on the path");
+    assert_eq!(Some(&report.position), drawn.last(), "the position is where the pen stopped");
+    let answers = report.answers();
+    assert!(answers.contains("ALARM:22\r\n[MSG:Card lost mid-plot"), "the host is told: {answers}");
+    // The pen went down for the strokes, and is up (as at power-on) once stopped.
+    let (first, last) = (report.pen.first().expect("pen").1, report.pen.last().expect("pen").1);
+    assert!(report.pen.iter().any(|&(_, us)| us != first), "the pen went down");
+    assert_eq!(last, first, "and is up at the end");
+    let stop_us = report.trace.pulses.last().expect("pulses").t_us;
+    let up_at = report.pen.last().unwrap().0;
+    assert!(up_at >= stop_us, "lifted once stopped, not while moving");
+    let end = lines(&report.frames.last().expect("frames").1);
+    assert!(end[0].starts_with("vpype.gcode") && end[0].contains("ALARM"), "the run screen says ALARM: {end:?}");
+    assert!(end[3].starts_with("No card"), "and why: {end:?}");
 }

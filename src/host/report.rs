@@ -159,6 +159,8 @@ pub const ALARM_DRIVER: u8 = 17;
 pub const ALARM_CURVE_STOPPED: u8 = 20;
 /// The alarm code for the step timer's interrupt coming a whole period late (not a GRBL code).
 pub const ALARM_MISSED_UPDATE: u8 = 21;
+/// The alarm code for the card lost while a file of it was plotted (not a GRBL code).
+pub const ALARM_CARD_LOST: u8 = 22;
 
 /// The alarm pushed when `fault` stops the machine: `ALARM:N`, then what happened and what
 /// clears it.
@@ -167,6 +169,9 @@ pub fn alarm(out: &mut impl Write, fault: MotionFault) -> fmt::Result {
         MotionFault::Curve(e) => curve_stopped(e),
         MotionFault::Tripped(trip) => tripped(trip),
         MotionFault::Homing(fail) => homing_failed(fail),
+        MotionFault::CardLost => {
+            (ALARM_CARD_LOST, ["Card lost mid-plot: stopped on the path, pen up", "", "", "; '$X' to unlock"])
+        }
     };
     let [a, b, c, d] = says.map(Text);
     write!(out, "ALARM:{}\r\n[MSG:{a}{b}{c}{d}]\r\n", Int::from(code))

@@ -3,7 +3,8 @@
 //! An alarm is raised by whoever finds the fault, and cleared only by an unlock, as GRBL's alarm
 //! state is: the motion task raises it for a curve that stopped part way or a trip, the homing
 //! task for a cycle that failed, the host link on the reset after `$SLP` (the free axes may have
-//! been moved), and the machine starts in it when homing is required. `$X` (the host link) and a
+//! been moved) and when the card is lost mid-plot, and the machine starts in it when homing is
+//! required. `$X` (the host link) and a
 //! homing cycle's start (the homing task) clear it. Each of these is one store of a whole value,
 //! done through the poster's own handle; no one else writes the latch.
 //!

@@ -62,6 +62,12 @@ impl HostWriter<'_> {
         }
     }
 
+    /// The card was lost while a file of it was plotted, and the machine has stopped: the alarm,
+    /// until `$X` (one of the [`alarm`](super::alarm)'s posters).
+    pub fn card_lost(self) {
+        self.machine.raise_alarm(Some(MotionFault::CardLost));
+    }
+
     /// `$X`: leaves the alarm, and lets pulses out again after a trip (handled by the motion
     /// task by now: the machine has stopped). One of the [`alarm`](super::alarm)'s posters.
     pub fn unlock(self) {

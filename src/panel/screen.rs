@@ -399,6 +399,7 @@ impl fmt::Display for FaultText {
             MotionFault::Curve(CurveError::Jump) => Msg::FaultJump,
             MotionFault::Curve(CurveError::Aliased) => Msg::ErrFine,
             MotionFault::Curve(CurveError::Travel) => Msg::FaultTravel,
+            MotionFault::CardLost => return write!(f, "{}", say(Msg::FaultCardLost)),
         };
         write!(f, "{}: {}", say(Msg::FaultStopped), say(why))
     }

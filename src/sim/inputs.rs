@@ -7,7 +7,9 @@
 //! drivers' alarms and the emergency stop are wired (they read low until raised) and raised only
 //! by an event script: each line is `<time ms> on|off <input>`, the input one of `x-` `x+` `y-`
 //! `y+` (a switch forced pressed, as when stuck, or released again), `alarm-x` `alarm-y` (a
-//! driver's alarm output) or `estop`. `#` starts a comment. For example:
+//! driver's alarm output), `estop`, or `card-out` (the card taken out of its slot, and put back
+//! with `off`; not an input pin: the simulated card slot reads it). `#` starts a comment. For
+//! example:
 //!
 //! ```text
 //! 1500 on alarm-x     # the X driver faults 1.5 s after power-on
@@ -15,6 +17,7 @@
 //! 2300 off estop
 //! 400 on y-           # a glitch of 0.2 ms on the Y min switch
 //! 400.2 off y-
+//! 3000 on card-out    # the card pulled 3 s after power-on
 //! ```
 
 use std::cell::RefCell;
@@ -30,6 +33,11 @@ use crate::machine_io::inputs::{
 use crate::settings::Settings;
 use crate::sim::clock;
 use crate::sim::pins::PulseTrace;
+
+/// The script's bit for the card taken out of its slot (no input pin's: the pins' bits are the
+/// low seven, see [`crate::machine_io::inputs`]).
+pub const CARD_OUT: u8 = 1 << 7;
+const _: () = assert!((LIMITS | DRIVER_ALARM_X | DRIVER_ALARM_Y | ESTOP) & CARD_OUT == 0);
 
 /// One scripted change of an input.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,6 +84,7 @@ impl InputScript {
                 "alarm-x" => DRIVER_ALARM_X,
                 "alarm-y" => DRIVER_ALARM_Y,
                 "estop" => ESTOP,
+                "card-out" => CARD_OUT,
                 _ => return Err(bad("unknown input")),
             };
             events.push(InputEvent { t_us: (t_ms * 1_000.0).round() as u64, input, on });
@@ -136,6 +145,11 @@ impl SimInputs {
         SimInputs { trace, script: Rc::new(script), switch_at, invert_mask: settings.dir_invert_mask }
     }
 
+    /// True while the script has the card out of its slot.
+    pub fn card_out(&self) -> bool {
+        self.script.raised_at(clock::now_ticks()) & CARD_OUT != 0
+    }
+
     /// The pins' levels now.
     pub fn levels(&self) -> InputLevels {
         let mut pressed = 0;
@@ -154,7 +168,7 @@ impl SimInputs {
                 }
             }
         }
-        let raised = self.script.raised_at(clock::now_ticks()) | pressed;
+        let raised = (self.script.raised_at(clock::now_ticks()) & !CARD_OUT) | pressed;
         // Switches pressed read low; alarms and the e-stop raised read high.
         (LIMITS & !raised) | (raised & !LIMITS)
     }

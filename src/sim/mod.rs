@@ -14,6 +14,7 @@
 //! while no work charged there (a slice of a build, see [`cpu::ThreadLevel`]) holds it.
 
 pub mod card;
+pub mod card_slot;
 pub mod cli;
 pub mod clock;
 pub mod cpu;
@@ -216,12 +217,10 @@ pub fn run(config: SimConfig) -> SimReport {
     let machine = Machine::new(store.kept().settings);
     let Some(handles) = machine.handles() else { unreachable!("a new machine has its handles") };
     let panel = Panel::new();
-    let (mut sim_card, mut no_slot) = (config.card, crate::card::NoSlot);
-    let slot = CardSlot::new(match &mut sim_card {
-        Some(card) => card,
-        None => &mut no_slot,
-    });
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
+    let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
+    let mut sim_slot = card_slot::SimSlot::new(config.card, inputs.clone());
+    let slot = CardSlot::new(&mut sim_slot);
     let mut step_queue = StepQueue::new();
     // On the heap: the host's stack need not hold its 50 KB.
     let mut planner: std::boxed::Box<Planner<Curve, PLANNER_SEGMENTS>> =
@@ -232,7 +231,6 @@ pub fn run(config: SimConfig) -> SimReport {
     let mut check = std::boxed::Box::new(ProgramCheck::new(GcodeState::new(), &machine.settings(), Pen::Up));
     let room = CardRoom { slot: &slot, check: &mut check, planner: &mut check_planner };
     let (steps, step_consumer) = step_queue.split();
-    let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
     let timer = SimStepTimer::new(pins, inputs.clone()).with_late_interrupt(config.late_interrupt);
     let mut engine = PulseEngine::new(timer, step_consumer);

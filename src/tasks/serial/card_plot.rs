@@ -17,7 +17,7 @@
 
 use embedded_io_async::{ErrorType, Write};
 
-use crate::card::{CardFacts, CardFile, CardLine, CardLines, CardProgress, CardSlot, CardStop};
+use crate::card::{CardError, CardFacts, CardFile, CardLine, CardLines, CardProgress, CardSlot, CardStop};
 use crate::host::GrblError;
 use crate::program::check::{CheckPlanner, ProgramCheck};
 use crate::program::preview::PlotProgress;
@@ -76,7 +76,9 @@ pub enum CardStep<'a> {
     Refused { number: u32, error: GrblError },
     /// Every line is sent: the plot lasts until the machine rests.
     SentAll,
-    /// The plot is over: the card failed, or the last move has ended.
+    /// The card failed (removed, unreadable) before every line was sent.
+    Lost(CardError),
+    /// The plot is over: every line was sent.
     Over,
 }
 
@@ -117,10 +119,7 @@ impl CardPlot {
                 self.sent_all = true;
                 CardStep::SentAll
             }
-            Err(e) => {
-                slot.stopped(CardStop::Card(e));
-                CardStep::Over
-            }
+            Err(e) => CardStep::Lost(e),
         }
     }
 

@@ -7,7 +7,9 @@ use embedded_storage::nor_flash::NorFlash;
 
 use super::card_plot::{CardPlot, CardRoom, CardSession, CardStep, CardTurn, US_PER_MS, end};
 use super::{Host, Parser, Unfinished};
-use crate::card::{CardFacts, CardFile, CardLine, CardLines, CardPicture, CardProgress, CardSlot, CardStop};
+use crate::card::{CardError, CardFacts, CardFile, CardLine, CardLines, CardPicture, CardProgress, CardSlot, CardStop};
+use crate::machine_io::pen::Pen;
+use crate::motion::job::Control;
 use crate::program::check::Progress;
 use crate::program::preview::StrokeMap;
 use crate::tasks::slices::BetweenSlices;
@@ -170,6 +172,10 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             }
             CardStep::Refused { number, error } if !aborted => (number, Err(Unfinished::Error(error))),
             CardStep::SentAll => return true,
+            CardStep::Lost(e) if !aborted => {
+                self.card_lost(slot, e).await;
+                return false;
+            }
             _ => {
                 self.card_end(slot);
                 return false;
@@ -192,6 +198,20 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         }
         self.card_end(slot);
         false
+    }
+
+    /// The card failed before the plot's last line was sent: what is queued would end the plot
+    /// at some point of the file no one chose. So the pen stops on its path (an abort: a
+    /// controlled stop, the position exact), the lines queued behind are dropped, the pen goes
+    /// up, and the machine is in an alarm until `$X`; the LCD and the log say why.
+    async fn card_lost(&mut self, slot: &CardSlot<'_>, e: CardError) {
+        let host = self.host;
+        host.machine.request(Control::Abort);
+        drop(host.machine_stopped().await);
+        host.machine.set_pen(Pen::Up);
+        host.machine.card_lost();
+        self.card_end(slot);
+        slot.stopped(CardStop::Card(e));
     }
 
     /// The card's file is done with: host lines are taken again.
