@@ -20,7 +20,7 @@
 //! yield between calls. A line of `n` steps takes about `n / BUILD_SLICE_STEPS` calls to walk
 //! (a curve; a straight line none) and `n / PLAN_SLICE_STEPS` to time, each call within a few
 //! milliseconds of the F407: a circle of 100 mm diameter (40,000 steps at the defaults) about
-//! 65 calls. The line's text is needed only by `push_line`. Nothing here waits, reads a card or
+//! 180 calls. The line's text is needed only by `push_line`. Nothing here waits, reads a card or
 //! moves anything.
 //!
 //! Commands of the host's session have no place in a program and are refused as the parser
@@ -47,11 +47,11 @@ use crate::status::RunState;
 pub type CheckPlanner = Planner<Curve, PLANNER_SEGMENTS>;
 
 /// Step commands one [`ProgramCheck::work`] takes from the planner at most. The planner's work
-/// per step is within the motion's budget (at most 400 instructions per step, the dearest curve,
-/// see the README's cost table) and the picture's a few dozen more (a pixel per step), so a
-/// call should take at most about 2.5 ms of the F407 (an estimate from those budgets, not yet
-/// counted on the model board): well within the 10 ms any task may hold the processor.
-pub const PLAN_SLICE_STEPS: usize = 1024;
+/// per step is the motion's (up to about 900 instructions a step for a function of 27
+/// operations, see the README's cost table) and the picture's (a pixel per step): 1024 steps
+/// took up to 11.6 ms of the F407 on the model board (`model/card.py`), so a quarter of that,
+/// well within the 10 ms any task may hold the processor.
+pub const PLAN_SLICE_STEPS: usize = 256;
 
 /// Step commands taken from the planner at a time, within a call.
 const PLAN_BATCH_STEPS: usize = 64;

@@ -14,14 +14,18 @@
 //! | TIM7 vector, the pulse news        | IRQ 16                                              |
 //! | flash sectors 10-11, the store     | code RAM at the same offsets (`devices::ModelFlash`) |
 //! | ST7920 on SPI2                     | the same driver on a bus that takes the F407's time |
-//! | keypad, SON, LED, buzzer, pen      | pins that drive nothing; no key pressed; inputs idle |
+//! | keypad matrix                      | keys tapped by the host on UART 2 (`keys`)          |
+//! | microSD card on SPI3               | a FAT image QEMU loads into its PSRAM (`card`)      |
+//! | SON, LED, buzzer, pen              | pins that drive nothing; inputs idle                |
 //! | defmt over RTT                     | defmt over semihosting, to QEMU's standard output   |
 //!
 //! A panic, a hard fault, an unexpected interrupt or the watchdog running out ends QEMU with a
 //! non-zero status (semihosting), after a line in the log.
 
+mod card;
 mod clock;
 mod devices;
+mod keys;
 pub mod poll_clock;
 mod regs;
 mod step_timer;
@@ -58,8 +62,8 @@ const EXIT_WRONG_MACHINE: i32 = 105;
 const SCC_ID: usize = 0x4002_FFFC;
 const SCC_ID_AN386: u32 = 0x4104_3860;
 
-pub type Column = devices::NoPin;
-pub type Row = devices::NoPin;
+pub type Column = keys::ModelColumn;
+pub type Row = keys::ModelRow;
 pub type Output = devices::NoPin;
 pub type PenPwm = devices::NoPwm;
 pub type Flash = devices::ModelFlash;
@@ -68,8 +72,7 @@ pub type HostTx = uart::UartTx;
 pub type LinkRx = uart::UartRx;
 pub type LinkTx = uart::UartTx;
 pub type Lcd = St7920Lcd<devices::LcdBus, devices::NoPin, Delay>;
-/// The model has no card slot: the card mode says "No card".
-pub type Card = servoplot::card::NoSlot;
+pub type Card = card::ModelCard;
 pub type Watchdog = clock::Watchdog;
 
 /// Everything the firmware's tasks drive, set up and idle.
@@ -94,7 +97,7 @@ pub fn safe_outputs() {
 }
 
 /// Sets the model up: its clock and watchdog (running from here on), the step timer, the two
-/// UARTs, at the firmware's priorities.
+/// UARTs, at the firmware's priorities, and the keys' UART.
 #[inline(never)]
 pub fn init(_spawner: Spawner) -> Board {
     if regs::read(SCC_ID, 0) != SCC_ID_AN386 {
@@ -111,13 +114,14 @@ pub fn init(_spawner: Spawner) -> Board {
         }
     }
     let watchdog = clock::Watchdog::start(WATCHDOG_TIMEOUT_MS);
+    keys::start();
     Board {
         step_timer: ModelStepTimer::new(),
         son: devices::NoPin,
         pen: devices::NoPwm,
         lights: [devices::NoPin, devices::NoPin],
-        columns: [devices::NoPin, devices::NoPin, devices::NoPin, devices::NoPin],
-        rows: [devices::NoPin, devices::NoPin, devices::NoPin, devices::NoPin],
+        columns: [0, 1, 2, 3].map(keys::ModelColumn),
+        rows: [0, 1, 2, 3].map(keys::ModelRow),
         watchdog,
         flash: devices::ModelFlash,
         host: uart::open(&uart::UART0_PORT, priority::HOST_LINK),
@@ -125,7 +129,7 @@ pub fn init(_spawner: Spawner) -> Board {
         lcd: St7920Lcd::new(devices::LcdBus, devices::NoPin, devices::NoPin, Delay, devices::LCD_SPI_HZ),
         card: {
             static CARD: static_cell::StaticCell<Card> = static_cell::StaticCell::new();
-            CARD.init(servoplot::card::NoSlot)
+            card::ModelCard::place(CARD.uninit())
         },
     }
 }

@@ -75,7 +75,11 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                 }
             }
             (CardTurn::Step, CardSession::Plotting(plot)) => {
-                if self.card_step(slot, plot).await {
+                let goes_on = self.card_step(slot, plot).await;
+                // A line that queued without waiting leaves the loop ready at once for the next:
+                // the other tasks run between two lines, as between two pieces of the check.
+                yield_now().await;
+                if goes_on {
                     return;
                 }
                 CardSession::Idle
