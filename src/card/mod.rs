@@ -10,6 +10,7 @@
 pub mod fat;
 pub mod lines;
 pub mod names;
+pub mod resume;
 pub mod slot;
 
 pub use lines::{CardLine, CardLines};
