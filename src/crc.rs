@@ -2,6 +2,8 @@
 //! and the card's resume record.
 
 /// CRC-32 (IEEE 802.3, reflected), bit by bit: a few hundred bytes per save or record read.
+/// Out of line, so that its callers share one copy in the image.
+#[inline(never)]
 pub fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = !0u32;
     for &byte in bytes {
