@@ -150,7 +150,9 @@ impl ResumeRecord {
         }
         let seq = u32::from_le_bytes(r.take());
         let file = name(&r.take())?;
-        let [file_bytes, offset, line] = [(); 3].map(|_| u32::from_le_bytes(r.take()));
+        let file_bytes = u32::from_le_bytes(r.take());
+        let offset = u32::from_le_bytes(r.take());
+        let line = u32::from_le_bytes(r.take());
         if line == 0 || offset > file_bytes || line - 1 > offset {
             return Err(BadResume::Place);
         }
@@ -172,12 +174,16 @@ impl ResumeRecord {
         }
         let feed_mm_per_min = optional(r.f32(), flags & FLAG_FEED != 0)?;
         let spindle_speed = optional(r.f32(), flags & FLAG_SPEED != 0)?;
-        let mut pair = || [r.f32(), r.f32()];
-        let kept_mm: [[f32; 2]; KEPT_OFFSETS] = core::array::from_fn(|_| pair());
-        let g92_mm = pair();
-        if !kept_mm.iter().chain([&g92_mm]).flatten().all(|v| v.is_finite()) {
-            return Err(BadResume::Number);
+        let mut offsets_mm = [[0.0; 2]; KEPT_OFFSETS + 1];
+        for pair in &mut offsets_mm {
+            *pair = [r.f32(), r.f32()];
+            if !(pair[0].is_finite() && pair[1].is_finite()) {
+                return Err(BadResume::Number);
+            }
         }
+        let mut kept_mm = [[0.0; 2]; KEPT_OFFSETS];
+        kept_mm.copy_from_slice(&offsets_mm[..KEPT_OFFSETS]);
+        let g92_mm = offsets_mm[KEPT_OFFSETS];
         let modal = Modal {
             motion,
             units,
