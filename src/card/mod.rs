@@ -3,9 +3,10 @@
 //! This module owns what the plotter makes of a card: the list of its G-code files
 //! ([`names`]), the lines of the file being plotted, framed by the host links' own rules
 //! ([`lines`]), the resume record a plot keeps on the card ([`resume`]), and the FAT volume on
-//! the card's 512-byte blocks ([`fat`], through the `embedded-sdmmc` crate). The boards give the blocks: the simulator a FAT image file, the
-//! F407 the card on SPI. Everything here is synchronous and owns no pin; the card is reached
-//! through [`Card`], which the boards implement.
+//! the card's 512-byte blocks ([`fat`], through the `embedded-sdmmc` crate). The boards give the
+//! blocks: the simulator a FAT image file, the F407 the card on SPI. Everything here is
+//! synchronous and owns no pin; the card is reached through [`Card`], which the boards
+//! implement.
 
 pub mod fat;
 pub mod lines;
@@ -61,15 +62,14 @@ pub trait Card {
 
     /// Reads the resume record's file ([`resume`]) into `slots`: each slot's record bytes,
     /// zeros where the card has no file or the file no such slot. The open file stays open, and
-    /// is read on from where it was. A slot that keeps no record (no card) says
-    /// [`CardError::NoCard`].
+    /// is read on from where it was. By default the slot keeps no record: [`CardError::NoCard`].
     fn read_resume(&mut self, _slots: &mut ResumeSlots) -> Result<(), CardError> {
         Err(CardError::NoCard)
     }
-    /// Writes `bytes` at the start of slot `slot` of the resume record's file, and only there
-    /// (its other slot is not written): the file is first made, at its full length, if the card
-    /// has none. The open file stays open, and is read on from where it was. A slot that keeps
-    /// no record (no card) says [`CardError::NoCard`].
+    /// Writes `bytes` at the start of slot `slot` of the resume record's file, and nowhere
+    /// else: the other slot is not written (but for the zeros that first fill out a file made
+    /// now, or one shorter than its two slots). The open file stays open, and is read on from
+    /// where it was. By default the slot keeps no record: [`CardError::NoCard`].
     fn write_resume(&mut self, _slot: usize, _bytes: &ResumeBytes) -> Result<(), CardError> {
         Err(CardError::NoCard)
     }
