@@ -15,6 +15,7 @@ extern crate std;
 mod fmt;
 
 pub mod card;
+pub mod crc;
 #[cfg(target_os = "none")]
 pub mod critical;
 pub mod decimal;

@@ -38,6 +38,8 @@ use core::ops::Range;
 
 use embedded_storage::nor_flash::NorFlash;
 
+use crate::crc::crc32;
+
 use crate::host::gcode::Offsets;
 use crate::host::startup::StartupLines;
 use crate::settings::Settings;
@@ -341,16 +343,4 @@ fn header_seq(copy: &[u8]) -> Option<u32> {
 /// The little-endian word at `at` in `bytes`.
 fn le_u32(bytes: &[u8], at: usize) -> u32 {
     u32::from_le_bytes([0, 1, 2, 3].map(|k| bytes[at + k]))
-}
-
-/// CRC-32 (IEEE 802.3, reflected), bit by bit: a few hundred bytes per save or record read.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
-        }
-    }
-    !crc
 }

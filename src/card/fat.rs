@@ -12,6 +12,7 @@ use embedded_sdmmc::{
 use heapless::String;
 
 use super::names::CARD_SHORT_NAME_MAX_BYTES;
+use super::resume::{RESUME_FILE_BYTES, RESUME_FILE_NAME, RESUME_SLOT_BYTES, ResumeBytes, ResumeSlots};
 use super::{CARD_NAME_MAX_BYTES, Card, CardError, CardFile, CardFiles};
 
 /// Where a partition table's first entry starts in block 0, and its type byte.
@@ -22,7 +23,8 @@ const MBR_TYPE_FAT16_LBA: u8 = 0x0E;
 const MBR_TYPE_FAT32_LBA: u8 = 0x0C;
 const MBR_FAT_TYPES: [u8; 5] = [0x01, 0x04, 0x06, MBR_TYPE_FAT16_LBA, MBR_TYPE_FAT32_LBA];
 
-/// The plotter writes nothing yet, so no file times: every stamp is the FAT epoch.
+/// The plotter keeps no clock, so no file times: every stamp is the FAT epoch (and a store
+/// rewrites the resume record's directory entry as it was).
 pub struct NoClock;
 
 impl TimeSource for NoClock {
@@ -122,8 +124,15 @@ impl<D: BlockDevice> BlockDevice for Partitioned<D> {
     }
 }
 
-/// The volume manager for one volume, one folder and one file open at a time.
-type Volumes<D> = VolumeManager<Partitioned<D>, NoClock, 1, 1, 1>;
+/// Volumes open at once: the card's first.
+const OPEN_VOLUMES_MAX: usize = 1;
+/// Folders open at once: the top one, which the plotted file and the resume record share.
+const OPEN_DIRS_MAX: usize = 1;
+/// Files open at once: the plotted file, and the resume record while it is read or stored.
+const OPEN_FILES_MAX: usize = 2;
+
+/// The volume manager for the limits above.
+type Volumes<D> = VolumeManager<Partitioned<D>, NoClock, OPEN_DIRS_MAX, OPEN_FILES_MAX, OPEN_VOLUMES_MAX>;
 
 /// A FAT card on `D`'s blocks: its first partition's top folder.
 pub struct FatCard<D: BlockDevice> {
@@ -131,6 +140,9 @@ pub struct FatCard<D: BlockDevice> {
     /// The volume, folder and file open while a file is read.
     open: Option<(RawVolume, RawDirectory, RawFile)>,
 }
+
+/// Zeros to fill the resume record's file with, a piece at a time.
+const ZERO_FILL_BYTES: usize = 64;
 
 /// The first of the volume manager's handle numbers (any will do).
 const HANDLE_IDS_FROM: u32 = 1;
@@ -168,6 +180,57 @@ impl<D: BlockDevice> FatCard<D> {
         let _ = self.volumes.close_dir(dir);
         let _ = self.volumes.close_volume(volume);
     }
+
+    /// Runs `f` on the top folder: the open file's (a volume is opened once), else opened for
+    /// `f` alone.
+    fn in_root<R>(&self, f: impl FnOnce(&Volumes<D>, RawDirectory) -> Result<R, CardError>) -> Result<R, CardError> {
+        if let Some((_, dir, _)) = self.open {
+            return f(&self.volumes, dir);
+        }
+        let (volume, dir) = self.open_root()?;
+        let result = f(&self.volumes, dir);
+        self.close_root(volume, dir);
+        result
+    }
+}
+
+/// Reads each slot's record bytes from the resume record's `file`; a slot the file is too short
+/// for is left as it was.
+fn read_slots<D: BlockDevice>(volumes: &Volumes<D>, file: RawFile, slots: &mut ResumeSlots) -> Result<(), CardError> {
+    let length = volumes.file_length(file).map_err(card_error)? as usize;
+    for (i, slot) in slots.slots.iter_mut().enumerate() {
+        let at = i * RESUME_SLOT_BYTES;
+        if at >= length {
+            break;
+        }
+        volumes.file_seek_from_start(file, at as u32).map_err(card_error)?;
+        let mut got = 0;
+        while got < slot.len() {
+            match volumes.read(file, &mut slot[got..]).map_err(card_error)? {
+                0 => break,
+                n => got += n,
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Writes `bytes` at the start of slot `slot` of the resume record's `file`, open for writing
+/// at its end: the file is first filled out with zeros to its two slots.
+fn write_slot<D: BlockDevice>(
+    volumes: &Volumes<D>,
+    file: RawFile,
+    slot: usize,
+    bytes: &ResumeBytes,
+) -> Result<(), CardError> {
+    let mut length = volumes.file_length(file).map_err(card_error)? as usize;
+    while length < RESUME_FILE_BYTES {
+        let n = ZERO_FILL_BYTES.min(RESUME_FILE_BYTES - length);
+        volumes.write(file, &[0; ZERO_FILL_BYTES][..n]).map_err(card_error)?;
+        length += n;
+    }
+    volumes.file_seek_from_start(file, (slot * RESUME_SLOT_BYTES) as u32).map_err(card_error)?;
+    volumes.write(file, bytes).map_err(card_error)
 }
 
 /// What the crate's error means to the user.
@@ -227,6 +290,31 @@ impl<D: BlockDevice> Card for FatCard<D> {
             let _ = self.volumes.close_file(file);
             self.close_root(volume, dir);
         }
+    }
+
+    fn read_resume(&mut self, slots: &mut ResumeSlots) -> Result<(), CardError> {
+        *slots = ResumeSlots::new();
+        self.in_root(|volumes, dir| {
+            let file = match volumes.open_file_in_dir(dir, RESUME_FILE_NAME, Mode::ReadOnly) {
+                Err(Error::NotFound) => return Ok(()),
+                opened => opened.map_err(card_error)?,
+            };
+            let read = read_slots(volumes, file, slots);
+            let _ = volumes.close_file(file);
+            read
+        })
+    }
+
+    fn write_resume(&mut self, slot: usize, bytes: &ResumeBytes) -> Result<(), CardError> {
+        self.in_root(|volumes, dir| {
+            // Created if missing, else open at its end.
+            let file =
+                volumes.open_file_in_dir(dir, RESUME_FILE_NAME, Mode::ReadWriteCreateOrAppend).map_err(card_error)?;
+            let written = write_slot(volumes, file, slot, bytes);
+            // Closing writes the file's directory entry (unchanged once the file has its size).
+            let closed = volumes.close_file(file).map_err(card_error);
+            written.and(closed)
+        })
     }
 }
 

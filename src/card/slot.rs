@@ -72,7 +72,8 @@ pub struct CardPicture {
     pub progress: Option<PlotProgress>,
 }
 
-/// A board without a card slot (the model board): every look says there is no card.
+/// A board without a card slot (the model board): every look says there is no card, and it
+/// keeps no resume record.
 pub struct NoSlot;
 
 impl Card for NoSlot {

@@ -114,6 +114,7 @@ mod curves;
 mod modal;
 mod motion;
 mod offsets;
+mod snapshot;
 mod system;
 mod words;
 
@@ -121,6 +122,7 @@ pub use modal::{
     Coolant, Distance, MM_PER_INCH, MotionMode, Spindle, TOOL_NUMBER_MAX, Units, WORK_SYSTEMS, WorkSystem,
 };
 pub use offsets::{KEPT_OFFSETS, Offsets, StoredPosition};
+pub use snapshot::Modal;
 
 use super::GrblError;
 use crate::geom::{Axis, Point};

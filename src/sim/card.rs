@@ -73,6 +73,13 @@ impl BlockDevice for ImageBlocks {
 /// The simulator's card: a FAT volume on an image in memory.
 pub type SimCard = FatCard<ImageBlocks>;
 
+impl SimCard {
+    /// The image's bytes as they are now, what the plotter wrote included.
+    pub fn image(&self) -> Vec<u8> {
+        self.with_blocks(|blocks| blocks.bytes.borrow().clone())
+    }
+}
+
 /// The card whose image is the file at `path`.
 pub fn card_from_image(path: &Path) -> Result<SimCard, String> {
     let bytes = std::fs::read(path).map_err(|e| std::format!("--sd {}: {e}", path.display()))?;
@@ -82,8 +89,29 @@ pub fn card_from_image(path: &Path) -> Result<SimCard, String> {
 /// A FAT16 image of [`SD_DIR_IMAGE_BLOCKS`] blocks holding `files` (name, bytes) in its top
 /// folder, without a partition table, as `mkfs.fat -C` and `mcopy` make one.
 pub fn image_of(files: &[(&str, &[u8])]) -> Result<Vec<u8>, String> {
-    let mut disk = Cursor::new(std::vec![0u8; SD_DIR_IMAGE_BLOCKS as usize * BLOCK_BYTES]);
     let options = fatfs::FormatVolumeOptions::new().fat_type(fatfs::FatType::Fat16);
+    image_formatted(options, SD_DIR_IMAGE_BLOCKS, files)
+}
+
+/// Size of the FAT32 image [`fat32_image_of`] makes, in 512-byte blocks: 36 MiB, the least
+/// that holds the clusters of a FAT32 volume (65,525 or more) at a block per cluster.
+pub const FAT32_IMAGE_BLOCKS: u32 = 72 * 1024;
+
+/// A FAT32 image of [`FAT32_IMAGE_BLOCKS`] blocks (one per cluster) holding `files`, as
+/// [`image_of`] makes a FAT16 one.
+pub fn fat32_image_of(files: &[(&str, &[u8])]) -> Result<Vec<u8>, String> {
+    let options =
+        fatfs::FormatVolumeOptions::new().fat_type(fatfs::FatType::Fat32).bytes_per_cluster(BLOCK_BYTES as u32);
+    image_formatted(options, FAT32_IMAGE_BLOCKS, files)
+}
+
+/// An image of `blocks` blocks formatted with `options`, holding `files` in its top folder.
+fn image_formatted(
+    options: fatfs::FormatVolumeOptions,
+    blocks: u32,
+    files: &[(&str, &[u8])],
+) -> Result<Vec<u8>, String> {
+    let mut disk = Cursor::new(std::vec![0u8; blocks as usize * BLOCK_BYTES]);
     fatfs::format_volume(&mut disk, options).map_err(|e| std::format!("formatting the card image: {e}"))?;
     disk.seek(SeekFrom::Start(0)).map_err(|e| e.to_string())?;
     {
@@ -115,68 +143,4 @@ pub fn card_from_dir(dir: &Path) -> Result<SimCard, String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::card::{Card, CardError, CardLine, CardLines};
-
-    fn lines_of(card: &mut SimCard, index: usize) -> Vec<String> {
-        let files = card.files().unwrap();
-        card.open(files.get(index).unwrap()).unwrap();
-        let mut lines = CardLines::new();
-        let mut out = Vec::new();
-        while let CardLine::Line { text, .. } = lines.next(card).unwrap() {
-            out.push(text.into());
-        }
-        out
-    }
-
-    #[test]
-    fn the_card_lists_its_gcode_files_and_reads_them() {
-        let big: String = (0..2000).map(|i| std::format!("G1 X{} Y{}\n", i % 50, i % 30)).collect();
-        let image = image_of(&[
-            ("square.gcode", b"G0 X0 Y0\nG1 X10\n"),
-            ("NOTES.TXT", b"not G-code"),
-            ("A Long Name For A Plot.NC", big.as_bytes()),
-        ])
-        .unwrap();
-        let mut card = FatCard::new(ImageBlocks::new(image));
-        let files = card.files().unwrap();
-        let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
-        assert_eq!(names, ["A Long Name For A Plot.NC", "square.gcode"]);
-        assert_eq!(lines_of(&mut card, 1), ["G0X0Y0", "G1X10"]);
-        let long = lines_of(&mut card, 0);
-        assert_eq!(long.len(), 2000);
-        assert_eq!(long[1999], "G1X49Y19");
-        assert_eq!(files.get(0).unwrap().bytes as usize, big.len());
-    }
-
-    #[test]
-    fn a_card_with_a_partition_table_reads_the_same() {
-        let bare = image_of(&[("plot.nc", b"G0 X1\nG1 Y2\n")]).unwrap();
-        let mut image = std::vec![0u8; BLOCK_BYTES];
-        let entry = &mut image[446..462];
-        entry[4] = 0x0E;
-        entry[8..12].copy_from_slice(&1u32.to_le_bytes());
-        entry[12..16].copy_from_slice(&((bare.len() / BLOCK_BYTES) as u32).to_le_bytes());
-        image[510..512].copy_from_slice(&[0x55, 0xAA]);
-        image.extend_from_slice(&bare);
-        let mut card = FatCard::new(ImageBlocks::new(image));
-        assert_eq!(lines_of(&mut card, 0), ["G0X1", "G1Y2"]);
-    }
-
-    #[test]
-    fn a_card_that_is_not_fat_says_so() {
-        let mut card = FatCard::new(ImageBlocks::new(std::vec![0x5Au8; 64 * BLOCK_BYTES]));
-        assert_eq!(card.files(), Err(CardError::NotFat));
-    }
-
-    #[test]
-    fn a_file_gone_from_the_card_says_so() {
-        let mut card = FatCard::new(ImageBlocks::new(image_of(&[("A.NC", b"G0X1\n")]).unwrap()));
-        let mut file = card.files().unwrap().get(0).unwrap().clone();
-        file.short = "B.NC".try_into().unwrap();
-        assert_eq!(card.open(&file), Err(CardError::NoSuchFile));
-        // The card is still read after the failure.
-        assert_eq!(card.files().unwrap().len(), 1);
-    }
-}
+mod tests;
