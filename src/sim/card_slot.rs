@@ -3,6 +3,7 @@
 //! look at it finds none, as the board's card-detect input tells it; the file open when it was
 //! taken out is closed, so a card put back is read again from its files.
 
+use crate::card::resume::{ResumeBytes, ResumeSlots};
 use crate::card::{Card, CardError, CardFile, CardFiles};
 use crate::sim::card::SimCard;
 use crate::sim::inputs::SimInputs;
@@ -55,5 +56,13 @@ impl Card for SimSlot {
         if let Ok(card) = self.present() {
             card.close();
         }
+    }
+
+    fn read_resume(&mut self, slots: &mut ResumeSlots) -> Result<(), CardError> {
+        self.present()?.read_resume(slots)
+    }
+
+    fn write_resume(&mut self, slot: usize, bytes: &ResumeBytes) -> Result<(), CardError> {
+        self.present()?.write_resume(slot, bytes)
     }
 }

@@ -10,6 +10,7 @@ use core::mem::MaybeUninit;
 use embassy_time::{Duration, block_for};
 use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx};
 use servoplot::card::fat::FatCard;
+use servoplot::card::resume::{ResumeBytes, ResumeSlots};
 use servoplot::card::{Card, CardError, CardFile, CardFiles};
 
 /// Where the image lies (the model's PSRAM, which the firmware does not use otherwise), and at
@@ -118,5 +119,15 @@ impl Card for ModelCard {
 
     fn close(&mut self) {
         self.0.close();
+    }
+
+    fn read_resume(&mut self, slots: &mut ResumeSlots) -> Result<(), CardError> {
+        self.ready()?;
+        self.0.read_resume(slots)
+    }
+
+    fn write_resume(&mut self, slot: usize, bytes: &ResumeBytes) -> Result<(), CardError> {
+        self.ready()?;
+        self.0.write_resume(slot, bytes)
     }
 }
