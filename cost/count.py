@@ -100,8 +100,11 @@ MODEL_HEADER = """\
 # `per_x_step_op` per operation of its expression. `build`: the drawing builder's walk per step,
 # plus per X step of a sine or a function `per_x_step`, and for a function `per_x_step_op`.
 """
-# How far the model may be from what is counted before --check-model fails.
-MODEL_TOLERANCE = 0.05
+# How far the model may be from what is counted before --check-model fails. The same source
+# built in another directory counts up to about 5 % apart on some cases (the builder's ellipse
+# with diagonal steps: 56.5 and 58.9 instructions a step from two clones): the paths change the
+# symbols' names, and with them the order LLVM visits functions in and what it inlines.
+MODEL_TOLERANCE = 0.10
 
 # The budgets (--check-budgets): instructions per step of the motion task all-in, by kind of
 # curve, and per pulse.
