@@ -107,9 +107,9 @@ impl SpiCard {
     }
 }
 
-/// The board keeps no resume record (the trait's `read_resume` and `write_resume` say there is
-/// none): the card's write path and the record's code would take about 12 KB of flash more than
-/// the image has room for.
+/// The board keeps no resume record yet (the trait's `read_resume` and `write_resume` say there
+/// is none): nothing writes one during a plot, and the card's write path and the record's code
+/// (about 12 KB of flash) come in with what does.
 impl Card for SpiCard {
     fn files(&mut self) -> Result<CardFiles, CardError> {
         self.ready()?;
