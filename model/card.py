@@ -19,7 +19,6 @@ poll took 10 ms or more of the F407's time (`$I`).
 import argparse
 import os
 import re
-import socket
 import subprocess
 import sys
 import tempfile
@@ -63,12 +62,7 @@ def simulate():
                           cwd=ROOT, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"the simulator failed:\n{done.stderr}")
-    summary = done.stderr.partition("pulses: ")[2]
-    m = re.match(r"X (\d+) forward, (\d+) back; Y (\d+) forward, (\d+) back", summary)
-    p = re.search(r"final position: X (-?[\d.]+) mm, Y (-?[\d.]+) mm", summary)
-    if not m or not p:
-        sys.exit(f"cannot read the simulator's summary:\n{summary}")
-    return [int(v) for v in m.groups()], (float(p.group(1)), float(p.group(2)))
+    return run.sim_summary(done.stderr)
 
 
 def plot(link, keys):
@@ -113,20 +107,8 @@ def check():
     qemu = subprocess.Popen(cmd, stdout=log, stderr=subprocess.PIPE)
     started = time.time()
     try:
-        for _ in range(500):
-            if os.path.exists(host_path):
-                break
-            time.sleep(0.01)
-        sock = socket.socket(socket.AF_UNIX)
-        sock.connect(host_path)
-        link = run.Link(sock)
-        for _ in range(500):
-            if os.path.exists(keys_path):
-                break
-            time.sleep(0.01)
-        keys = socket.socket(socket.AF_UNIX)
-        keys.connect(keys_path)
-        status = plot(link, keys)
+        link = run.Link(run.connect(host_path))
+        status = plot(link, run.connect(keys_path))
         with link.lock:
             seen = len(link.answers)
         link.send(b"$I\n")
@@ -148,38 +130,11 @@ def check():
 
     print(f"\nplotted from the card in {time.time() - started:.1f} s of wall time; "
           f"{len(link.statuses)} status reports")
-    bad = [s for s in link.statuses if not run.STATUS.match(s)]
-    if bad:
-        failures.append(f"malformed status report: {bad[0]!r}")
-    for field, what in (("Un:", "step-queue underruns"), ("Mu:", "missed timer updates")):
-        counted = [s for s in link.statuses if "|" + field in s]
-        if counted:
-            failures.append(f"{what}: {counted[-1]}")
+    run.check_reports(link.statuses, failures)
     lines = [int(m.group(1)) for s in link.statuses for m in [LINE.search(s)] if m]
     print(f"lines reported in `|Ln:`: up to {max(lines, default=0)}")
-    print(f"pulses: model X {pulses[0]} forward, {pulses[1]} back; Y {pulses[2]} forward, {pulses[3]} back")
-    print(f"        simulator X {sim_pulses[0]} forward, {sim_pulses[1]} back; Y {sim_pulses[2]} forward, "
-          f"{sim_pulses[3]} back")
-    if pulses != sim_pulses:
-        failures.append("the model's pulses are not the simulator's")
-    m = re.search(r"MPos:(-?[\d.]+),(-?[\d.]+)", status)
-    position = (float(m.group(1)), float(m.group(2))) if m else None
-    print(f"final position: model {position}, simulator {sim_position}")
-    if position != sim_position:
-        failures.append("the model's final position is not the simulator's")
-    stack = next((re.match(r"\[STACK:(\d+),(\d+)\]", l) for l in info if l.startswith("[STACK:")), None)
-    poll = next((re.match(r"\[POLL:(\d+),(\d+)\]", l) for l in info if l.startswith("[POLL:")), None)
-    if not stack or not poll:
-        failures.append(f"`$I` gave no stack or poll figure: {info}")
-    else:
-        peak, size, poll_us = int(stack.group(1)), int(stack.group(2)), int(poll.group(1))
-        print(f"stack: {peak} of {size} bytes at most ({peak / size:.0%}); longest task poll: "
-              f"{poll_us / 1000:.2f} ms of the F407's time, {int(poll.group(2)) / 1000:.2f} ms with the "
-              f"motion task's polls that preempted it")
-        if peak > run.STACK_MAX_SHARE * size:
-            failures.append(f"the stack's peak is over {run.STACK_MAX_SHARE:.0%} of the stack")
-        if poll_us >= run.POLL_MAX_US:
-            failures.append(f"a task poll took {poll_us} us, {run.POLL_MAX_US} at most")
+    run.check_motion(pulses, status, sim_pulses, sim_position, failures)
+    run.check_health(info, failures)
     text = run.decode_log(defmt_path)
     with open(os.path.join(ROOT, "target", "model", "defmt-card.txt"), "w") as f:
         f.write(text)

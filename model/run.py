@@ -209,13 +209,71 @@ def simulate(path):
     if done.returncode != 0:
         sys.exit(f"the simulator failed:\n{done.stderr}")
     # The answers on standard output, the summary on standard error.
-    summary = done.stderr.partition("pulses: ")[2]
+    lines = [l for l in done.stdout.splitlines() if l.strip() and not l.startswith("<")]
+    return (lines, *sim_summary(done.stderr))
+
+
+def sim_summary(stderr):
+    """The pulses and the final position the simulator's summary gives."""
+    summary = stderr.partition("pulses: ")[2]
     m = re.match(r"X (\d+) forward, (\d+) back; Y (\d+) forward, (\d+) back", summary)
     p = re.search(r"final position: X (-?[\d.]+) mm, Y (-?[\d.]+) mm", summary)
     if not m or not p:
         sys.exit(f"cannot read the simulator's summary:\n{summary}")
-    lines = [l for l in done.stdout.splitlines() if l.strip() and not l.startswith("<")]
-    return lines, [int(v) for v in m.groups()], (float(p.group(1)), float(p.group(2)))
+    return [int(v) for v in m.groups()], (float(p.group(1)), float(p.group(2)))
+
+
+def connect(path):
+    """The client end of one of QEMU's Unix sockets, once QEMU has made it."""
+    for _ in range(500):
+        if os.path.exists(path):
+            break
+        time.sleep(0.01)
+    sock = socket.socket(socket.AF_UNIX)
+    sock.connect(path)
+    return sock
+
+
+def check_reports(statuses, failures):
+    """Every status report well formed, and none counting an underrun or a missed update."""
+    bad = [s for s in statuses if not STATUS.match(s)]
+    if bad:
+        failures.append(f"malformed status report: {bad[0]!r}")
+    for field, what in (("Un:", "step-queue underruns"), ("Mu:", "missed timer updates")):
+        counted = [s for s in statuses if "|" + field in s]
+        if counted:
+            failures.append(f"{what}: {counted[-1]}")
+
+
+def check_motion(pulses, status, sim_pulses, sim_position, failures):
+    """The model's pulses and final position (from its last status report) are the simulator's."""
+    print(f"pulses: model X {pulses[0]} forward, {pulses[1]} back; Y {pulses[2]} forward, {pulses[3]} back")
+    print(f"        simulator X {sim_pulses[0]} forward, {sim_pulses[1]} back; Y {sim_pulses[2]} forward, "
+          f"{sim_pulses[3]} back")
+    if pulses != sim_pulses:
+        failures.append("the model's pulses are not the simulator's")
+    m = re.search(r"MPos:(-?[\d.]+),(-?[\d.]+)", status)
+    position = (float(m.group(1)), float(m.group(2))) if m else None
+    print(f"final position: model {position}, simulator {sim_position}")
+    if position != sim_position:
+        failures.append("the model's final position is not the simulator's")
+
+
+def check_health(info, failures):
+    """`$I`'s stack peak under half the stack, and no task poll of 10 ms or more of its own."""
+    stack = next((re.match(r"\[STACK:(\d+),(\d+)\]", l) for l in info if l.startswith("[STACK:")), None)
+    poll = next((re.match(r"\[POLL:(\d+),(\d+)\]", l) for l in info if l.startswith("[POLL:")), None)
+    if not stack or not poll:
+        failures.append(f"`$I` gave no stack or poll figure: {info}")
+        return
+    peak, size, poll_us = int(stack.group(1)), int(stack.group(2)), int(poll.group(1))
+    print(f"stack: {peak} of {size} bytes at most ({peak / size:.0%}); longest task poll: "
+          f"{poll_us / 1000:.2f} ms of the F407's time, {int(poll.group(2)) / 1000:.2f} ms with the "
+          f"motion task's polls that preempted it")
+    if peak > STACK_MAX_SHARE * size:
+        failures.append(f"the stack's peak is over {STACK_MAX_SHARE:.0%} of the stack")
+    if poll_us >= POLL_MAX_US:
+        failures.append(f"a task poll took {poll_us} us, {POLL_MAX_US} at most")
 
 
 def decode_log(defmt_path):
@@ -244,13 +302,7 @@ def check(args):
     qemu = subprocess.Popen(cmd, stdout=log, stderr=subprocess.PIPE)
     started = time.time()
     try:
-        for _ in range(500):
-            if os.path.exists(sock_path):
-                break
-            time.sleep(0.01)
-        sock = socket.socket(socket.AF_UNIX)
-        sock.connect(sock_path)
-        link = Link(sock)
+        link = Link(connect(sock_path))
         stream(link, lines)
         # At rest: the final position and the status fields.
         end = time.time() + 60
@@ -291,36 +343,9 @@ def check(args):
                 break
         else:
             failures.append(f"{len(model_answers)} answers from the model, {len(sim_answers)} from the simulator")
-    bad = [s for s in link.statuses if not STATUS.match(s)]
-    if bad:
-        failures.append(f"malformed status report: {bad[0]!r}")
-    for field, what in (("Un:", "step-queue underruns"), ("Mu:", "missed timer updates")):
-        counted = [s for s in link.statuses if "|" + field in s]
-        if counted:
-            failures.append(f"{what}: {counted[-1]}")
-    print(f"pulses: model X {pulses[0]} forward, {pulses[1]} back; Y {pulses[2]} forward, {pulses[3]} back")
-    print(f"        simulator X {sim_pulses[0]} forward, {sim_pulses[1]} back; Y {sim_pulses[2]} forward, "
-          f"{sim_pulses[3]} back")
-    if pulses != sim_pulses:
-        failures.append("the model's pulses are not the simulator's")
-    m = re.search(r"MPos:(-?[\d.]+),(-?[\d.]+)", status)
-    position = (float(m.group(1)), float(m.group(2))) if m else None
-    print(f"final position: model {position}, simulator {sim_position}")
-    if position != sim_position:
-        failures.append("the model's final position is not the simulator's")
-    stack = next((re.match(r"\[STACK:(\d+),(\d+)\]", l) for l in info if l.startswith("[STACK:")), None)
-    poll = next((re.match(r"\[POLL:(\d+),(\d+)\]", l) for l in info if l.startswith("[POLL:")), None)
-    if not stack or not poll:
-        failures.append(f"`$I` gave no stack or poll figure: {info}")
-    else:
-        peak, size, poll_us = int(stack.group(1)), int(stack.group(2)), int(poll.group(1))
-        print(f"stack: {peak} of {size} bytes at most ({peak / size:.0%}); longest task poll: "
-              f"{poll_us / 1000:.2f} ms of the F407's time, {int(poll.group(2)) / 1000:.2f} ms with the "
-              f"motion task's polls that preempted it")
-        if peak > STACK_MAX_SHARE * size:
-            failures.append(f"the stack's peak is over {STACK_MAX_SHARE:.0%} of the stack")
-        if poll_us >= POLL_MAX_US:
-            failures.append(f"a task poll took {poll_us} us, {POLL_MAX_US} at most")
+    check_reports(link.statuses, failures)
+    check_motion(pulses, status, sim_pulses, sim_position, failures)
+    check_health(info, failures)
 
     print()
     stretches, notes = count.read_masked_log(masked_log, sorted(functions(ELF)))

@@ -19,6 +19,7 @@ pub mod crc;
 #[cfg(target_os = "none")]
 pub mod critical;
 pub mod decimal;
+pub mod fields;
 pub mod geom;
 pub mod host;
 pub mod machine;

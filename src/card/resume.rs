@@ -18,6 +18,7 @@ use heapless::String;
 
 use crate::card::names::{CARD_SHORT_NAME_MAX_BYTES, CardFile};
 use crate::crc::crc32;
+use crate::fields::FieldWriter;
 use crate::geom::Point;
 use crate::host::gcode::{Coolant, Distance, KEPT_OFFSETS, Modal, MotionMode, Spindle, Units, WorkSystem};
 
@@ -105,7 +106,7 @@ impl ResumeRecord {
             | if m.spindle_speed.is_some() { FLAG_SPEED } else { 0 };
         let mut name = [0u8; CARD_SHORT_NAME_MAX_BYTES];
         name[..self.file.len()].copy_from_slice(self.file.as_bytes());
-        let mut w = Writer { out: &mut out, at: 0 };
+        let mut w = FieldWriter::new(&mut out);
         w.put(&RESUME_MAGIC.to_le_bytes());
         w.put(&RESUME_FORMAT.to_le_bytes());
         w.put(&[flags, m.tool]);
@@ -262,19 +263,6 @@ impl ResumeSlots {
 /// Whether sequence number `a` was given after `b`, across a wrap: within half the range.
 pub fn newer(a: u32, b: u32) -> bool {
     (a.wrapping_sub(b) as i32) > 0
-}
-
-/// Writes a record's fields in order.
-struct Writer<'a> {
-    out: &'a mut [u8],
-    at: usize,
-}
-
-impl Writer<'_> {
-    fn put(&mut self, bytes: &[u8]) {
-        self.out[self.at..self.at + bytes.len()].copy_from_slice(bytes);
-        self.at += bytes.len();
-    }
 }
 
 /// Reads a record's fields in order; `bytes` is a whole record, so every take is in it.

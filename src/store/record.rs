@@ -6,6 +6,7 @@
 //! (the setting numbers, the counts of offsets and blocks, [`RECORD_FORMAT`]): a record written
 //! by a firmware with other settings does not read back as this one's.
 
+use crate::fields::FieldWriter;
 use crate::host::gcode::{KEPT_OFFSETS, Offsets};
 use crate::host::startup::{STARTUP_LINE_MAX_BYTES, STARTUP_LINES, StartupLine, StartupLines, ascii_line};
 use crate::settings::{SETTING_INFO, Settings};
@@ -58,7 +59,7 @@ impl Record {
 
     /// Writes the record into `out` (at least [`RECORD_MAX_BYTES`] long); returns its length.
     pub fn encode(&self, out: &mut [u8]) -> usize {
-        let mut w = Writer { out, at: 0 };
+        let mut w = FieldWriter::new(out);
         w.put(&LAYOUT_TAG.to_le_bytes());
         for value in self.settings.values() {
             w.put(&value.to_le_bytes());
@@ -70,7 +71,7 @@ impl Record {
             w.put(&[line.len() as u8]);
             w.put(line.as_bytes());
         }
-        w.at
+        w.written()
     }
 
     /// The record `bytes` hold, all of them.
@@ -100,18 +101,6 @@ impl Record {
             return Err(BadRecord::Invalid);
         }
         Ok(Record { settings, offsets_mm, startup })
-    }
-}
-
-struct Writer<'a> {
-    out: &'a mut [u8],
-    at: usize,
-}
-
-impl Writer<'_> {
-    fn put(&mut self, bytes: &[u8]) {
-        self.out[self.at..self.at + bytes.len()].copy_from_slice(bytes);
-        self.at += bytes.len();
     }
 }
 
