@@ -285,6 +285,13 @@ impl<D: BlockDevice> Card for FatCard<D> {
         self.volumes.read(file, buf).map_err(card_error)
     }
 
+    fn seek(&mut self, offset: u32) -> Result<(), CardError> {
+        let Some((_, _, file)) = self.open else {
+            return Err(CardError::NoSuchFile);
+        };
+        self.volumes.file_seek_from_start(file, offset).map_err(card_error)
+    }
+
     fn close(&mut self) {
         if let Some((volume, dir, file)) = self.open.take() {
             let _ = self.volumes.close_file(file);

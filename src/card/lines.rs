@@ -59,6 +59,18 @@ impl CardLines {
         }
     }
 
+    /// Reads on from where a reader had taken `bytes_done` bytes and `lines_done` lines, the
+    /// file already sought there; `after_cr` if the line before ended in a CR (as
+    /// [`after_cr`](Self::after_cr) said there), so that an LF met first ends no line.
+    pub fn resumed(bytes_done: u32, lines_done: u32, after_cr: bool) -> Self {
+        CardLines { lines: lines_done, after_cr, bytes: bytes_done, ..CardLines::new() }
+    }
+
+    /// The last byte taken was a CR: an LF next belongs to the line it ended.
+    pub const fn after_cr(&self) -> bool {
+        self.after_cr
+    }
+
     /// Lines handed out so far.
     pub const fn lines_done(&self) -> u32 {
         self.lines
@@ -159,6 +171,10 @@ mod tests {
             self.at += n;
             Ok(n)
         }
+        fn seek(&mut self, offset: u32) -> Result<(), CardError> {
+            self.at = offset as usize;
+            Ok(())
+        }
         fn close(&mut self) {}
     }
 
@@ -168,7 +184,11 @@ mod tests {
 
     /// Every line of `card`'s file, as owned text.
     fn all(card: &mut Bytes) -> std::vec::Vec<std::string::String> {
-        let mut lines = CardLines::new();
+        all_from(&mut CardLines::new(), card)
+    }
+
+    /// Every line `lines` reads on from `card`, as owned text.
+    fn all_from(lines: &mut CardLines, card: &mut Bytes) -> std::vec::Vec<std::string::String> {
         let mut out = std::vec::Vec::new();
         loop {
             match lines.next(card).unwrap() {
@@ -201,6 +221,26 @@ mod tests {
         let mut failing = Bytes { bytes: b"G0X1\nG0X2\n", at: 0, step: 4, fail_at: 4 };
         let mut lines = CardLines::new();
         assert_eq!(lines.next(&mut failing), Err(CardError::Unreadable));
+    }
+
+    #[test]
+    fn a_reader_resumed_after_any_line_reads_on_as_the_first_did() {
+        let text = b"G21\r\nG0 X1\r\n\r\nG1 X3\n\nG1 Y4\rG1 Y5";
+        let whole = all(&mut card(text, 3));
+        let mut c = card(text, 3);
+        let mut first = CardLines::new();
+        loop {
+            let (bytes, lines, after_cr) = (first.bytes_done(), first.lines_done(), first.after_cr());
+            let mut again = card(text, 5);
+            again.seek(bytes).unwrap();
+            let mut resumed = CardLines::resumed(bytes, lines, after_cr);
+            let rest = all_from(&mut resumed, &mut again);
+            assert_eq!(rest, whole[lines as usize..], "resumed after line {lines}, byte {bytes}");
+            assert_eq!(resumed.bytes_done(), text.len() as u32);
+            if first.next(&mut c).unwrap() == CardLine::End {
+                break;
+            }
+        }
     }
 
     #[test]

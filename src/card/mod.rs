@@ -9,6 +9,7 @@
 //! implement.
 
 pub mod fat;
+pub mod keeper;
 pub mod lines;
 pub mod names;
 pub mod resume;
@@ -18,7 +19,7 @@ use resume::{RESUME_RECORD_BYTES, ResumeBytes, ResumeRecord, ResumeSlots};
 
 pub use lines::{CardLine, CardLines};
 pub use names::{CARD_FILES_MAX, CARD_NAME_MAX_BYTES, CardFile, CardFiles, FileName, is_gcode_name};
-pub use slot::{CardFacts, CardPicture, CardProgress, CardSlot, CardStop, NoSlot};
+pub use slot::{CardFacts, CardPicture, CardProgress, CardSlot, CardStop, NoSlot, ResumeOffer};
 
 /// Why the card gave no files or no bytes. Each says so on the LCD and in a log line; nothing
 /// moves.
@@ -57,6 +58,8 @@ pub trait Card {
     fn open(&mut self, file: &CardFile) -> Result<u32, CardError>;
     /// The open file's next bytes, into `buf`: how many, 0 at its end.
     fn read(&mut self, buf: &mut [u8]) -> Result<usize, CardError>;
+    /// The open file is read on from byte `offset` (at most its length).
+    fn seek(&mut self, offset: u32) -> Result<(), CardError>;
     /// Closes the open file, if any.
     fn close(&mut self);
 

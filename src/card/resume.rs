@@ -36,15 +36,17 @@ const RESUME_MAGIC: u32 = u32::from_le_bytes(*b"SPRR");
 /// The record's layout; a record of another is not read.
 pub const RESUME_FORMAT: u16 = 1;
 
-/// Flag bits: the parser has had an F word, an S word.
+/// Flag bits: the parser has had an F word, an S word; the line before the offset ended in a
+/// CR (so an LF at the offset ends no line of its own).
 const FLAG_FEED: u8 = 1;
 const FLAG_SPEED: u8 = 2;
+const FLAG_AFTER_CR: u8 = 4;
 
 /// A record's bytes: magic 4, format 2, flags 1, tool 1, sequence 4, file name 12, file length
-/// 4, offset 4, line 4, position 8, modes 6, two bytes kept zero, feed 4, S 4, the kept offsets
-/// 8 each, G92 8, CRC 4.
+/// 4, offset 4, line 4, position 8, the file's lines 4, modes 6, two bytes kept zero, feed 4,
+/// S 4, the kept offsets 8 each, G92 8, CRC 4.
 pub const RESUME_RECORD_BYTES: usize =
-    4 + 2 + 1 + 1 + 4 + CARD_SHORT_NAME_MAX_BYTES + 4 + 4 + 4 + 8 + 6 + 2 + 4 + 4 + 8 * KEPT_OFFSETS + 8 + 4;
+    4 + 2 + 1 + 1 + 4 + CARD_SHORT_NAME_MAX_BYTES + 4 + 4 + 4 + 8 + 4 + 6 + 2 + 4 + 4 + 8 * KEPT_OFFSETS + 8 + 4;
 
 const _: () = assert!(RESUME_RECORD_BYTES <= RESUME_SLOT_BYTES);
 
@@ -65,7 +67,7 @@ pub enum BadResume {
     Checksum,
     /// The file name is empty or not text.
     Name,
-    /// The place in the file is impossible: past the file's end, or line 0.
+    /// The place in the file is impossible: past the file's end, past its last line, or line 0.
     Place,
     /// A modal group's value, or a flag, is unknown.
     Mode,
@@ -86,8 +88,12 @@ pub struct ResumeRecord {
     pub offset: u32,
     /// That line's number, from 1.
     pub line: u32,
+    /// The line before the offset ended in a CR: an LF at the offset belongs to it.
+    pub after_cr: bool,
     /// The pen's machine position once the completed line had run, steps.
     pub position: Point,
+    /// The file's lines, as its check counted them.
+    pub lines: u32,
     /// The parser's state after the completed line.
     pub modal: Modal,
 }
@@ -103,7 +109,8 @@ impl ResumeRecord {
         let mut out = [0u8; RESUME_RECORD_BYTES];
         let m = &self.modal;
         let flags = if m.feed_mm_per_min.is_some() { FLAG_FEED } else { 0 }
-            | if m.spindle_speed.is_some() { FLAG_SPEED } else { 0 };
+            | if m.spindle_speed.is_some() { FLAG_SPEED } else { 0 }
+            | if self.after_cr { FLAG_AFTER_CR } else { 0 };
         let mut name = [0u8; CARD_SHORT_NAME_MAX_BYTES];
         name[..self.file.len()].copy_from_slice(self.file.as_bytes());
         let mut w = FieldWriter::new(&mut out);
@@ -117,6 +124,7 @@ impl ResumeRecord {
         }
         w.put(&self.position.x.to_le_bytes());
         w.put(&self.position.y.to_le_bytes());
+        w.put(&self.lines.to_le_bytes());
         let system = m.work_system.index() as u8;
         w.put(&[motion_code(m.motion), units_code(m.units), distance_code(m.distance), system]);
         w.put(&[spindle_code(m.spindle), coolant_code(m.coolant), 0, 0]);
@@ -146,7 +154,7 @@ impl ResumeRecord {
             return Err(BadResume::Checksum);
         }
         let [flags, tool] = r.take();
-        if flags & !(FLAG_FEED | FLAG_SPEED) != 0 {
+        if flags & !(FLAG_FEED | FLAG_SPEED | FLAG_AFTER_CR) != 0 {
             return Err(BadResume::Mode);
         }
         let seq = u32::from_le_bytes(r.take());
@@ -158,6 +166,10 @@ impl ResumeRecord {
             return Err(BadResume::Place);
         }
         let position = Point::new(i32::from_le_bytes(r.take()), i32::from_le_bytes(r.take()));
+        let lines = u32::from_le_bytes(r.take());
+        if line - 1 > lines {
+            return Err(BadResume::Place);
+        }
         let [motion, units, distance, system, spindle, coolant, zero_a, zero_b] = r.take();
         let modes = (
             motion_of(motion),
@@ -198,7 +210,8 @@ impl ResumeRecord {
             kept_mm,
             g92_mm,
         };
-        Ok(ResumeRecord { seq, file, file_bytes, offset, line, position, modal })
+        let after_cr = flags & FLAG_AFTER_CR != 0;
+        Ok(ResumeRecord { seq, file, file_bytes, offset, line, after_cr, position, lines, modal })
     }
 }
 

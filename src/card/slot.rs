@@ -11,6 +11,7 @@ use core::cell::{Cell, Ref, RefCell, RefMut};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 
+use super::names::CARD_SHORT_NAME_MAX_BYTES;
 use super::{Card, CardError, CardFile, CardFiles};
 use crate::host::GrblError;
 use crate::program::preview::{MapScale, PlotProgress, StrokeMap};
@@ -53,6 +54,33 @@ pub enum CardProgress {
     Checked(CardFacts),
     /// `done` of the file's `total` lines sent.
     Plotting { done: u32, total: u32 },
+    /// At power-on, a plot a power cut stopped is offered: `#` resumes it, `D` drops it.
+    Offer(ResumeOffer),
+}
+
+/// A plot a power cut stopped, as the LCD offers it: the file's 8.3 name, the line it goes on
+/// from and the file's lines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(target_os = "none", derive(defmt::Format))]
+pub struct ResumeOffer {
+    name: [u8; CARD_SHORT_NAME_MAX_BYTES],
+    pub line: u32,
+    pub lines: u32,
+}
+
+impl ResumeOffer {
+    pub fn new(name: &str, line: u32, lines: u32) -> Self {
+        let mut bytes = [0; CARD_SHORT_NAME_MAX_BYTES];
+        let len = name.len().min(CARD_SHORT_NAME_MAX_BYTES);
+        bytes[..len].copy_from_slice(&name.as_bytes()[..len]);
+        ResumeOffer { name: bytes, line, lines }
+    }
+
+    /// The file's 8.3 name.
+    pub fn name(&self) -> &str {
+        let len = self.name.iter().position(|&b| b == 0).unwrap_or(CARD_SHORT_NAME_MAX_BYTES);
+        core::str::from_utf8(&self.name[..len]).unwrap_or("?")
+    }
 }
 
 impl CardProgress {
@@ -84,6 +112,9 @@ impl Card for NoSlot {
         Err(CardError::NoCard)
     }
     fn read(&mut self, _: &mut [u8]) -> Result<usize, CardError> {
+        Err(CardError::NoCard)
+    }
+    fn seek(&mut self, _: u32) -> Result<(), CardError> {
         Err(CardError::NoCard)
     }
     fn close(&mut self) {}

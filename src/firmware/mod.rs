@@ -25,6 +25,7 @@ use defmt::info;
 use embassy_executor::{SendSpawner, SpawnError, SpawnToken, Spawner};
 use embassy_time::{Duration, Timer};
 use servoplot::card::CardSlot;
+use servoplot::card::keeper::ResumeKeeper;
 use servoplot::machine::{HomingWriter, HostWriter, Machine, MotionWriter, ServoWriter};
 use servoplot::machine_io::health::{self, Health};
 use servoplot::motion::interp::Curve;
@@ -52,8 +53,8 @@ static MACHINE: StaticCell<Machine> = StaticCell::new();
 static STEP_QUEUE: ConstStaticCell<StepQueue> = ConstStaticCell::new(StepQueue::new());
 static PLANNER: StaticCell<Planner<Curve, PLANNER_SEGMENTS>> = StaticCell::new();
 static STORE: StaticCell<Store<board::Flash>> = StaticCell::new();
-/// The host link's future, 17 KB (its links' pipes and answers, the parser and the drawing it
-/// builds): built in its slot, not on the stack (see `slot`).
+/// The host link's future, 19 KB (its links' pipes and answers, the parser, the drawing it
+/// builds and the card plot with its resume marks): built in its slot, not on the stack (see `slot`).
 static HOST_LINK: FutureSlot<HOST_LINK_FUTURE_BYTES> = FutureSlot::new();
 /// The host links' ends.
 type Links = ((board::HostRx, board::HostTx), (board::LinkRx, board::LinkTx));
@@ -72,6 +73,9 @@ static CARD_SLOT: StaticCell<CardSlot<'static>> = StaticCell::new();
 static mut CHECK: MaybeUninit<ProgramCheck> = MaybeUninit::uninit();
 #[unsafe(link_section = ".ccmram")]
 static mut CHECK_PLANNER: MaybeUninit<CheckPlanner> = MaybeUninit::uninit();
+/// A card plot's resume bookkeeping (2 KB), beside them.
+#[unsafe(link_section = ".ccmram")]
+static mut RESUME_KEEPER: MaybeUninit<ResumeKeeper> = MaybeUninit::uninit();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -138,10 +142,11 @@ fn card_room(slot: &'static CardSlot<'static>, settings: &Settings) -> CardRoom<
     if TAKEN.swap(true, Ordering::Relaxed) {
         defmt::panic!("the card check's room taken twice");
     }
-    // SAFETY: `TAKEN` lets this run once, so these are the only references to the two statics.
-    let (check, planner) = unsafe { (&mut *addr_of_mut!(CHECK), &mut *addr_of_mut!(CHECK_PLANNER)) };
+    // SAFETY: `TAKEN` lets this run once, so these are the only references to the three statics.
+    let (check, planner, keeper) =
+        unsafe { (&mut *addr_of_mut!(CHECK), &mut *addr_of_mut!(CHECK_PLANNER), &mut *addr_of_mut!(RESUME_KEEPER)) };
     let planner = Planner::init(planner, Limits::from_settings(settings));
-    CardRoom { slot, check: ProgramCheck::init(check, settings), planner }
+    CardRoom { slot, check: ProgramCheck::init(check, settings), planner, keeper: keeper.write(ResumeKeeper::new()) }
 }
 
 /// The flash store, opened into `slot` (out of line: its buffers are a temporary of this

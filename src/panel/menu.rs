@@ -254,6 +254,11 @@ impl Menu {
             self.run = Some(Run { plan: Some(plan), started_ms: None, ended_ms: None });
             self.run_page = RunPage::Numbers;
         }
+        if let (CardProgress::Offer(_), CardProgress::Plotting { .. }) = (self.card_progress, progress) {
+            // A plot resumed: its run from here, without the check's plan.
+            self.run = Some(Run { plan: None, started_ms: None, ended_ms: None });
+            self.run_page = RunPage::Numbers;
+        }
         self.card_progress = progress;
         self.message = match stop {
             Some(CardStop::Refused { line, error }) => Some(UiError::CardLine { line, error }),
@@ -406,11 +411,16 @@ impl Menu {
 
     fn press(&mut self, key: Key, repeated: bool, status: &Status, settings: &Settings) -> MenuAction {
         let shown = self.message.take();
-        // A card file being checked, or shown checked: `#` plots it, `D` leaves it.
+        // A card file being checked, or shown checked: `#` plots it, `D` leaves it. A plot a
+        // power cut stopped, offered at power-on: `#` resumes it, `D` drops it.
         match (self.card_progress, key) {
-            (CardProgress::Checked(_), Key::Hash) => return MenuAction::CardAnswer(true),
-            (CardProgress::Checking { .. } | CardProgress::Checked(_), Key::D) => return MenuAction::CardAnswer(false),
-            (CardProgress::Checking { .. } | CardProgress::Checked(_), _) => return MenuAction::None,
+            (CardProgress::Checked(_) | CardProgress::Offer(_), Key::Hash) => return MenuAction::CardAnswer(true),
+            (CardProgress::Checking { .. } | CardProgress::Checked(_) | CardProgress::Offer(_), Key::D) => {
+                return MenuAction::CardAnswer(false);
+            }
+            (CardProgress::Checking { .. } | CardProgress::Checked(_) | CardProgress::Offer(_), _) => {
+                return MenuAction::None;
+            }
             _ => {}
         }
         if let Some(form) = self.form_mut().filter(|f| f.building) {

@@ -70,6 +70,7 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> S
     let language = settings.language;
     let mut v = match (menu.run(), menu.screen()) {
         (Some(r), _) => run::run_view(menu, r, status, settings, live),
+        (None, _) if let CardProgress::Offer(offer) = menu.card_progress() => card::offer_view(&offer, language),
         (None, Screen::Splash) if live.now_ms < SPLASH_MS => splash_view(language),
         (None, Screen::Preview { plan, .. }) => run::preview_view(plan, status, language),
         (None, Screen::Card(_)) if let CardProgress::Checked(facts) = menu.card_progress() => {

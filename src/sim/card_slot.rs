@@ -52,6 +52,10 @@ impl Card for SimSlot {
         self.present()?.read(buf)
     }
 
+    fn seek(&mut self, offset: u32) -> Result<(), CardError> {
+        self.present()?.seek(offset)
+    }
+
     fn close(&mut self) {
         if let Ok(card) = self.present() {
             card.close();

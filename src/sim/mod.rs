@@ -42,6 +42,7 @@ use std::vec::Vec;
 use embassy_futures::join::{join, join5};
 
 use crate::card::CardSlot;
+use crate::card::keeper::ResumeKeeper;
 use crate::geom::{Axis, Point};
 use crate::host::GcodeState;
 use crate::machine::Machine;
@@ -229,7 +230,8 @@ pub fn run(config: SimConfig) -> SimReport {
     let mut check_planner: std::boxed::Box<CheckPlanner> =
         std::boxed::Box::new(Planner::new(Limits::from_settings(&machine.settings())));
     let mut check = std::boxed::Box::new(ProgramCheck::new(GcodeState::new(), &machine.settings(), Pen::Up));
-    let room = CardRoom { slot: &slot, check: &mut check, planner: &mut check_planner };
+    let mut keeper = std::boxed::Box::new(ResumeKeeper::new());
+    let room = CardRoom { slot: &slot, check: &mut check, planner: &mut check_planner, keeper: &mut keeper };
     let (steps, step_consumer) = step_queue.split();
     let pins = Axis::ALL.map(|axis| TracePin::pair(&trace, axis));
     let timer = SimStepTimer::new(pins, inputs.clone()).with_late_interrupt(config.late_interrupt);

@@ -385,7 +385,7 @@ async fn lines<F: NorFlash>(
 ) -> ! {
     let card = room.slot;
     let gcode = GcodeState::with_offsets(Offsets::from_kept_mm(store.kept().offsets_mm));
-    let mut parser = Parser { host, gcode, store, plan: None, restart_after_answer: false, between };
+    let mut parser = Parser { host, gcode, store, plan: None, restart_after_answer: false, between, handed_steps: 0 };
     let links = [&host.links[0], &host.links[1]];
     if let Err(e) = loaded {
         for link in links {
@@ -398,7 +398,8 @@ async fn lines<F: NorFlash>(
     // The link looked at first: the other after each turn, so a link streaming without pause
     // never holds the other up.
     let mut first = 0;
-    let mut session = CardSession::Idle;
+    // At power-on, a card plot a power cut stopped is looked for first.
+    let mut session = CardSession::PowerOn;
     loop {
         let card_turn = session.turn(host, card);
         let (intake, k) =
@@ -445,6 +446,8 @@ struct Parser<'h, 'm, F: NorFlash, B: BetweenSlices> {
     restart_after_answer: bool,
     /// The pause between two slices of a line's curve.
     between: B,
+    /// Steps of the jobs handed to the motion so far (wrapping), as the motion counts them.
+    handed_steps: u32,
 }
 
 impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
@@ -683,8 +686,11 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     async fn queue(&mut self, link: &Link, job: Job) -> Result<(), Unfinished> {
         let stale = || Unfinished::Error(GrblError::Locked);
         let from = self.plan.ok_or_else(stale)?;
+        // A drawing's steps fit the count: the travel is far shorter than 2^32 steps.
+        let steps = job.drawing.steps() as u32;
         let queued = link.unless_reset(self.host.machine.submit(job, from)).await.ok_or(Unfinished::Reset)?;
         self.plan = Some(queued.map_err(|Stale| stale())?);
+        self.handed_steps = self.handed_steps.wrapping_add(steps);
         Ok(())
     }
 }

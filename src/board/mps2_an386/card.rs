@@ -117,6 +117,10 @@ impl Card for ModelCard {
         self.0.read(buf)
     }
 
+    fn seek(&mut self, offset: u32) -> Result<(), CardError> {
+        self.0.seek(offset)
+    }
+
     fn close(&mut self) {
         self.0.close();
     }

@@ -16,8 +16,9 @@ use embassy_stm32::time::Hertz;
 use embedded_hal_bus::spi::ExclusiveDevice;
 
 use super::spi_delay::SpiDelay;
-use embedded_sdmmc::{Block, BlockCount, BlockDevice, BlockIdx, SdCard, SdCardError};
+use embedded_sdmmc::SdCard;
 use servoplot::card::fat::FatCard;
+use servoplot::card::resume::{ResumeBytes, ResumeSlots};
 use servoplot::card::{Card, CardError, CardFile, CardFiles};
 
 /// SPI3's clock while a card is identified: its bus clock (APB1, 42 MHz) / 128, 328 kHz (at most
@@ -29,29 +30,9 @@ pub const CARD_SPI_DIVIDER: u32 = 2;
 /// The card's SPI device: SPI3 with its own chip select.
 pub type CardSpi = ExclusiveDevice<Spi<'static, Blocking, spi::mode::Master>, Output<'static>, SpiDelay>;
 
-/// The card's blocks as the plot reads them: read, never written (nothing on the card is written
-/// yet), so the SD protocol's write commands stay out of the image.
-pub struct ReadOnlySd(SdCard<CardSpi, SpiDelay>);
-
-impl BlockDevice for ReadOnlySd {
-    type Error = SdCardError;
-
-    fn read(&self, blocks: &mut [Block], start_block_idx: BlockIdx) -> Result<(), SdCardError> {
-        self.0.read(blocks, start_block_idx)
-    }
-
-    fn write(&self, _blocks: &[Block], _start_block_idx: BlockIdx) -> Result<(), SdCardError> {
-        Err(SdCardError::WriteError)
-    }
-
-    fn num_blocks(&self) -> Result<BlockCount, SdCardError> {
-        self.0.num_blocks()
-    }
-}
-
 /// The slot: the FAT card on SPI3 and the card-detect input.
 pub struct SpiCard {
-    fat: FatCard<ReadOnlySd>,
+    fat: FatCard<SdCard<CardSpi, SpiDelay>>,
     /// Low while a card is in (the slot's switch closes to GND; pull-up).
     detect: Input<'static>,
     /// The card in the slot has been brought up.
@@ -77,14 +58,14 @@ impl SpiCard {
         detect: Input<'static>,
         bus_hz: u32,
     ) -> &'static mut SpiCard {
-        slot.write(SpiCard { fat: FatCard::new(ReadOnlySd(SdCard::new(spi, SpiDelay))), detect, up: false, bus_hz })
+        slot.write(SpiCard { fat: FatCard::new(SdCard::new(spi, SpiDelay)), detect, up: false, bus_hz })
     }
 
     /// A card is in the slot and up: brought up now if it was just put in.
     fn ready(&mut self) -> Result<(), CardError> {
         if self.detect.is_high() {
             if self.up {
-                self.fat.with_blocks(|sd| sd.0.mark_card_uninit());
+                self.fat.with_blocks(|sd| sd.mark_card_uninit());
                 self.up = false;
             }
             return Err(CardError::NoCard);
@@ -92,13 +73,13 @@ impl SpiCard {
         if !self.up {
             let (slow, fast) = (self.bus_hz / CARD_INIT_SPI_DIVIDER, self.bus_hz / CARD_SPI_DIVIDER);
             let size = self.fat.with_blocks(|sd| {
-                let _ = sd.0.spi(|dev| dev.bus_mut().set_config(&spi_config(slow)));
-                let size = sd.0.num_bytes();
-                let _ = sd.0.spi(|dev| dev.bus_mut().set_config(&spi_config(fast)));
+                let _ = sd.spi(|dev| dev.bus_mut().set_config(&spi_config(slow)));
+                let size = sd.num_bytes();
+                let _ = sd.spi(|dev| dev.bus_mut().set_config(&spi_config(fast)));
                 size
             });
             if size.is_err() {
-                self.fat.with_blocks(|sd| sd.0.mark_card_uninit());
+                self.fat.with_blocks(|sd| sd.mark_card_uninit());
                 return Err(CardError::NoCard);
             }
             self.up = true;
@@ -107,9 +88,7 @@ impl SpiCard {
     }
 }
 
-/// The board keeps no resume record yet (the trait's `read_resume` and `write_resume` say there
-/// is none): nothing writes one during a plot, and the card's write path and the record's code
-/// (about 12 KB of flash) come in with what does.
+/// Files are read; the resume record's file (and only it) is written.
 impl Card for SpiCard {
     fn files(&mut self) -> Result<CardFiles, CardError> {
         self.ready()?;
@@ -129,7 +108,21 @@ impl Card for SpiCard {
         self.fat.read(buf)
     }
 
+    fn seek(&mut self, offset: u32) -> Result<(), CardError> {
+        self.fat.seek(offset)
+    }
+
     fn close(&mut self) {
         self.fat.close();
+    }
+
+    fn read_resume(&mut self, slots: &mut ResumeSlots) -> Result<(), CardError> {
+        self.ready()?;
+        self.fat.read_resume(slots)
+    }
+
+    fn write_resume(&mut self, slot: usize, bytes: &ResumeBytes) -> Result<(), CardError> {
+        self.ready()?;
+        self.fat.write_resume(slot, bytes)
     }
 }

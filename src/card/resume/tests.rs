@@ -19,7 +19,9 @@ fn sample(seq: u32) -> ResumeRecord {
         file_bytes: 5000,
         offset: 1234,
         line: 42,
+        after_cr: true,
         position: Point::new(-1500, 2750),
+        lines: 120,
         modal: Modal {
             motion: MotionMode::ArcCcw,
             units: Units::Inch,
@@ -53,7 +55,7 @@ fn changed(f: impl FnOnce(&mut ResumeBytes)) -> Result<ResumeRecord, BadResume> 
 /// Where the fields lie in the bytes (see `RESUME_RECORD_BYTES`).
 const NAME_AT: usize = 12;
 const PLACE_AT: usize = NAME_AT + CARD_SHORT_NAME_MAX_BYTES;
-const MODES_AT: usize = PLACE_AT + 20;
+const MODES_AT: usize = PLACE_AT + 24;
 const FEED_AT: usize = MODES_AT + 8;
 const OFFSETS_AT: usize = FEED_AT + 8;
 
@@ -107,11 +109,14 @@ fn bytes_that_are_not_a_record_say_why() {
     assert_eq!(place(100, 50, 0), Err(BadResume::Place), "line 0");
     assert_eq!(place(100, 5, 7), Err(BadResume::Place), "more lines than bytes before");
     assert!(place(100, 100, 3).is_ok(), "the end of the file");
+    let lines = |lines: u32| changed(|b| b[PLACE_AT + 20..PLACE_AT + 24].copy_from_slice(&lines.to_le_bytes()));
+    assert_eq!(lines(40), Err(BadResume::Place), "line 42 of a file of 40 lines");
+    assert!(lines(41).is_ok(), "the end of a file of 41 lines");
 
     for (at, value) in [(0, 5), (1, 2), (2, 2), (3, WORK_SYSTEMS as u8), (4, 3), (5, 2), (6, 1), (7, 1)] {
         assert_eq!(changed(|b| b[MODES_AT + at] = value), Err(BadResume::Mode), "mode byte {at} = {value}");
     }
-    assert_eq!(changed(|b| b[6] |= 4), Err(BadResume::Mode), "an unknown flag");
+    assert_eq!(changed(|b| b[6] |= 8), Err(BadResume::Mode), "an unknown flag");
 
     let nan = f32::NAN.to_le_bytes();
     assert_eq!(changed(|b| b[FEED_AT..FEED_AT + 4].copy_from_slice(&nan)), Err(BadResume::Number));
@@ -192,11 +197,13 @@ fn any_record() -> impl Strategy<Value = ResumeRecord> {
             String::<CARD_SHORT_NAME_MAX_BYTES>::try_from(text.as_str()).unwrap()
         },
     );
-    let place = (any::<u32>(), any::<u32>(), any::<u32>()).prop_map(|(file_bytes, o, l)| {
-        let offset = if file_bytes == 0 { 0 } else { o % (file_bytes + 1) };
-        let line = if offset == u32::MAX { l.max(1) } else { 1 + l % (offset + 1) };
-        (file_bytes, offset, line)
-    });
+    let place = (any::<u32>(), any::<u32>(), any::<u32>(), any::<u32>(), any::<bool>()).prop_map(
+        |(file_bytes, o, l, more, after_cr)| {
+            let offset = if file_bytes == 0 { 0 } else { o % (file_bytes + 1) };
+            let line = if offset == u32::MAX { l.max(1) } else { 1 + l % (offset + 1) };
+            (file_bytes, offset, line, (line - 1).saturating_add(more), after_cr)
+        },
+    );
     let value = -1.0e6f32..1.0e6;
     let modes = (0u8..5, 0u8..2, 0u8..2, 0..WORK_SYSTEMS, 0u8..3, 0u8..2, any::<u8>());
     let numbers = (
@@ -206,7 +213,7 @@ fn any_record() -> impl Strategy<Value = ResumeRecord> {
         prop::array::uniform2(value),
     );
     (any::<u32>(), name, place, any::<(i32, i32)>(), modes, numbers).prop_map(
-        |(seq, file, (file_bytes, offset, line), (x, y), modes, numbers)| {
+        |(seq, file, (file_bytes, offset, line, lines, after_cr), (x, y), modes, numbers)| {
             let (motion, units, distance, system, spindle, coolant, tool) = modes;
             let (feed_mm_per_min, spindle_speed, kept_mm, g92_mm) = numbers;
             ResumeRecord {
@@ -215,7 +222,9 @@ fn any_record() -> impl Strategy<Value = ResumeRecord> {
                 file_bytes,
                 offset,
                 line,
+                after_cr,
                 position: Point::new(x, y),
+                lines,
                 modal: Modal {
                     motion: motion_of(motion).unwrap(),
                     units: units_of(units).unwrap(),

@@ -8,12 +8,21 @@
 //! 80x60 mm         │  ~~  │  the pen-down strokes' size
 //! # plot  D back   └──────┘  the keys; the travel's outline, the strokes
 //! ```
+//!
+//! and, at power-on, a plot a power cut stopped, offered to be resumed:
+//!
+//! ```text
+//! RESUME PLOT?               (inverted)
+//! DRAWING.GCO                the file's 8.3 name
+//! from line 213/412          the line it goes on from, the file's lines
+//! # resume  D drop           the keys
+//! ```
 
 use embedded_graphics::geometry::{Point, Size};
 use embedded_graphics::primitives::Rectangle;
 
 use crate::card::names::cut_to;
-use crate::card::{CardError, CardFacts};
+use crate::card::{CardError, CardFacts, ResumeOffer};
 use crate::decimal::Int;
 use crate::panel::language::Language;
 use crate::panel::layout::{SCREEN_CHAR_WIDTH_PX, SCREEN_COLUMNS, SCREEN_HEIGHT_PX, SCREEN_MARGIN_PX, SCREEN_WIDTH_PX};
@@ -97,5 +106,22 @@ pub fn checked_view(name: &str, facts: &CardFacts, language: Language) -> Screen
             pen: None,
             card: Some(CardMark { pen: None }),
         }),
+    }
+}
+
+/// At power-on, the plot a power cut stopped, offered to be resumed.
+pub fn offer_view(offer: &ResumeOffer, language: Language) -> ScreenView {
+    let say = |msg| Say(msg, language);
+    ScreenView {
+        lines: [
+            TextLine { inverted: true, ..TextLine::say(Msg::ResumeTitle, language) },
+            TextLine::new(format_args!("{}", Text(cut_to(offer.name(), SCREEN_COLUMNS))), false),
+            TextLine::new(
+                format_args!("{} {}/{}", say(Msg::ResumeFrom), Int::from(offer.line), Int::from(offer.lines)),
+                false,
+            ),
+            TextLine::say(Msg::KeysResume, language),
+        ],
+        preview: None,
     }
 }

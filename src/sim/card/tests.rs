@@ -90,7 +90,9 @@ fn record(line: u32) -> ResumeRecord {
         file_bytes: plot_file().len() as u32,
         offset: line * 10,
         line,
+        after_cr: false,
         position: Point::new(line as i32 * 3, -7),
+        lines: 1500,
         modal: gcode.modal(),
     }
 }

@@ -1,13 +1,18 @@
 //! How the line loop carries out the card's turns (see `card_plot` for the file's session): the
-//! check of the chosen file a bounded piece at a time, the user's answer, and the plot's lines,
-//! each carried out by the one parser as a host link's line is.
+//! resume record looked for at power-on, the check of the chosen file a bounded piece at a time,
+//! the user's answers, and the plot's moves and lines, each carried out by the one parser as a
+//! host link's line is.
 
+use embassy_futures::select::select;
 use embassy_futures::yield_now;
+use embassy_time::{Duration, Instant, Timer};
 use embedded_storage::nor_flash::NorFlash;
 
-use super::card_plot::{CardPlot, CardRoom, CardSession, CardStep, CardTurn, US_PER_MS, end};
+use super::card_plot::{self, CardPlot, CardRoom, CardSession, CardStep, CardTurn, US_PER_MS, end};
 use super::{Host, Parser, Unfinished};
+use crate::card::keeper::{LineMark, RESUME_STORE_MIN_MS, ResumeKeeper};
 use crate::card::{CardError, CardFacts, CardFile, CardLine, CardLines, CardPicture, CardProgress, CardSlot, CardStop};
+use crate::host::gcode::GcodeState;
 use crate::machine_io::pen::Pen;
 use crate::motion::job::Control;
 use crate::program::check::Progress;
@@ -15,15 +20,21 @@ use crate::program::preview::StrokeMap;
 use crate::tasks::slices::BetweenSlices;
 
 impl CardSession {
-    /// The card's turn: the file the keypad chooses while none is; the user's answer once it is
-    /// checked; at once while it is being checked or has lines to send; once the machine rests
-    /// after its last line (the plot lasts until then).
+    /// The card's turn: the file the keypad chooses while none is; the user's answer once a
+    /// file is checked or a resume offered; at once at power-on, while a file is being checked
+    /// or has lines to send; once the machine rests after its last line (the plot lasts until
+    /// then), or a record's time later.
     pub async fn turn(&self, host: &Host<'_>, slot: &CardSlot<'_>) -> CardTurn {
         match self {
             CardSession::Idle => return CardTurn::Chosen(slot.plot_requested().await),
-            CardSession::Checked { .. } => return CardTurn::Answer(slot.answered().await),
-            CardSession::Plotting(p) if p.sent_all() => drop(host.machine_at_rest().await),
-            CardSession::Checking { .. } | CardSession::Plotting(_) => {}
+            CardSession::Checked { .. } | CardSession::Offered { .. } => {
+                return CardTurn::Answer(slot.answered().await);
+            }
+            CardSession::Plotting(p) if p.sent_all() => {
+                let keep = Timer::after(Duration::from_millis(RESUME_STORE_MIN_MS));
+                let _rest_or_time = select(host.machine_at_rest(), keep).await;
+            }
+            CardSession::PowerOn | CardSession::Checking { .. } | CardSession::Plotting(_) => {}
         }
         CardTurn::Step
     }
@@ -39,10 +50,28 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         session: &mut CardSession,
     ) {
         let next = match (turn, &mut *session) {
+            (CardTurn::Step, CardSession::PowerOn) => offer(slot),
             (CardTurn::Chosen(file), _) => self.check_start(slot, file, room),
+            (CardTurn::Answer(true), CardSession::Offered { file, record }) => {
+                self.host.card_abort.set(false);
+                self.host.card_line.set(Some(0));
+                match CardPlot::resume(slot, room.keeper, file, record, &self.host.machine.settings()) {
+                    Some(plot) => CardSession::Plotting(plot),
+                    None => {
+                        self.card_end(slot);
+                        CardSession::Idle
+                    }
+                }
+            }
+            (CardTurn::Answer(false), CardSession::Offered { .. }) => {
+                info!("card: resume dropped");
+                self.plot_over(slot, room.keeper);
+                CardSession::Idle
+            }
             // A reset on a host link while the file was shown leaves it.
             (CardTurn::Answer(true), CardSession::Checked { file, facts }) if !self.host.card_abort.take() => {
-                match CardPlot::start(slot, file, facts.lines) {
+                let at = self.plan.map_or(self.host.machine.position(), |end| end.at());
+                match CardPlot::start(slot, room.keeper, file, facts.lines, at, self.gcode.modal()) {
                     Some(plot) => CardSession::Plotting(plot),
                     None => {
                         self.card_end(slot);
@@ -75,7 +104,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                 }
             }
             (CardTurn::Step, CardSession::Plotting(plot)) => {
-                let goes_on = self.card_step(slot, plot).await;
+                let goes_on = self.card_step(slot, plot, room.keeper).await;
                 // A line that queued without waiting leaves the loop ready at once for the next:
                 // the other tasks run between two lines, as between two pieces of the check.
                 yield_now().await;
@@ -161,18 +190,44 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         }
     }
 
-    /// Carries out the card plot's next line, as a line of a host link, and hands the plot its
-    /// answer; an abort since the line before ends the plot. True while the plot goes on.
-    async fn card_step(&mut self, slot: &CardSlot<'_>, plot: &mut CardPlot) -> bool {
+    /// Carries out the card plot's next move or line, as a line of a host link, and hands the
+    /// plot its answer; an abort since the line before ends the plot. Keeps the resume record
+    /// when it is due. True while the plot goes on.
+    async fn card_step(&mut self, slot: &CardSlot<'_>, plot: &mut CardPlot, keeper: &mut ResumeKeeper) -> bool {
         let host = self.host;
         let aborted = slot.take_abort() | host.card_abort.take() || host.machine.plan_end() != self.plan;
+        if plot.sent_all() && !aborted && !host.machine.at_rest() {
+            // The last lines still run: their record is kept meanwhile.
+            card_plot::keep(slot, keeper, host.machine.emitted_totals().0, Instant::now().as_millis());
+            return true;
+        }
+        let (resume_line, _, _) = plot.place();
         let (number, result) = match plot.next(slot) {
+            CardStep::Move(text) if !aborted => {
+                return match self.card_line(text).await {
+                    Ok(()) => true,
+                    Err(Unfinished::Error(error)) => {
+                        // The plot cannot go on from its place: the record stays for another try.
+                        self.card_end(slot);
+                        slot.stopped(CardStop::Refused { line: resume_line, error });
+                        false
+                    }
+                    Err(_) => self.plot_over(slot, keeper),
+                };
+            }
+            CardStep::Restore(modal) if !aborted => {
+                let at = self.plan.map_or(host.machine.position(), |end| end.at());
+                self.gcode = GcodeState::resumed(modal, at, &host.machine.settings());
+                return true;
+            }
+            CardStep::Begin if !aborted => {
+                drop(host.machine_at_rest().await);
+                keeper.begin(self.handed_steps, host.machine.emitted_totals().0);
+                return true;
+            }
             CardStep::Line { number, text } if !aborted => {
                 host.card_line.set(Some(number));
-                match self.line(&host.card, text).await {
-                    Ok(()) => (number, self.keep(&host.card).await),
-                    refused => (number, refused),
-                }
+                (number, self.card_line(text).await)
             }
             CardStep::Refused { number, error } if !aborted => (number, Err(Unfinished::Error(error))),
             CardStep::SentAll => return true,
@@ -180,26 +235,52 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                 self.card_lost(slot, e).await;
                 return false;
             }
-            _ => {
-                self.card_end(slot);
-                return false;
-            }
+            _ => return self.plot_over(slot, keeper),
         };
-        if core::mem::take(&mut self.restart_after_answer) {
-            self.restart(&host.card).await;
-        }
         let refused = match result {
             Ok(()) => None,
             // Not refused by an abort that came while it waited: that ends the plot silently.
             Err(Unfinished::Error(e)) if host.machine.plan_end() == self.plan || self.plan.is_none() => Some(e),
-            Err(_) => {
-                self.card_end(slot);
-                return false;
-            }
+            Err(_) => return self.plot_over(slot, keeper),
         };
-        if plot.answered(slot, number, refused) {
-            return true;
+        let (next_line, offset, after_cr) = plot.place();
+        let mark = self.plan.map(|end| LineMark {
+            next_line,
+            offset,
+            after_cr,
+            handed_steps: self.handed_steps,
+            position: end.at(),
+            modal: self.gcode.modal(),
+        });
+        if !plot.answered(slot, number, refused) {
+            return self.plot_over(slot, keeper);
         }
+        let emitted = host.machine.emitted_totals().0;
+        if let Some(mark) = mark {
+            keeper.answered(mark, emitted);
+        }
+        card_plot::keep(slot, keeper, emitted, Instant::now().as_millis());
+        true
+    }
+
+    /// Carries out a line of the card plot (of its file, or a move of its own), as a line of a
+    /// host link.
+    async fn card_line(&mut self, text: &str) -> Result<(), Unfinished> {
+        let host = self.host;
+        let result = match self.line(&host.card, text).await {
+            Ok(()) => self.keep(&host.card).await,
+            refused => refused,
+        };
+        if core::mem::take(&mut self.restart_after_answer) {
+            self.restart(&host.card).await;
+        }
+        result
+    }
+
+    /// The plot is over as meant (its last line, a refusal, an abort): its resume record is
+    /// cleared, and host lines are taken again. False: the plot does not go on.
+    fn plot_over(&mut self, slot: &CardSlot<'_>, keeper: &mut ResumeKeeper) -> bool {
+        card_plot::clear(slot, keeper);
         self.card_end(slot);
         false
     }
@@ -222,5 +303,20 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
     fn card_end(&mut self, slot: &CardSlot<'_>) {
         end(slot);
         self.host.card_line.set(None);
+    }
+}
+
+/// At power-on: the plot a power cut stopped, offered if the card keeps one whose file is there.
+fn offer(slot: &CardSlot<'_>) -> CardSession {
+    match slot.with(|card| card.load_resume()) {
+        Ok(Some(record)) => match card_plot::offer(slot, &record) {
+            Some(file) => CardSession::Offered { file, record },
+            None => CardSession::Idle,
+        },
+        Ok(None) | Err(CardError::NoCard) => CardSession::Idle,
+        Err(e) => {
+            warn!("card: no resume record read: {}", e.message());
+            CardSession::Idle
+        }
     }
 }
