@@ -60,7 +60,9 @@ defaults to `out`).
                   the pen when hard limits are on ($21=1)
   --events FILE   input events at set times, one per line: `<ms> on|off <input>`, the input
                   one of x- x+ y- y+ (a switch stuck pressed, or let go), alarm-x alarm-y (a
-                  driver's alarm output, watched with $207=1) or estop (watched with $208=1)
+                  driver's alarm output, watched with $207=1), estop (watched with $208=1) or
+                  card-out (the card taken out; off puts it back); `<ms> off power` cuts the
+                  power then (once): the run ends at that instant, whatever it was doing
   --sd IMAGE      a microSD card in the slot: IMAGE is a FAT16 or FAT32 image (e.g.
                   `mkfs.fat -F 16 -C card.img 16384` then `mcopy -i card.img plot.gcode ::`);
                   the keypad's card mode lists its G-code files and plots the one chosen
@@ -222,6 +224,9 @@ pub fn main() -> ExitCode {
         stop: live.then(sim::stop::on_ctrl_c),
         ..SimConfig::default()
     });
+    if let Some(off_us) = report.power_off_us {
+        note!("power cut at {:.3} s of virtual time: the run ended there", off_us as f64 / 1e6);
+    }
     if let Some((wall_us, virtual_us)) = report.live_kept_us {
         // How well the virtual clock kept to the wall clock while the session was live.
         let (wall_s, virtual_s) = (wall_us as f64 / 1e6, virtual_us as f64 / 1e6);
@@ -331,7 +336,9 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
         lcd_dir.display(),
         if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
     );
-    note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    if !distinct.is_empty() {
+        note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    }
     note!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
     Ok(())
 }
