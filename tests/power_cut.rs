@@ -1,9 +1,12 @@
 //! The power cut on the simulated board (`<ms> off power` in the event script): the run ends at
 //! that instant, whatever it is doing; what went out before it is as without the cut, nothing
-//! goes out after it.
+//! goes out after it, and the card is as the cut left it.
 
+use servoplot::card::fat::FatCard;
 use servoplot::geom::TICKS_PER_US;
+use servoplot::sim::card::{ImageBlocks, image_of};
 use servoplot::sim::inputs::InputScript;
+use servoplot::sim::keys::KeyScript;
 use servoplot::sim::serial::SimSerial;
 use servoplot::sim::{self, SimConfig, SimReport};
 
@@ -63,4 +66,22 @@ fn a_power_cut_after_the_drawing_leaves_the_board_on_until_then() {
     assert_eq!((cut.power_off_us, cut.end_us), (Some(cut_us), cut_us), "on, at rest, until the cut");
     assert_eq!(cut.trace.pulses, whole.trace.pulses, "the drawing is whole");
     assert_eq!(cut.answers(), whole.answers());
+}
+
+#[test]
+fn the_card_comes_back_in_the_report_as_the_cut_left_it() {
+    // A card plot cut 4 s after power-on: the card, as it was at the cut, is in the report.
+    let file = polyline_file();
+    let image = image_of(&[("vpype.gcode", file.as_bytes())]).unwrap();
+    let card = Some(FatCard::new(ImageBlocks::new(image.clone())));
+    let keys = KeyScript::parse("B B B B B B B B B B # # wait:500 #").unwrap();
+    let events = InputScript::parse("4000 off power").unwrap();
+    let report = sim::run(SimConfig { keys, events, card, ..SimConfig::default() });
+    assert_eq!(report.power_off_us, Some(4_000_000));
+    assert!(!report.trace.pulses.is_empty(), "the plot had begun");
+    let kept = report.card_image.expect("the card's image");
+    // The plotter keeps nothing on the card yet: the image is the one the run began with.
+    assert_eq!(kept, image);
+    let no_card = stream("G1 X1 F3000\n", "");
+    assert_eq!(no_card.card_image, None, "no card, no image");
 }

@@ -32,7 +32,6 @@ pub mod step_timer;
 pub mod stop;
 
 use core::future::Future;
-use core::pin::pin;
 use core::task::{Context, Poll, Waker};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -139,6 +138,9 @@ pub struct SimReport {
     pub end_us: u64,
     /// The time the event script cut the power, if it did: the run ended there (`end_us`).
     pub power_off_us: Option<u64>,
+    /// The card's image at the end (or at the cut), with what the plotter wrote on it: the next
+    /// power-on's card. `None` without a card.
+    pub card_image: Option<Vec<u8>>,
     /// True if the run hit `SIM_MAX_VIRTUAL_US` before coming to rest.
     pub timed_out: bool,
     /// Times the pulses had to wait for the motion task.
@@ -298,7 +300,8 @@ pub fn run(config: SimConfig) -> SimReport {
         ),
         tasks::homing::run(handles.homing),
     );
-    let (mut interrupts, mut threads) = (pin!(interrupts), pin!(threads));
+    // On the heap, so that they can be dropped when the run ends and the card be taken out.
+    let (mut interrupts, mut threads) = (std::boxed::Box::pin(interrupts), std::boxed::Box::pin(threads));
     let (irq_flag, thread_flag) =
         (Arc::new(FlagWaker(AtomicBool::new(true))), Arc::new(FlagWaker(AtomicBool::new(true))));
     let (irq_waker, thread_waker) = (Waker::from(irq_flag.clone()), Waker::from(thread_flag.clone()));
@@ -397,6 +400,10 @@ pub fn run(config: SimConfig) -> SimReport {
     let missed_updates = machine.missed_updates();
     let settings = machine.settings();
     let end_us = clock::now_ticks();
+    // The tasks are gone (at a cut, wherever they were): the card comes out of its slot.
+    drop((interrupts, threads));
+    drop(slot);
+    let card_image = sim_slot.into_card().map(|card| card.image());
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
@@ -414,6 +421,7 @@ pub fn run(config: SimConfig) -> SimReport {
         flash,
         end_us,
         power_off_us: powered_off.then_some(end_us),
+        card_image,
         timed_out,
         underruns,
         missed_updates,
