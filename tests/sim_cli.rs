@@ -153,3 +153,43 @@ fn a_sender_drives_the_simulated_plotter_through_its_pseudo_terminal() {
     assert!(std::fs::read_to_string(dir.join("plot.svg")).unwrap().contains("<svg"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_off_power_event_ends_the_run_at_the_cut_and_an_unchanged_card_is_left_alone() {
+    let dir = std::env::temp_dir().join(format!("servoplot-power-cut-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (gcode, events, card) = (dir.join("long.gcode"), dir.join("cut.events"), dir.join("card.img"));
+    std::fs::write(&gcode, "G1 X100 Y50 F600\nG1 X0 Y0\n").unwrap();
+    std::fs::write(&events, "800 off power   # the plug pulled mid-line\n").unwrap();
+    let image = servoplot::sim::card::image_of(&[("plot.gcode", b"G1 X5\n")]).unwrap();
+    std::fs::write(&card, &image).unwrap();
+    let written_at = std::fs::metadata(&card).unwrap().modified().unwrap();
+    let out = servoplot()
+        .args(["--serial".as_ref(), gcode.as_os_str(), "--events".as_ref(), events.as_os_str()])
+        .args(["--sd".as_ref(), card.as_os_str(), "--out".as_ref(), dir.as_os_str()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(stderr.contains("power cut at 0.800 s of virtual time"), "{stderr}");
+    let last_pulse_s: f64 = stderr
+        .split("last pulse at ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("the summary gives the last pulse: {stderr}"));
+    // Given to the ms: a pulse just before the cut reads 0.800.
+    assert!(last_pulse_s > 0.7 && last_pulse_s <= 0.8, "pulses until the cut, none after: {last_pulse_s}");
+    // The firmware wrote nothing on the card: the image is not rewritten.
+    assert!(!stderr.contains("written back"), "{stderr}");
+    assert_eq!(std::fs::read(&card).unwrap(), image);
+    assert_eq!(std::fs::metadata(&card).unwrap().modified().unwrap(), written_at);
+
+    // `on power` is refused with its line, before anything runs.
+    std::fs::write(&events, "100 on power\n").unwrap();
+    let out = servoplot().args(["--events".as_ref(), events.as_os_str()]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("line 1: the power is on from the start"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

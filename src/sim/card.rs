@@ -1,5 +1,6 @@
 //! The simulator's card: a FAT image file (`--sd IMAGE`), or one made from a folder's files
-//! (`--sd-dir DIR`), as the 512-byte blocks the card module reads.
+//! (`--sd-dir DIR`), as the 512-byte blocks the card module reads; and the image file kept
+//! after a run ([`keep_image`]).
 
 use std::cell::RefCell;
 use std::io::{Cursor, Read, Seek, SeekFrom, Write};
@@ -84,6 +85,33 @@ impl SimCard {
 pub fn card_from_image(path: &Path) -> Result<SimCard, String> {
     let bytes = std::fs::read(path).map_err(|e| std::format!("--sd {}: {e}", path.display()))?;
     Ok(FatCard::new(ImageBlocks::new(bytes)))
+}
+
+/// Keeps a run's card in the image file at `path` (`--sd IMAGE`): writes `after` there if it
+/// differs from `before`, the image the run began with, and tells whether it did. The bytes go
+/// to a new file beside it first (with its permissions), which then takes its place, so a
+/// write cut short leaves the old image whole, never a torn one.
+pub fn keep_image(path: &Path, before: &[u8], after: &[u8]) -> std::io::Result<bool> {
+    if before == after {
+        return Ok(false);
+    }
+    // Beside the file itself, not a link to it: the link stays a link.
+    let path = std::fs::canonicalize(path)?;
+    let name = path.file_name().ok_or_else(|| std::io::Error::other("no file name"))?;
+    let mut temp_name = name.to_os_string();
+    temp_name.push(std::format!(".{}.tmp", std::process::id()));
+    let temp = path.with_file_name(temp_name);
+    let written = (|| {
+        let mut file = std::fs::File::create(&temp)?;
+        file.write_all(after)?;
+        file.sync_all()?;
+        std::fs::set_permissions(&temp, std::fs::metadata(&path)?.permissions())?;
+        std::fs::rename(&temp, &path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    written.map(|()| true)
 }
 
 /// A FAT16 image of [`SD_DIR_IMAGE_BLOCKS`] blocks holding `files` (name, bytes) in its top

@@ -60,11 +60,17 @@ defaults to `out`).
                   the pen when hard limits are on ($21=1)
   --events FILE   input events at set times, one per line: `<ms> on|off <input>`, the input
                   one of x- x+ y- y+ (a switch stuck pressed, or let go), alarm-x alarm-y (a
-                  driver's alarm output, watched with $207=1) or estop (watched with $208=1)
+                  driver's alarm output, watched with $207=1), estop (watched with $208=1) or
+                  card-out (the card taken out; off puts it back); `<ms> off power` cuts the
+                  power then (once): the run ends at that instant, whatever it was doing
   --sd IMAGE      a microSD card in the slot: IMAGE is a FAT16 or FAT32 image (e.g.
                   `mkfs.fat -F 16 -C card.img 16384` then `mcopy -i card.img plot.gcode ::`);
-                  the keypad's card mode lists its G-code files and plots the one chosen
-  --sd-dir DIR    the same with a card made from the files in DIR
+                  the keypad's card mode lists its G-code files and plots the one chosen.
+                  The card is kept in IMAGE: what the plotter writes on it (its resume record)
+                  is there for the next run (written back at the end, cut or not, if changed).
+                  Two runs with the same IMAGE and `off power` in the first are a power cut.
+  --sd-dir DIR    the same with a card made from the files in DIR; what the plotter writes
+                  on it is forgotten (nothing is written to DIR)
   --out DIR       where the pictures go
 
 Set SERVOPLOT_LOG=info (or debug, trace) to see the firmware's log on standard error.";
@@ -118,6 +124,8 @@ struct Args {
     switches: Option<Switches>,
     events: InputScript,
     card: Option<sim::card::SimCard>,
+    /// The image file the card is kept in (`--sd`; none with `--sd-dir`).
+    sd_image: Option<PathBuf>,
     out: PathBuf,
 }
 
@@ -131,6 +139,7 @@ fn parse_args() -> Result<Args, String> {
         switches: None,
         events: InputScript::default(),
         card: None,
+        sd_image: None,
         out: PathBuf::from("out"),
     };
     let mut it = std::env::args().skip(1);
@@ -161,8 +170,15 @@ fn parse_args() -> Result<Args, String> {
                 let text = std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?;
                 args.events = InputScript::parse(&text).map_err(|e| format!("{path}: {e}"))?;
             }
-            "--sd" => args.card = Some(sim::card::card_from_image(Path::new(&value()?))?),
-            "--sd-dir" => args.card = Some(sim::card::card_from_dir(Path::new(&value()?))?),
+            "--sd" => {
+                let path = PathBuf::from(value()?);
+                args.card = Some(sim::card::card_from_image(&path)?);
+                args.sd_image = Some(path);
+            }
+            "--sd-dir" => {
+                args.card = Some(sim::card::card_from_dir(Path::new(&value()?))?);
+                args.sd_image = None;
+            }
             "--out" => args.out = PathBuf::from(value()?),
             "-h" | "--help" => return Err(String::new()),
             other => return Err(format!("unknown argument `{other}`")),
@@ -210,6 +226,8 @@ pub fn main() -> ExitCode {
     };
     let with_cpu = args.cpu.is_some();
     let live = serial.is_live();
+    // The image the card began with, to tell whether the run changed it.
+    let sd_before = args.sd_image.clone().zip(args.card.as_ref().map(sim::card::SimCard::image));
     let report = sim::run(SimConfig {
         flash,
         serial: serial.echo_to_stdout(),
@@ -222,6 +240,21 @@ pub fn main() -> ExitCode {
         stop: live.then(sim::stop::on_ctrl_c),
         ..SimConfig::default()
     });
+    if let Some(off_us) = report.power_off_us {
+        note!("power cut at {:.3} s of virtual time: the run ended there", off_us as f64 / 1e6);
+    }
+    // A card not written back is an error, but the pictures are still made.
+    let mut card_kept = true;
+    if let (Some((path, before)), Some(after)) = (&sd_before, &report.card_image) {
+        match sim::card::keep_image(path, before, after) {
+            Ok(true) => note!("the card as the run left it: written back to {}", path.display()),
+            Ok(false) => {}
+            Err(e) => {
+                note!("error: --sd {}: writing the card back: {e}", path.display());
+                card_kept = false;
+            }
+        }
+    }
     if let Some((wall_us, virtual_us)) = report.live_kept_us {
         // How well the virtual clock kept to the wall clock while the session was live.
         let (wall_s, virtual_s) = (wall_us as f64 / 1e6, virtual_us as f64 / 1e6);
@@ -248,6 +281,9 @@ pub fn main() -> ExitCode {
             "error: the machine did not come to rest within {} s of virtual time",
             sim::SIM_MAX_VIRTUAL_US / 1_000_000
         );
+        return ExitCode::FAILURE;
+    }
+    if !card_kept {
         return ExitCode::FAILURE;
     }
     ExitCode::SUCCESS
@@ -331,7 +367,9 @@ fn write_pictures(report: &sim::SimReport, out: &Path) -> std::io::Result<()> {
         lcd_dir.display(),
         if written < distinct.len() { " (the rest are left out; the last is lcd-final.png)" } else { "" }
     );
-    note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    if !distinct.is_empty() {
+        note!("final LCD frame: {}", out.join("lcd-final.png").display());
+    }
     note!("the LCD through the whole session, animated: {}", out.join("session.gif").display());
     Ok(())
 }

@@ -8,8 +8,10 @@
 //! by an event script: each line is `<time ms> on|off <input>`, the input one of `x-` `x+` `y-`
 //! `y+` (a switch forced pressed, as when stuck, or released again), `alarm-x` `alarm-y` (a
 //! driver's alarm output), `estop`, or `card-out` (the card taken out of its slot, and put back
-//! with `off`; not an input pin: the simulated card slot reads it). `#` starts a comment. For
-//! example:
+//! with `off`; not an input pin: the simulated card slot reads it). `off power` cuts the board's
+//! power at that instant: the run ends there ([`InputScript::power_off_us`]); it is no input
+//! pin either, comes at most once, and is never switched `on` (a run is a power-on). `#` starts
+//! a comment. For example:
 //!
 //! ```text
 //! 1500 on alarm-x     # the X driver faults 1.5 s after power-on
@@ -18,6 +20,7 @@
 //! 400 on y-           # a glitch of 0.2 ms on the Y min switch
 //! 400.2 off y-
 //! 3000 on card-out    # the card pulled 3 s after power-on
+//! 4500 off power      # the power cut 4.5 s after power-on: the run ends
 //! ```
 
 use std::cell::RefCell;
@@ -49,14 +52,18 @@ pub struct InputEvent {
     pub on: bool,
 }
 
-/// A script of input events, in time order.
+/// A script of input events, in time order, and the power cut, if it has one.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct InputScript(Vec<InputEvent>);
+pub struct InputScript {
+    events: Vec<InputEvent>,
+    power_off_us: Option<u64>,
+}
 
 impl InputScript {
     /// Reads an event script (see the module documentation); the error names the line.
     pub fn parse(text: &str) -> Result<InputScript, String> {
         let mut events = Vec::new();
+        let mut power_off_us = None;
         for (n, line) in text.lines().enumerate() {
             let line = line.split('#').next().unwrap_or("").trim();
             if line.is_empty() {
@@ -76,6 +83,17 @@ impl InputScript {
                 "off" => false,
                 _ => return Err(bad("expected on or off")),
             };
+            let t_us = (t_ms * 1_000.0).round() as u64;
+            if name == "power" {
+                if on {
+                    return Err(bad("the power is on from the start: only `off power` cuts it"));
+                }
+                if power_off_us.is_some() {
+                    return Err(bad("the power is cut once: a second `off power`"));
+                }
+                power_off_us = Some(t_us);
+                continue;
+            }
             let input = match name {
                 "x-" => LIMIT_X_MIN,
                 "x+" => LIMIT_X_MAX,
@@ -87,16 +105,21 @@ impl InputScript {
                 "card-out" => CARD_OUT,
                 _ => return Err(bad("unknown input")),
             };
-            events.push(InputEvent { t_us: (t_ms * 1_000.0).round() as u64, input, on });
+            events.push(InputEvent { t_us, input, on });
         }
         events.sort_by_key(|e| e.t_us);
-        Ok(InputScript(events))
+        Ok(InputScript { events, power_off_us })
+    }
+
+    /// When the script cuts the power (`off power`), µs after power-on; `None`: it stays on.
+    pub fn power_off_us(&self) -> Option<u64> {
+        self.power_off_us
     }
 
     /// Inputs raised by the script at `t_us`.
     fn raised_at(&self, t_us: u64) -> u8 {
         let mut raised = 0;
-        for e in self.0.iter().take_while(|e| e.t_us <= t_us) {
+        for e in self.events.iter().take_while(|e| e.t_us <= t_us) {
             if e.on {
                 raised |= e.input;
             } else {
@@ -181,12 +204,35 @@ mod tests {
     #[test]
     fn scripts_read_in_time_order_and_bad_lines_are_named() {
         let s = InputScript::parse("2000 off estop\n# comment\n1500 on estop  # pressed\n0.5 on x+\n").unwrap();
-        assert_eq!(s.0[0], InputEvent { t_us: 500, input: LIMIT_X_MAX, on: true });
+        assert_eq!(s.events[0], InputEvent { t_us: 500, input: LIMIT_X_MAX, on: true });
         assert_eq!(s.raised_at(1_600_000), ESTOP | LIMIT_X_MAX);
         assert_eq!(s.raised_at(2_000_000), LIMIT_X_MAX);
         assert_eq!(InputScript::parse("1 on z+").unwrap_err(), "line 1: unknown input: `1 on z+`");
         assert!(InputScript::parse("\n-3 on estop").unwrap_err().starts_with("line 2: not a time"));
         assert!(InputScript::parse("5 up estop").is_err());
         assert!(InputScript::parse("5 on").is_err());
+        assert_eq!(s.power_off_us(), None, "no cut: the power stays on");
+    }
+
+    #[test]
+    fn off_power_cuts_the_power_once_and_is_no_input() {
+        let s = InputScript::parse("1500 on estop\n2750.5 off power  # the plug pulled\n3000 off estop\n").unwrap();
+        assert_eq!(s.power_off_us(), Some(2_750_500));
+        assert_eq!(s.events.len(), 2, "the cut is no input event");
+        assert_eq!(s.raised_at(2_800_000), ESTOP, "and raises no input bit");
+        assert_eq!(InputScript::parse("0 off power").unwrap().power_off_us(), Some(0), "a cut before anything");
+    }
+
+    #[test]
+    fn power_switched_on_or_cut_twice_is_refused_with_its_line() {
+        assert_eq!(
+            InputScript::parse("# power\n100 on power").unwrap_err(),
+            "line 2: the power is on from the start: only `off power` cuts it: `100 on power`"
+        );
+        assert_eq!(
+            InputScript::parse("100 off power\n200 on estop\n300 off power").unwrap_err(),
+            "line 3: the power is cut once: a second `off power`: `300 off power`"
+        );
+        assert!(InputScript::parse("-1 off power").unwrap_err().starts_with("line 1: not a time"));
     }
 }

@@ -4,8 +4,10 @@
 //! pins and ports are models: step/direction pins record a pulse trace, the keypad is a matrix
 //! pressed by a script, the two host links (the board's UART and USB port) read transcripts,
 //! standard input or a sender on a pseudo-terminal, and the LCD is a model of the ST7920 fed by
-//! the real driver. A run ends when every input is used up and the machine has come to rest. In
-//! a live session (standard input, a pseudo-terminal) virtual time keeps to the wall clock.
+//! the real driver. A run ends when every input is used up and the machine has come to rest, or
+//! at the instant the event script cuts the power (`off power`, see [`inputs`]): then nothing
+//! runs on, whatever it was doing. In a live session (standard input, a pseudo-terminal) virtual
+//! time keeps to the wall clock.
 //! [`cli`] is the simulator's command line: what the firmware binary runs when built for the
 //! host.
 //!
@@ -30,7 +32,6 @@ pub mod step_timer;
 pub mod stop;
 
 use core::future::Future;
-use core::pin::pin;
 use core::task::{Context, Poll, Waker};
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -102,7 +103,8 @@ pub struct SimConfig {
     pub cpu: Option<CpuModel>,
     /// Limit switches at the ends of the travel; none if `None`.
     pub switches: Option<Switches>,
-    /// Driver alarms, e-stops and stuck switches at set virtual times.
+    /// Driver alarms, e-stops, stuck switches, the card pulled and the power cut at set virtual
+    /// times.
     pub events: InputScript,
     /// A step timer interrupt that comes late (none by default).
     pub late_interrupt: Option<LateInterrupt>,
@@ -135,6 +137,11 @@ pub struct SimReport {
     pub flash: SimFlash,
     /// Virtual time at the end, and when the last pulse went out.
     pub end_us: u64,
+    /// The time the event script cut the power, if it did: the run ended there (`end_us`).
+    pub power_off_us: Option<u64>,
+    /// The card's image at the end (or at the cut), with what the plotter wrote on it: the next
+    /// power-on's card. `None` without a card.
+    pub card_image: Option<Vec<u8>>,
     /// True if the run hit `SIM_MAX_VIRTUAL_US` before coming to rest.
     pub timed_out: bool,
     /// Times the pulses had to wait for the motion task.
@@ -219,6 +226,10 @@ pub fn run(config: SimConfig) -> SimReport {
     let Some(handles) = machine.handles() else { unreachable!("a new machine has its handles") };
     let panel = Panel::new();
     let trace = Rc::new(RefCell::new(PulseTrace::default()));
+    let power_off_us = config.events.power_off_us();
+    if let Some(off) = power_off_us {
+        trace.borrow_mut().power_off_at(off * u64::from(crate::geom::TICKS_PER_US));
+    }
     let inputs = SimInputs::new(trace.clone(), config.switches, config.events, &machine.settings());
     let mut sim_slot = card_slot::SimSlot::new(config.card, inputs.clone());
     let slot = CardSlot::new(&mut sim_slot);
@@ -291,7 +302,8 @@ pub fn run(config: SimConfig) -> SimReport {
         ),
         tasks::homing::run(handles.homing),
     );
-    let (mut interrupts, mut threads) = (pin!(interrupts), pin!(threads));
+    // On the heap, so that they can be dropped when the run ends and the card be taken out.
+    let (mut interrupts, mut threads) = (std::boxed::Box::pin(interrupts), std::boxed::Box::pin(threads));
     let (irq_flag, thread_flag) =
         (Arc::new(FlagWaker(AtomicBool::new(true))), Arc::new(FlagWaker(AtomicBool::new(true))));
     let (irq_waker, thread_waker) = (Waker::from(irq_flag.clone()), Waker::from(thread_flag.clone()));
@@ -300,7 +312,13 @@ pub fn run(config: SimConfig) -> SimReport {
     let mut wall_pace: Option<clock::WallPace> = None;
     let mut live_kept_us = None;
     let mut timed_out = false;
+    let mut powered_off = false;
     loop {
+        // The power cut: nothing runs from then on.
+        if power_off_us.is_some_and(|off| clock::now_ticks() >= off) {
+            powered_off = true;
+            break;
+        }
         // The interrupts first, whenever they are woken, as their priority has them on the board.
         if irq_flag.0.swap(false, Ordering::AcqRel) {
             if let Poll::Ready(never) = interrupts.as_mut().poll(&mut irq_cx) {
@@ -333,7 +351,8 @@ pub fn run(config: SimConfig) -> SimReport {
             matrix.start();
         }
         let at_rest = input_done && matrix.script_done() && thread_free_at.is_none() && machine.at_rest();
-        if at_rest {
+        // A power cut to come ends the run, not the rest before it.
+        if at_rest && power_off_us.is_none() {
             let since = *rest_since.get_or_insert(now);
             if now >= since + SIM_SETTLE_US {
                 break;
@@ -342,10 +361,9 @@ pub fn run(config: SimConfig) -> SimReport {
             rest_since = None;
         }
         // Thread mode taken with a task of it woken: it is polled once free.
-        let next_deadline = match (clock::next_deadline(), thread_free_at.filter(|_| woken(&thread_flag))) {
-            (Some(d), Some(free)) => Some(d.min(free)),
-            (d, free) => d.or(free),
-        };
+        // Time never passes the power cut: it is the last deadline.
+        let next_deadline =
+            earliest(earliest(clock::next_deadline(), thread_free_at.filter(|_| woken(&thread_flag))), power_off_us);
         if serial.is_live() {
             // A person or a sender is at the link: let time pass as it does for them (so a `!`
             // typed mid-move lands mid-move), waiting for their input until the wall clock
@@ -360,7 +378,7 @@ pub fn run(config: SimConfig) -> SimReport {
                 clock::jump_to(next_deadline.map_or(pace.wall_us(), |d| d.min(pace.wall_us())));
                 continue;
             }
-        } else if now >= SIM_MAX_VIRTUAL_US {
+        } else if now >= SIM_MAX_VIRTUAL_US && !at_rest {
             timed_out = true;
             break;
         }
@@ -384,6 +402,10 @@ pub fn run(config: SimConfig) -> SimReport {
     let missed_updates = machine.missed_updates();
     let settings = machine.settings();
     let end_us = clock::now_ticks();
+    // The tasks are gone (at a cut, wherever they were): the card comes out of its slot.
+    drop((interrupts, threads));
+    drop(slot);
+    let card_image = sim_slot.into_card().map(|card| card.image());
     let trace =
         Rc::try_unwrap(trace).map(RefCell::into_inner).unwrap_or_else(|rc| core::mem::take(&mut *rc.borrow_mut()));
     let frames = core::mem::take(&mut spi.model.borrow_mut().frames);
@@ -400,6 +422,8 @@ pub fn run(config: SimConfig) -> SimReport {
         loaded,
         flash,
         end_us,
+        power_off_us: powered_off.then_some(end_us),
+        card_image,
         timed_out,
         underruns,
         missed_updates,
@@ -409,6 +433,14 @@ pub fn run(config: SimConfig) -> SimReport {
         led: led.changes(),
         buzzer: buzzer.changes(),
         live_kept_us,
+    }
+}
+
+/// The earlier of two times, either of which may be none.
+fn earliest(a: Option<u64>, b: Option<u64>) -> Option<u64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     }
 }
 

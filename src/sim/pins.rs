@@ -51,6 +51,8 @@ pub struct PulseTrace {
     sign_changed_at: [Option<u64>; 2],
     puls_high_since: [Option<u64>; 2],
     puls_low_since: [Option<u64>; 2],
+    /// From this step tick on the pins have no power: no edge is made.
+    power_off_at_ticks: Option<u64>,
 }
 
 /// `at` becomes the smaller of itself and `v`.
@@ -59,7 +61,16 @@ fn keep_min(at: &mut Option<u64>, v: u64) {
 }
 
 impl PulseTrace {
+    /// The power goes off at `t_ticks` (step ticks): no edge is made from then on, not even one
+    /// the step timer set up before it (a SIGN change stamped its latency ahead).
+    pub fn power_off_at(&mut self, t_ticks: u64) {
+        self.power_off_at_ticks = Some(t_ticks);
+    }
+
     fn edge(&mut self, axis: Axis, role: Role, high: bool, t: u64) {
+        if self.power_off_at_ticks.is_some_and(|off| t >= off) {
+            return;
+        }
         let i = axis.index();
         match role {
             Role::Sign => {
