@@ -2,6 +2,7 @@
 //! that instant, whatever it is doing; what went out before it is as without the cut, nothing
 //! goes out after it, and the card is as the cut left it.
 
+use servoplot::card::Card;
 use servoplot::card::fat::FatCard;
 use servoplot::geom::TICKS_PER_US;
 use servoplot::sim::card::{ImageBlocks, image_of};
@@ -80,8 +81,10 @@ fn the_card_comes_back_in_the_report_as_the_cut_left_it() {
     assert_eq!(report.power_off_us, Some(4_000_000));
     assert!(!report.trace.pulses.is_empty(), "the plot had begun");
     let kept = report.card_image.expect("the card's image");
-    // The plotter keeps nothing on the card yet: the image is the one the run began with.
-    assert_eq!(kept, image);
+    // The plot's resume record is on it (`card_resume.rs` resumes from such a card).
+    assert_ne!(kept, image);
+    let record = FatCard::new(ImageBlocks::new(kept)).load_resume().unwrap().expect("a resume record");
+    assert!(record.line > 1 && record.file.as_str() == "VPYPE~1.GCO", "{record:?}");
     let no_card = stream("G1 X1 F3000\n", "");
     assert_eq!(no_card.card_image, None, "no card, no image");
 }

@@ -2,11 +2,11 @@
 //!
 //! This module owns what the plotter makes of a card: the list of its G-code files
 //! ([`names`]), the lines of the file being plotted, framed by the host links' own rules
-//! ([`lines`]), the resume record a plot keeps on the card ([`resume`]), and the FAT volume on
-//! the card's 512-byte blocks ([`fat`], through the `embedded-sdmmc` crate). The boards give the
-//! blocks: the simulator a FAT image file, the F407 the card on SPI. Everything here is
-//! synchronous and owns no pin; the card is reached through [`Card`], which the boards
-//! implement.
+//! ([`lines`]), the resume record a plot keeps on the card ([`resume`]) and which of its lines
+//! has completed for it ([`keeper`]), and the FAT volume on the card's 512-byte blocks
+//! ([`fat`], through the `embedded-sdmmc` crate). The boards give the blocks: the simulator a
+//! FAT image file, the F407 the card on SPI. Everything here is synchronous and owns no pin;
+//! the card is reached through [`Card`], which the boards implement.
 
 pub mod fat;
 pub mod keeper;

@@ -11,7 +11,7 @@ use core::cell::{Cell, Ref, RefCell, RefMut};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::signal::Signal;
 
-use super::names::CARD_SHORT_NAME_MAX_BYTES;
+use super::names::CARD_NAME_MAX_BYTES;
 use super::{Card, CardError, CardFile, CardFiles};
 use crate::host::GrblError;
 use crate::program::preview::{MapScale, PlotProgress, StrokeMap};
@@ -58,27 +58,31 @@ pub enum CardProgress {
     Offer(ResumeOffer),
 }
 
-/// A plot a power cut stopped, as the LCD offers it: the file's 8.3 name, the line it goes on
-/// from and the file's lines.
+/// A plot a power cut stopped, as the LCD offers it: the file's name as listed, the line it
+/// goes on from and the file's lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(target_os = "none", derive(defmt::Format))]
 pub struct ResumeOffer {
-    name: [u8; CARD_SHORT_NAME_MAX_BYTES],
+    name: [u8; CARD_NAME_MAX_BYTES],
     pub line: u32,
     pub lines: u32,
 }
 
 impl ResumeOffer {
     pub fn new(name: &str, line: u32, lines: u32) -> Self {
-        let mut bytes = [0; CARD_SHORT_NAME_MAX_BYTES];
-        let len = name.len().min(CARD_SHORT_NAME_MAX_BYTES);
+        // A name longer than the room (never one the list gives) is cut at a character's end.
+        let mut bytes = [0; CARD_NAME_MAX_BYTES];
+        let mut len = name.len().min(CARD_NAME_MAX_BYTES);
+        while !name.is_char_boundary(len) {
+            len -= 1;
+        }
         bytes[..len].copy_from_slice(&name.as_bytes()[..len]);
         ResumeOffer { name: bytes, line, lines }
     }
 
-    /// The file's 8.3 name.
+    /// The file's name.
     pub fn name(&self) -> &str {
-        let len = self.name.iter().position(|&b| b == 0).unwrap_or(CARD_SHORT_NAME_MAX_BYTES);
+        let len = self.name.iter().position(|&b| b == 0).unwrap_or(CARD_NAME_MAX_BYTES);
         core::str::from_utf8(&self.name[..len]).unwrap_or("?")
     }
 }

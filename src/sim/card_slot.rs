@@ -110,7 +110,9 @@ mod tests {
             file_bytes: 4_000,
             offset: line * 20,
             line,
+            after_cr: false,
             position: Point::new(120, -40),
+            lines: 200,
             modal: GcodeState::new().modal(),
         }
     }

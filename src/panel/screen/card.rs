@@ -13,7 +13,7 @@
 //!
 //! ```text
 //! RESUME PLOT?               (inverted)
-//! DRAWING.GCO                the file's 8.3 name
+//! drawing.gcode              the file
 //! from line 213/412          the line it goes on from, the file's lines
 //! # resume  D drop           the keys
 //! ```

@@ -319,14 +319,19 @@ fn travel_line(at: Point, settings: &Settings) -> String<TRAVEL_LINE_BYTES> {
 /// The offer of the plot `record` was kept of, if its file is on the card as it was (same name,
 /// same length); a record of a file changed or gone is cleared.
 pub fn offer(slot: &CardSlot<'_>, record: &ResumeRecord) -> Option<CardFile> {
-    let file =
-        CardFile { name: record.file.as_str().try_into().ok()?, short: record.file.clone(), bytes: record.file_bytes };
-    let length = slot.with(|card| {
-        let length = card.open(&file);
-        card.close();
-        length
+    // The file as the list shows it (its long name), or, beyond the list, by its 8.3 name.
+    let listed =
+        slot.with(|card| card.files()).ok().and_then(|files| files.iter().find(|f| f.short == record.file).cloned());
+    let file = listed.or_else(|| {
+        let file = CardFile { name: record.file.as_str().try_into().ok()?, short: record.file.clone(), bytes: 0 };
+        let bytes = slot.with(|card| {
+            let bytes = card.open(&file);
+            card.close();
+            bytes
+        });
+        Some(CardFile { bytes: bytes.ok()?, ..file })
     });
-    if length != Ok(record.file_bytes) {
+    let Some(file) = file.filter(|file| record.is_for(file)) else {
         warn!(
             "card: the plot stopped at line {} of {} cannot resume: its file changed",
             record.line,
@@ -336,9 +341,9 @@ pub fn offer(slot: &CardSlot<'_>, record: &ResumeRecord) -> Option<CardFile> {
             warn!("card: resume record not cleared: {}", e.message());
         }
         return None;
-    }
-    info!("card: the plot of {} stopped at line {}: offered to resume", record.file.as_str(), record.line);
-    slot.set_progress(CardProgress::Offer(ResumeOffer::new(&record.file, record.line, record.lines)));
+    };
+    info!("card: the plot of {} stopped at line {}: offered to resume", file.name.as_str(), record.line);
+    slot.set_progress(CardProgress::Offer(ResumeOffer::new(&file.name, record.line, record.lines)));
     Some(file)
 }
 

@@ -55,6 +55,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             (CardTurn::Answer(true), CardSession::Offered { file, record }) => {
                 self.host.card_abort.set(false);
                 self.host.card_line.set(Some(0));
+                self.plan = self.host.machine.plan_end();
                 match CardPlot::resume(slot, room.keeper, file, record, &self.host.machine.settings()) {
                     Some(plot) => CardSession::Plotting(plot),
                     None => {
@@ -205,7 +206,11 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         let (number, result) = match plot.next(slot) {
             CardStep::Move(text) if !aborted => {
                 return match self.card_line(text).await {
-                    Ok(()) => true,
+                    Ok(()) => {
+                        // Homing moved the plan's end: the next step starts from there.
+                        self.plan = host.machine.plan_end();
+                        true
+                    }
                     Err(Unfinished::Error(error)) => {
                         // The plot cannot go on from its place: the record stays for another try.
                         self.card_end(slot);
