@@ -13,8 +13,9 @@ the host link asks `?` at 5 Hz and the LCD redraws the run screen: every task ru
 
 It fails unless the plot starts and ends, every status report is well formed, no step-queue
 underrun and no missed timer update is reported, the pulses and the final position are the
-simulator's for the same card and keys, the stack's peak stays under half the stack and no task
-poll took 10 ms or more of the F407's time (`$I`).
+simulator's for the same card and keys, the plot kept its resume record on the card (written
+at most once a second as it ran, cleared at its end, every write taken), the stack's peak stays
+under half the stack and no task poll took 10 ms or more of the F407's time (`$I`).
 """
 import argparse
 import os
@@ -138,12 +139,16 @@ def check():
     text = run.decode_log(defmt_path)
     with open(os.path.join(ROOT, "target", "model", "defmt-card.txt"), "w") as f:
         f.write(text)
-    for what, pattern in (("check", r"card file checked"), ("plot", r"card plot: all \d+ lines sent")):
+    for what, pattern in (("check", r"card file checked"), ("plot", r"card plot: all \d+ lines sent"),
+                          ("resume record", r"resume record, kept [1-9]\d* times, cleared")):
         found = [l for l in text.splitlines() if re.search(pattern, l)]
         if not found:
             failures.append(f"the defmt log has no {what} line")
         else:
             print(f"defmt ({what}): {found[-1].strip()}")
+    for line in text.splitlines():
+        if "resume record not" in line:
+            failures.append(f"a resume record was not written: {line.strip()}")
     if failures:
         print("\nthe model's card plot FAILED:\n  " + "\n  ".join(failures))
         sys.exit(1)

@@ -54,6 +54,8 @@ pub struct ResumeKeeper {
     stored_at_ms: Option<u64>,
     /// The line the stored record goes on from.
     stored_line: u32,
+    /// Records handed out to be stored since the plot began.
+    stores: u32,
 }
 
 impl Default for ResumeKeeper {
@@ -72,6 +74,7 @@ impl ResumeKeeper {
             done: None,
             stored_at_ms: None,
             stored_line: 0,
+            stores: 0,
         }
     }
 
@@ -83,6 +86,12 @@ impl ResumeKeeper {
         self.marks.clear();
         self.done = None;
         self.stored_at_ms = None;
+        self.stores = 0;
+    }
+
+    /// Records handed out to be stored since the plot began.
+    pub fn stores(&self) -> u32 {
+        self.stores
     }
 
     /// The plot is over: nothing more is kept.
@@ -144,6 +153,7 @@ impl ResumeKeeper {
         }
         self.stored_at_ms = Some(now_ms);
         self.stored_line = record.line;
+        self.stores += 1;
         Some(record)
     }
 }
@@ -157,6 +167,7 @@ mod tests {
         ResumeRecord {
             seq: 0,
             file: "PLOT.NC".try_into().unwrap(),
+            name: "plot.nc".try_into().unwrap(),
             file_bytes: 1000,
             offset: 0,
             line: 1,
@@ -219,5 +230,28 @@ mod tests {
         // The last mark moved on to the newest line: nothing completes before its steps.
         assert!(k.due(10 * last - 1, 5_000).is_none());
         assert_eq!(k.due(10 * last, 10_000).unwrap().line, last + 1);
+    }
+
+    #[test]
+    fn marks_freed_as_their_lines_complete_keep_the_record_close_behind_the_pen() {
+        // Lines of 10 steps, 40 of them in flight at any time (far more than the marks), each
+        // answered as the one 40 before it completes; a store is due every 100 lines.
+        let mut k = ResumeKeeper::new();
+        k.start(record());
+        k.begin(0, 0);
+        let in_flight = 40;
+        for line in 1..=1_000u32 {
+            let emitted = 10 * line.saturating_sub(in_flight);
+            k.answered(mark(line, 10 * line), emitted);
+            if let Some(r) = k.due(emitted, u64::from(line) * 10) {
+                let completed = line.saturating_sub(in_flight);
+                // Never ahead of the pen, and at most the marks' reach behind it.
+                assert!(r.line <= completed + 1, "line {line}: record of {} ahead of {completed}", r.line);
+                if line > 200 {
+                    let behind = completed + 1 - r.line;
+                    assert!(behind <= in_flight, "line {line}: record {behind} lines behind the pen");
+                }
+            }
+        }
     }
 }

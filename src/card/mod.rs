@@ -99,7 +99,7 @@ pub trait Card {
     fn clear_resume(&mut self) -> Result<(), CardError> {
         let mut slots = ResumeSlots::new();
         self.read_resume(&mut slots)?;
-        let Some((newest, _)) = slots.newest() else {
+        let Some((newest, _)) = slots.newest_seq() else {
             return Ok(());
         };
         let empty = [0; RESUME_RECORD_BYTES];

@@ -16,7 +16,7 @@
 
 use heapless::String;
 
-use crate::card::names::{CARD_SHORT_NAME_MAX_BYTES, CardFile};
+use crate::card::names::{CARD_NAME_MAX_BYTES, CARD_SHORT_NAME_MAX_BYTES, CardFile, FileName};
 use crate::crc::crc32;
 use crate::fields::FieldWriter;
 use crate::geom::Point;
@@ -44,9 +44,26 @@ const FLAG_AFTER_CR: u8 = 4;
 
 /// A record's bytes: magic 4, format 2, flags 1, tool 1, sequence 4, file name 12, file length
 /// 4, offset 4, line 4, position 8, the file's lines 4, modes 6, two bytes kept zero, feed 4,
-/// S 4, the kept offsets 8 each, G92 8, CRC 4.
-pub const RESUME_RECORD_BYTES: usize =
-    4 + 2 + 1 + 1 + 4 + CARD_SHORT_NAME_MAX_BYTES + 4 + 4 + 4 + 8 + 4 + 6 + 2 + 4 + 4 + 8 * KEPT_OFFSETS + 8 + 4;
+/// S 4, the kept offsets 8 each, G92 8, the name as listed 32, CRC 4.
+pub const RESUME_RECORD_BYTES: usize = 4
+    + 2
+    + 1
+    + 1
+    + 4
+    + CARD_SHORT_NAME_MAX_BYTES
+    + 4
+    + 4
+    + 4
+    + 8
+    + 4
+    + 6
+    + 2
+    + 4
+    + 4
+    + 8 * KEPT_OFFSETS
+    + 8
+    + CARD_NAME_MAX_BYTES
+    + 4;
 
 const _: () = assert!(RESUME_RECORD_BYTES <= RESUME_SLOT_BYTES);
 
@@ -82,6 +99,8 @@ pub struct ResumeRecord {
     pub seq: u32,
     /// The plotted file's 8.3 name ([`CardFile::short`]).
     pub file: String<CARD_SHORT_NAME_MAX_BYTES>,
+    /// Its name as the card's list shows it ([`CardFile::name`]).
+    pub name: FileName,
     /// The file's length when it was plotted, bytes: a file of another length has changed.
     pub file_bytes: u32,
     /// Where in the file the line after the last completed one starts, bytes.
@@ -111,14 +130,16 @@ impl ResumeRecord {
         let flags = if m.feed_mm_per_min.is_some() { FLAG_FEED } else { 0 }
             | if m.spindle_speed.is_some() { FLAG_SPEED } else { 0 }
             | if self.after_cr { FLAG_AFTER_CR } else { 0 };
-        let mut name = [0u8; CARD_SHORT_NAME_MAX_BYTES];
-        name[..self.file.len()].copy_from_slice(self.file.as_bytes());
+        let mut short = [0u8; CARD_SHORT_NAME_MAX_BYTES];
+        short[..self.file.len()].copy_from_slice(self.file.as_bytes());
+        let mut name = [0u8; CARD_NAME_MAX_BYTES];
+        name[..self.name.len()].copy_from_slice(self.name.as_bytes());
         let mut w = FieldWriter::new(&mut out);
         w.put(&RESUME_MAGIC.to_le_bytes());
         w.put(&RESUME_FORMAT.to_le_bytes());
         w.put(&[flags, m.tool]);
         w.put(&self.seq.to_le_bytes());
-        w.put(&name);
+        w.put(&short);
         for word in [self.file_bytes, self.offset, self.line] {
             w.put(&word.to_le_bytes());
         }
@@ -134,6 +155,7 @@ impl ResumeRecord {
             w.put(&pair[0].to_le_bytes());
             w.put(&pair[1].to_le_bytes());
         }
+        w.put(&name);
         let crc = crc32(&out[..RESUME_RECORD_BYTES - 4]);
         out[RESUME_RECORD_BYTES - 4..].copy_from_slice(&crc.to_le_bytes());
         out
@@ -158,7 +180,7 @@ impl ResumeRecord {
             return Err(BadResume::Mode);
         }
         let seq = u32::from_le_bytes(r.take());
-        let file = name(&r.take())?;
+        let file = text(&r.take())?;
         let file_bytes = u32::from_le_bytes(r.take());
         let offset = u32::from_le_bytes(r.take());
         let line = u32::from_le_bytes(r.take());
@@ -197,6 +219,7 @@ impl ResumeRecord {
         let mut kept_mm = [[0.0; 2]; KEPT_OFFSETS];
         kept_mm.copy_from_slice(&offsets_mm[..KEPT_OFFSETS]);
         let g92_mm = offsets_mm[KEPT_OFFSETS];
+        let name = text(&r.take())?;
         let modal = Modal {
             motion,
             units,
@@ -211,7 +234,7 @@ impl ResumeRecord {
             g92_mm,
         };
         let after_cr = flags & FLAG_AFTER_CR != 0;
-        Ok(ResumeRecord { seq, file, file_bytes, offset, line, after_cr, position, lines, modal })
+        Ok(ResumeRecord { seq, file, name, file_bytes, offset, line, after_cr, position, lines, modal })
     }
 }
 
@@ -225,7 +248,7 @@ fn optional(value: f32, present: bool) -> Result<Option<f32>, BadResume> {
 }
 
 /// A file name's bytes: UTF-8 text without control bytes, then zeros to the end.
-fn name(bytes: &[u8; CARD_SHORT_NAME_MAX_BYTES]) -> Result<String<CARD_SHORT_NAME_MAX_BYTES>, BadResume> {
+fn text<const N: usize>(bytes: &[u8; N]) -> Result<String<N>, BadResume> {
     let len = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
     let text = core::str::from_utf8(&bytes[..len]).map_err(|_| BadResume::Name)?;
     if len == 0 || bytes[len..].iter().any(|&b| b != 0) || text.chars().any(char::is_control) {
@@ -254,20 +277,36 @@ impl ResumeSlots {
 
     /// The slot holding the newest valid record, and the record.
     pub fn newest(&self) -> Option<(usize, ResumeRecord)> {
-        let [a, b] = [0, 1].map(|i| ResumeRecord::decode(&self.slots[i]).ok());
-        match (a, b) {
-            (Some(a), Some(b)) if newer(b.seq, a.seq) => Some((1, b)),
-            (Some(a), _) => Some((0, a)),
-            (None, Some(b)) => Some((1, b)),
-            (None, None) => None,
+        let mut newest: Option<(usize, ResumeRecord)> = None;
+        for (slot, bytes) in self.slots.iter().enumerate() {
+            if let Ok(record) = ResumeRecord::decode(bytes)
+                && newest.as_ref().is_none_or(|(_, other)| newer(record.seq, other.seq))
+            {
+                newest = Some((slot, record));
+            }
         }
+        newest
+    }
+
+    /// The slot holding the newest valid record, and its sequence number (the record itself is
+    /// not kept: a store needs no more).
+    pub fn newest_seq(&self) -> Option<(usize, u32)> {
+        let mut newest: Option<(usize, u32)> = None;
+        for (slot, bytes) in self.slots.iter().enumerate() {
+            if let Ok(seq) = ResumeRecord::decode(bytes).map(|record| record.seq)
+                && newest.is_none_or(|(_, other)| newer(seq, other))
+            {
+                newest = Some((slot, seq));
+            }
+        }
+        newest
     }
 
     /// Where the next store goes: the slot not holding the newest valid record, and the
     /// sequence number one after it (the first slot, number 1, when neither holds one).
     pub fn next_write(&self) -> (usize, u32) {
-        match self.newest() {
-            Some((slot, record)) => (1 - slot, record.seq.wrapping_add(1)),
+        match self.newest_seq() {
+            Some((slot, seq)) => (1 - slot, seq.wrapping_add(1)),
             None => (0, 1),
         }
     }

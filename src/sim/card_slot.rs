@@ -107,6 +107,7 @@ mod tests {
         ResumeRecord {
             seq: 0,
             file: "PLOT.NC".try_into().unwrap(),
+            name: "plot.nc".try_into().unwrap(),
             file_bytes: 4_000,
             offset: line * 20,
             line,

@@ -16,6 +16,7 @@ fn sample(seq: u32) -> ResumeRecord {
     ResumeRecord {
         seq,
         file: String::try_from("SQUARE~1.GCO").unwrap(),
+        name: String::try_from("square with a long name.gcode").unwrap(),
         file_bytes: 5000,
         offset: 1234,
         line: 42,
@@ -218,6 +219,7 @@ fn any_record() -> impl Strategy<Value = ResumeRecord> {
             let (feed_mm_per_min, spindle_speed, kept_mm, g92_mm) = numbers;
             ResumeRecord {
                 seq,
+                name: file.as_str().try_into().unwrap(),
                 file,
                 file_bytes,
                 offset,

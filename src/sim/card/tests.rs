@@ -87,6 +87,7 @@ fn record(line: u32) -> ResumeRecord {
     ResumeRecord {
         seq: 0,
         file: "PLOT.NC".try_into().unwrap(),
+        name: "plot.nc".try_into().unwrap(),
         file_bytes: plot_file().len() as u32,
         offset: line * 10,
         line,

@@ -154,6 +154,7 @@ impl CardPlot {
         let record = ResumeRecord {
             seq: 0,
             file: file.short.clone(),
+            name: file.name.clone(),
             file_bytes: file.bytes,
             offset: 0,
             line: 1,
@@ -288,6 +289,7 @@ impl CardPlot {
 
 /// Stores the plot's resume record if one is due, `emitted_steps` emitted at `now_ms`. A card
 /// that takes no record says so in a log line, and the plot goes on.
+#[inline(never)]
 pub fn keep(slot: &CardSlot<'_>, keeper: &mut ResumeKeeper, emitted_steps: u32, now_ms: u64) {
     if let Some(record) = keeper.due(emitted_steps, now_ms)
         && let Err(e) = slot.with(|card| card.store_resume(record))
@@ -298,7 +300,9 @@ pub fn keep(slot: &CardSlot<'_>, keeper: &mut ResumeKeeper, emitted_steps: u32, 
 
 /// The plot ends as it was meant to (its last line, a refusal, an abort), or a resume is
 /// dropped: no record stays.
+#[inline(never)]
 pub fn clear(slot: &CardSlot<'_>, keeper: &mut ResumeKeeper) {
+    info!("card plot over: its resume record, kept {} times, cleared", keeper.stores());
     keeper.stop();
     if let Err(e) = slot.with(|card| card.clear_resume()) {
         warn!("card: resume record not cleared: {}", e.message());
@@ -319,29 +323,23 @@ fn travel_line(at: Point, settings: &Settings) -> String<TRAVEL_LINE_BYTES> {
 /// The offer of the plot `record` was kept of, if its file is on the card as it was (same name,
 /// same length); a record of a file changed or gone is cleared.
 pub fn offer(slot: &CardSlot<'_>, record: &ResumeRecord) -> Option<CardFile> {
-    // The file as the list shows it (its long name), or, beyond the list, by its 8.3 name.
-    let listed =
-        slot.with(|card| card.files()).ok().and_then(|files| files.iter().find(|f| f.short == record.file).cloned());
-    let file = listed.or_else(|| {
-        let file = CardFile { name: record.file.as_str().try_into().ok()?, short: record.file.clone(), bytes: 0 };
-        let bytes = slot.with(|card| {
-            let bytes = card.open(&file);
-            card.close();
-            bytes
-        });
-        Some(CardFile { bytes: bytes.ok()?, ..file })
+    let file = CardFile { name: record.name.clone(), short: record.file.clone(), bytes: record.file_bytes };
+    let bytes = slot.with(|card| {
+        let bytes = card.open(&file);
+        card.close();
+        bytes
     });
-    let Some(file) = file.filter(|file| record.is_for(file)) else {
+    if bytes != Ok(record.file_bytes) {
         warn!(
             "card: the plot stopped at line {} of {} cannot resume: its file changed",
             record.line,
-            record.file.as_str()
+            file.name.as_str()
         );
         if let Err(e) = slot.with(|card| card.clear_resume()) {
             warn!("card: resume record not cleared: {}", e.message());
         }
         return None;
-    };
+    }
     info!("card: the plot of {} stopped at line {}: offered to resume", file.name.as_str(), record.line);
     slot.set_progress(CardProgress::Offer(ResumeOffer::new(&file.name, record.line, record.lines)));
     Some(file)

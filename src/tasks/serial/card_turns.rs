@@ -12,7 +12,7 @@ use super::card_plot::{self, CardPlot, CardRoom, CardSession, CardStep, CardTurn
 use super::{Host, Parser, Unfinished};
 use crate::card::keeper::{LineMark, RESUME_STORE_MIN_MS, ResumeKeeper};
 use crate::card::{CardError, CardFacts, CardFile, CardLine, CardLines, CardPicture, CardProgress, CardSlot, CardStop};
-use crate::host::gcode::GcodeState;
+use crate::host::gcode::{GcodeState, Modal};
 use crate::machine_io::pen::Pen;
 use crate::motion::job::Control;
 use crate::program::check::Progress;
@@ -221,8 +221,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
                 };
             }
             CardStep::Restore(modal) if !aborted => {
-                let at = self.plan.map_or(host.machine.position(), |end| end.at());
-                self.gcode = GcodeState::resumed(modal, at, &host.machine.settings());
+                self.restore(modal);
                 return true;
             }
             CardStep::Begin if !aborted => {
@@ -248,24 +247,33 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
             Err(Unfinished::Error(e)) if host.machine.plan_end() == self.plan || self.plan.is_none() => Some(e),
             Err(_) => return self.plot_over(slot, keeper),
         };
-        let (next_line, offset, after_cr) = plot.place();
-        let mark = self.plan.map(|end| LineMark {
-            next_line,
-            offset,
-            after_cr,
-            handed_steps: self.handed_steps,
-            position: end.at(),
-            modal: self.gcode.modal(),
-        });
         if !plot.answered(slot, number, refused) {
             return self.plot_over(slot, keeper);
         }
-        let emitted = host.machine.emitted_totals().0;
-        if let Some(mark) = mark {
-            keeper.answered(mark, emitted);
+        self.line_done(slot, plot, keeper);
+        true
+    }
+
+    /// The plot's line was answered `ok`: marked for the resume record, which is stored if due.
+    /// Out of line: the mark and the record are temporaries of this frame only.
+    #[inline(never)]
+    fn line_done(&self, slot: &CardSlot<'_>, plot: &CardPlot, keeper: &mut ResumeKeeper) {
+        let emitted = self.host.machine.emitted_totals().0;
+        if let Some(end) = self.plan {
+            let (next_line, offset, after_cr) = plot.place();
+            let modal = self.gcode.modal();
+            let handed_steps = self.handed_steps;
+            keeper.answered(LineMark { next_line, offset, after_cr, handed_steps, position: end.at(), modal }, emitted);
         }
         card_plot::keep(slot, keeper, emitted, Instant::now().as_millis());
-        true
+    }
+
+    /// The parser's state is `modal`'s, planned from where the plan ends (the resume's rapid
+    /// took the pen there).
+    #[inline(never)]
+    fn restore(&mut self, modal: &Modal) {
+        let at = self.plan.map_or(self.host.machine.position(), |end| end.at());
+        self.gcode = GcodeState::resumed(modal, at, &self.host.machine.settings());
     }
 
     /// Carries out a line of the card plot (of its file, or a move of its own), as a line of a
@@ -312,6 +320,7 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
 }
 
 /// At power-on: the plot a power cut stopped, offered if the card keeps one whose file is there.
+#[inline(never)]
 fn offer(slot: &CardSlot<'_>) -> CardSession {
     match slot.with(|card| card.load_resume()) {
         Ok(Some(record)) => match card_plot::offer(slot, &record) {
