@@ -92,7 +92,8 @@ fn a_file_that_leaves_the_travel_is_refused_before_the_pen_goes_down() {
     for (head, said) in [("$213=1\n", "Line 7: error:15"), ("$213=1\n$20=0\n", "Line 8: error:15")] {
         let file = format!("{head}{body}");
         let report = run_keys_with(Some(card(&[("wide.gcode", file.as_bytes())])), &format!("{TO_CARD} # {PLOT}"));
-        assert!(shown(&report, said), "the LCD says why: {said}");
+        assert!(shown(&report, said), "the LCD says which line: {said}");
+        assert!(shown(&report, "Beyond travel limits"), "and why");
         assert_eq!(report.trace.counts(), [0; 4], "nothing moved, not even the moves before it");
         assert_eq!(report.position, Point::ORIGIN);
     }
@@ -126,6 +127,11 @@ fn a_file_with_an_error_on_line_300_is_refused_before_anything_moves() {
     let answers = sim::run_serial("G1 X1 Y1 W5\n").answers();
     let error = answers.lines().find(|l| l.starts_with("error:")).expect("refused over the wire");
     assert!(shown(&report, &format!("Line 300: {error}")), "the LCD names the line and the error");
+    // and, below them, why in words.
+    let said = report.frames.iter().map(|(_, f)| lines(f)).find(|l| l[2].starts_with("Line 300: error:"));
+    let said = said.expect("the refusal on the screen");
+    assert_eq!(error, "error:20");
+    assert_eq!(said[3].trim_end(), "Unsupported command", "{said:?}");
 }
 
 #[test]

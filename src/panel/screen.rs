@@ -35,7 +35,6 @@ use crate::decimal::{Int, Num};
 use crate::geom::Step;
 use crate::machine_io::homing::HomingFail;
 use crate::machine_io::inputs::Trip;
-use crate::motion::drawing::DrawError;
 use crate::motion::interp::CurveError;
 use crate::motion::overrides::OVERRIDE_NONE_PERCENT;
 use crate::panel::entry::{ENTRY_MAX_CHARS, EntryError};
@@ -79,7 +78,11 @@ pub fn view(menu: &Menu, status: &Status, settings: &Settings, live: &Live) -> S
         }
         (None, _) => menu_view(menu, status, settings, live),
     };
-    if let Some(error) = menu.message() {
+    if let Some(refused @ UiError::CardLine { error, .. }) = menu.message() {
+        // A card file's line refused: its number and error, and why in words below.
+        v.lines[SCREEN_LINES - 2] = TextLine::new(format_args!("{}", ErrorText(refused, language)), true);
+        v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", Say(Msg::from(error), language)), true);
+    } else if let Some(error) = menu.message() {
         v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", ErrorText(error, language)), true);
     } else if let (RunState::Idle | RunState::Alarm, Some(fault)) = (status.state, status.fault) {
         v.lines[SCREEN_LINES - 1] = TextLine::new(format_args!("{}", FaultText(fault, language)), true);
@@ -349,14 +352,7 @@ impl fmt::Display for ErrorText {
             }
             UiError::Zero => Msg::ErrZero,
             UiError::SameEnds => Msg::ErrSameEnds,
-            UiError::Drawing(DrawError::Travel) => Msg::ErrTravel,
-            UiError::Drawing(DrawError::TooSteep) => Msg::ErrSteep,
-            UiError::Drawing(DrawError::TooFine) => Msg::ErrFine,
-            UiError::Drawing(DrawError::Imprecise) => Msg::ErrImprecise,
-            UiError::Drawing(DrawError::BadParameter) => Msg::ErrParameter,
-            UiError::Drawing(DrawError::Setup(_)) => Msg::ErrStart,
-            UiError::Drawing(DrawError::Fails { error: CurveError::Jump, .. }) => Msg::ErrJumps,
-            UiError::Drawing(DrawError::Fails { .. }) => Msg::ErrUndefinedThere,
+            UiError::Drawing(e) => Msg::from(e),
             UiError::Busy => Msg::ErrBusy,
             UiError::Alarm => Msg::ErrAlarm,
             UiError::HomingOff => Msg::ErrHomingOff,

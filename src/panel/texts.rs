@@ -12,7 +12,10 @@
 
 use core::fmt::{self, Write};
 
+use crate::host::GrblError;
+use crate::motion::drawing::DrawError;
 use crate::motion::expr::{EvalError, ParseErrorKind};
+use crate::motion::interp::CurveError;
 use crate::panel::language::Language;
 
 include!(concat!(env!("OUT_DIR"), "/texts.rs"));
@@ -108,6 +111,62 @@ impl From<EvalError> for Msg {
             EvalError::TanPole => Msg::EvalTan,
             EvalError::DivisionByZero => Msg::FaultDivision,
             EvalError::Overflow => Msg::FaultOverflow,
+        }
+    }
+}
+
+/// Why a drawing was refused: on the LCD.
+impl From<DrawError> for Msg {
+    fn from(e: DrawError) -> Msg {
+        match e {
+            DrawError::Travel => Msg::ErrTravel,
+            DrawError::TooSteep => Msg::ErrSteep,
+            DrawError::TooFine => Msg::ErrFine,
+            DrawError::Imprecise => Msg::ErrImprecise,
+            DrawError::BadParameter => Msg::ErrParameter,
+            DrawError::Setup(_) => Msg::ErrStart,
+            DrawError::Fails { error: CurveError::Jump, .. } => Msg::ErrJumps,
+            DrawError::Fails { .. } => Msg::ErrUndefinedThere,
+        }
+    }
+}
+
+/// Why a line was refused, in words (the host link sends its number, `error:N`): on the LCD,
+/// for a card file's line.
+impl From<GrblError> for Msg {
+    fn from(e: GrblError) -> Msg {
+        match e {
+            GrblError::ExpectedCommandLetter => Msg::WhyLetter,
+            GrblError::BadNumberFormat => Msg::WhyNumber,
+            GrblError::Expression { kind, .. } => Msg::from(kind),
+            GrblError::InvalidStatement => Msg::WhyStatement,
+            GrblError::NegativeValue => Msg::WhyNegative,
+            GrblError::SettingDisabled => Msg::WhySettingOff,
+            GrblError::NotIdle => Msg::WhyNotIdle,
+            GrblError::Locked => Msg::WhyLocked,
+            GrblError::LineOverflow | GrblError::LineLengthExceeded => Msg::WhyLineLong,
+            GrblError::TravelExceeded => Msg::ErrTravel,
+            GrblError::InvalidJog => Msg::WhyJog,
+            GrblError::Unsupported => Msg::WhyUnsupported,
+            GrblError::ModalGroupViolation => Msg::WhyModal,
+            GrblError::UndefinedFeedRate => Msg::WhyFeed,
+            GrblError::ValueNotInteger => Msg::ErrWhole,
+            GrblError::AxisCommandConflict => Msg::WhyAxisConflict,
+            GrblError::RepeatedWord => Msg::WhyRepeated,
+            GrblError::NoAxisWords | GrblError::NoAxisWordsInPlane => Msg::WhyNoAxis,
+            GrblError::InvalidLineNumber => Msg::WhyLineNumber,
+            GrblError::ValueWordMissing => Msg::WhyValueMissing,
+            GrblError::UnsupportedCoordSys => Msg::WhyCoordSys,
+            GrblError::G53InvalidMotionMode => Msg::WhyG53,
+            GrblError::AxisWordsExist => Msg::WhyAxisWords,
+            GrblError::InvalidTarget => Msg::WhyArcTarget,
+            GrblError::FunctionUndefined { error, .. } => Msg::from(error),
+            GrblError::Drawing(e) => Msg::from(e),
+            GrblError::ArcRadius => Msg::WhyArcRadius,
+            GrblError::NoOffsetsInPlane => Msg::WhyArcOffsets,
+            GrblError::UnusedWords => Msg::WhyUnused,
+            GrblError::MaxValueExceeded => Msg::WhyTooLarge,
+            GrblError::ReceiveBufferFull => Msg::WhyBufferFull,
         }
     }
 }
