@@ -22,6 +22,8 @@
 //! the pen up, a rapid to where the completed line left the pen, the parser's state as it was
 //! there and the pen as that state has it; then the file's lines go on from the next.
 
+use core::fmt::Write as _;
+
 use embedded_io_async::{ErrorType, Write};
 use heapless::String;
 
@@ -35,7 +37,6 @@ use crate::host::gcode::{Modal, Spindle};
 use crate::program::check::{CheckPlanner, ProgramCheck};
 use crate::program::preview::PlotProgress;
 use crate::settings::Settings;
-use core::fmt::Write as _;
 
 /// A line from a host link while a card file is checked or plotted: refused, not idle.
 pub const HOST_LINE_DURING_CARD_PLOT: GrblError = GrblError::NotIdle;
@@ -80,8 +81,8 @@ pub enum CardTurn {
     Step,
 }
 
-/// The file being plotted, where its reading has got to, its number of lines, the resume's
-/// moves still to make, and its resume record.
+/// The file being plotted, where its reading has got to, its number of lines, and a resumed
+/// plot's own moves still to make.
 pub struct CardPlot {
     lines: CardLines,
     total: u32,
