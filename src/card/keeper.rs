@@ -15,7 +15,7 @@ use heapless::Deque;
 
 use super::resume::ResumeRecord;
 use crate::geom::Point;
-use crate::host::gcode::Modal;
+use crate::host::gcode::{GcodeState, Modal};
 
 /// Lines whose motion is awaited, at most (more merge into the newest).
 pub const RESUME_MARKS: usize = 16;
@@ -94,6 +94,12 @@ impl ResumeKeeper {
         self.stores
     }
 
+    /// Where the plot began (a resumed one: where the record said it goes on), until the first
+    /// store after its lines began: the pen's point and the parser's state there.
+    pub fn record_at(&self) -> (Point, Modal) {
+        self.record.as_ref().map_or((Point::ORIGIN, GcodeState::new().modal()), |r| (r.position, r.modal))
+    }
+
     /// The plot is over: nothing more is kept.
     pub fn stop(&mut self) {
         self.record = None;
@@ -161,7 +167,6 @@ impl ResumeKeeper {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::host::gcode::GcodeState;
 
     fn record() -> ResumeRecord {
         ResumeRecord {

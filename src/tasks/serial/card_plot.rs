@@ -90,16 +90,14 @@ pub struct CardPlot {
     sent_all: bool,
     /// The resume's next move; [`ResumeMove::Lines`] for a plot from the start.
     next_move: ResumeMove,
-    /// A resumed plot's state after its last completed line, restored by its moves.
-    resumed: Option<Modal>,
-    /// The rapid to that place, as a line.
-    travel: String<TRAVEL_LINE_BYTES>,
+    /// A resumed plot's state, as restored, has the pen down.
+    pen_down: bool,
     /// The file's lines have begun: the resume's bookkeeping counts from then.
     begun: bool,
 }
 
 /// Bytes of the resume's rapid: `G21 G53 G0 X<mm> Y<mm>`, each coordinate to 4 decimals.
-const TRAVEL_LINE_BYTES: usize = 64;
+pub const TRAVEL_LINE_BYTES: usize = 64;
 /// Decimals of the resume's rapid: a ten-thousandth of a millimetre, far below a step.
 const TRAVEL_DECIMALS: u8 = 4;
 
@@ -123,9 +121,14 @@ pub enum ResumeMove {
 /// What the plot gives the line loop next.
 pub enum CardStep<'a> {
     /// A line of the resume's own moves, to carry out: the plot stops if it is refused.
-    Move(&'a str),
-    /// The parser's state is to be `modal`, planned from where the rapid left the pen.
-    Restore(&'a Modal),
+    Move(&'static str),
+    /// The resume's rapid to where the plot goes on ([`travel_line`]), a move as well.
+    Travel,
+    /// The parser's state is to be the one the plot goes on with, planned from where the rapid
+    /// left the pen.
+    Restore,
+    /// `M3` or `M4`, as the restored state has the pen down.
+    PenDown,
     /// The file's lines begin: the plot's counts are to be taken at rest.
     Begin,
     /// Line `number`, to carry out and answer with [`CardPlot::answered`].
@@ -184,8 +187,7 @@ impl CardPlot {
         info!("card plot: {} resumed from line {}", file.name.as_str(), record.line);
         let first = if settings.homing { ResumeMove::Home } else { ResumeMove::PenUp };
         let mut plot = CardPlot::open(slot, file, record, first)?;
-        plot.travel = travel_line(record.position, settings);
-        plot.resumed = Some(record.modal);
+        plot.pen_down = record.modal.spindle != Spindle::Off;
         keeper.start(record.clone());
         Some(plot)
     }
@@ -207,8 +209,7 @@ impl CardPlot {
             total,
             sent_all: false,
             next_move: first,
-            resumed: None,
-            travel: String::new(),
+            pen_down: false,
             begun: false,
         })
     }
@@ -221,15 +222,13 @@ impl CardPlot {
     /// The plot's next move or line, read from the card.
     pub fn next<'s>(&'s mut self, slot: &CardSlot<'_>) -> CardStep<'s> {
         if let Some(step) = self.next_move() {
-            let modal = self.resumed.as_ref();
-            return match (step, modal) {
-                (ResumeMove::Home, _) => CardStep::Move("$H"),
-                (ResumeMove::PenUp, _) => CardStep::Move("M5"),
-                (ResumeMove::Travel, _) => CardStep::Move(&self.travel),
-                (ResumeMove::Restore, Some(modal)) => CardStep::Restore(modal),
-                (ResumeMove::PenDown, Some(modal)) if modal.spindle == Spindle::Ccw => CardStep::Move("M4"),
-                (ResumeMove::PenDown, _) => CardStep::Move("M3"),
-                (ResumeMove::Lines | ResumeMove::Restore, _) => CardStep::Begin,
+            return match step {
+                ResumeMove::Home => CardStep::Move("$H"),
+                ResumeMove::PenUp => CardStep::Move("M5"),
+                ResumeMove::Travel => CardStep::Travel,
+                ResumeMove::Restore => CardStep::Restore,
+                ResumeMove::PenDown => CardStep::PenDown,
+                ResumeMove::Lines => CardStep::Begin,
             };
         }
         if self.sent_all {
@@ -251,7 +250,7 @@ impl CardPlot {
     /// The resume's next move, if one is left (`Lines` once: the file's lines begin).
     fn next_move(&mut self) -> Option<ResumeMove> {
         let step = self.next_move;
-        let pen_down = self.resumed.as_ref().is_some_and(|modal| modal.spindle != Spindle::Off);
+        let pen_down = self.pen_down;
         self.next_move = match step {
             ResumeMove::Home => ResumeMove::PenUp,
             ResumeMove::PenUp => ResumeMove::Travel,
@@ -311,7 +310,7 @@ pub fn clear(slot: &CardSlot<'_>, keeper: &mut ResumeKeeper) {
 }
 
 /// The resume's rapid to `at`: in millimetres, machine coordinates.
-fn travel_line(at: Point, settings: &Settings) -> String<TRAVEL_LINE_BYTES> {
+pub fn travel_line(at: Point, settings: &Settings) -> String<TRAVEL_LINE_BYTES> {
     let mut line = String::new();
     let mm = |axis: usize, steps: i32| steps as f32 / settings.steps_per_mm[axis];
     let _fits = write!(line, "G21 G53 G0 X")

@@ -12,7 +12,7 @@ use super::card_plot::{self, CardPlot, CardRoom, CardSession, CardStep, CardTurn
 use super::{Host, Parser, Unfinished};
 use crate::card::keeper::{LineMark, RESUME_STORE_MIN_MS, ResumeKeeper};
 use crate::card::{CardError, CardFacts, CardFile, CardLine, CardLines, CardPicture, CardProgress, CardSlot, CardStop};
-use crate::host::gcode::{GcodeState, Modal};
+use crate::host::gcode::{GcodeState, Spindle};
 use crate::machine_io::pen::Pen;
 use crate::motion::job::Control;
 use crate::program::check::Progress;
@@ -204,24 +204,17 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         }
         let (resume_line, _, _) = plot.place();
         let (number, result) = match plot.next(slot) {
-            CardStep::Move(text) if !aborted => {
-                return match self.card_line(text).await {
-                    Ok(()) => {
-                        // Homing moved the plan's end: the next step starts from there.
-                        self.plan = host.machine.plan_end();
-                        true
-                    }
-                    Err(Unfinished::Error(error)) => {
-                        // The plot cannot go on from its place: the record stays for another try.
-                        self.card_end(slot);
-                        slot.stopped(CardStop::Refused { line: resume_line, error });
-                        false
-                    }
-                    Err(_) => self.plot_over(slot, keeper),
-                };
+            CardStep::Move(text) if !aborted => return self.resume_move(slot, keeper, resume_line, text).await,
+            CardStep::Travel if !aborted => {
+                let text = card_plot::travel_line(keeper.record_at().0, &host.machine.settings());
+                return self.resume_move(slot, keeper, resume_line, &text).await;
             }
-            CardStep::Restore(modal) if !aborted => {
-                self.restore(modal);
+            CardStep::PenDown if !aborted => {
+                let text = if keeper.record_at().1.spindle == Spindle::Ccw { "M4" } else { "M3" };
+                return self.resume_move(slot, keeper, resume_line, text).await;
+            }
+            CardStep::Restore if !aborted => {
+                self.restore(keeper);
                 return true;
             }
             CardStep::Begin if !aborted => {
@@ -268,12 +261,36 @@ impl<F: NorFlash, B: BetweenSlices> Parser<'_, '_, F, B> {
         card_plot::keep(slot, keeper, emitted, Instant::now().as_millis());
     }
 
-    /// The parser's state is `modal`'s, planned from where the plan ends (the resume's rapid
-    /// took the pen there).
+    /// A move of the resume's own (`text`), before the file's lines from `resume_line`: true if
+    /// the plot goes on. One refused leaves the record for another try.
+    async fn resume_move(
+        &mut self,
+        slot: &CardSlot<'_>,
+        keeper: &mut ResumeKeeper,
+        resume_line: u32,
+        text: &str,
+    ) -> bool {
+        match self.card_line(text).await {
+            Ok(()) => {
+                // Homing moved the plan's end: the next step starts from there.
+                self.plan = self.host.machine.plan_end();
+                true
+            }
+            Err(Unfinished::Error(error)) => {
+                self.card_end(slot);
+                slot.stopped(CardStop::Refused { line: resume_line, error });
+                false
+            }
+            Err(_) => self.plot_over(slot, keeper),
+        }
+    }
+
+    /// The parser's state is the one the plot goes on with, planned from where the plan ends
+    /// (the resume's rapid took the pen there).
     #[inline(never)]
-    fn restore(&mut self, modal: &Modal) {
+    fn restore(&mut self, keeper: &ResumeKeeper) {
         let at = self.plan.map_or(self.host.machine.position(), |end| end.at());
-        self.gcode = GcodeState::resumed(modal, at, &self.host.machine.settings());
+        self.gcode = GcodeState::resumed(&keeper.record_at().1, at, &self.host.machine.settings());
     }
 
     /// Carries out a line of the card plot (of its file, or a move of its own), as a line of a
