@@ -570,9 +570,6 @@ impl GcodeState {
         self.commit(&mut pending, settings).map(|_| ())
     }
 
-    /// Out of line: its words are temporaries of its own frame, not of [`parse`](Self::parse)'s,
-    /// which then holds the curve's builder.
-    #[inline(never)]
     fn parse_line(
         &mut self,
         line: &str,
