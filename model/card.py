@@ -110,15 +110,7 @@ def check():
     try:
         link = run.Link(run.connect(host_path))
         status = plot(link, run.connect(keys_path))
-        with link.lock:
-            seen = len(link.answers)
-        link.send(b"$I\n")
-        link.answered.acquire(timeout=10)
-        with link.lock:
-            info = link.answers[seen:]
-        address, _ = run.symbol("PULSES_EMITTED")
-        pulses = run.read_words(mon_path, address, 4)
-        run.monitor(mon_path, "quit")
+        _, info, pulses = run.finish(link, mon_path)
     finally:
         try:
             qemu.wait(timeout=10)

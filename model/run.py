@@ -201,6 +201,22 @@ def symbol(name):
     return found[0]
 
 
+def finish(link, mon_path):
+    """At the end of a run: the answers so far, the `$I` answer's lines (the stack's peak, the
+    longest poll) and the pulses the model emitted (`PULSES_EMITTED`, read through the
+    monitor); then QEMU quits."""
+    with link.lock:
+        before = list(link.answers)
+    link.send(b"$I\n")
+    link.answered.acquire(timeout=10)
+    with link.lock:
+        info = link.answers[len(before):]
+    address, _ = symbol("PULSES_EMITTED")
+    pulses = read_words(mon_path, address, 4)
+    monitor(mon_path, "quit")
+    return before, info, pulses
+
+
 def simulate(path):
     """The simulator's answers, pulses and final position for the same file."""
     out_dir = os.path.join(ROOT, "target", "model", "sim")
@@ -313,15 +329,7 @@ def check(args):
                 break
             time.sleep(0.05)
             status = link.status_now()
-        with link.lock:
-            seen = len(link.answers)
-        link.send(b"$I\n")
-        link.answered.acquire(timeout=10)
-        with link.lock:
-            info = link.answers[seen:]
-        address, _ = symbol("PULSES_EMITTED")
-        pulses = read_words(mon_path, address, 4)
-        monitor(mon_path, "quit")
+        answers, info, pulses = finish(link, mon_path)
     finally:
         try:
             qemu.wait(timeout=10)
@@ -333,7 +341,7 @@ def check(args):
     if stderr.strip():
         print(stderr)
 
-    model_answers = [a for a in link.answers[:seen] if a.strip()]
+    model_answers = [a for a in answers if a.strip()]
     print(f"\n{len(lines)} lines streamed in {elapsed:.1f} s of wall time; {len(model_answers)} answers, "
           f"{len(link.statuses)} status reports")
     if model_answers != sim_answers:

@@ -52,8 +52,6 @@ pub struct ResumeKeeper {
     done: Option<LineMark>,
     /// When the last record was stored, ms; `None` before the first.
     stored_at_ms: Option<u64>,
-    /// The line the stored record goes on from.
-    stored_line: u32,
     /// Records handed out to be stored since the plot began.
     stores: u32,
 }
@@ -73,14 +71,12 @@ impl ResumeKeeper {
             marks: Deque::new(),
             done: None,
             stored_at_ms: None,
-            stored_line: 0,
             stores: 0,
         }
     }
 
     /// A plot of `record.file` begins (from its start, or resumed): `record` is where.
     pub fn start(&mut self, record: ResumeRecord) {
-        self.stored_line = record.line;
         self.record = Some(record);
         self.counts_at_start = None;
         self.marks.clear();
@@ -146,19 +142,21 @@ impl ResumeKeeper {
         if self.counts_at_start.is_none() || self.stored_at_ms.is_some_and(|at| now_ms < at + RESUME_STORE_MIN_MS) {
             return None;
         }
+        // Once stored, the record is of the last line stored: only a newer one is worth a store.
+        let first = self.stored_at_ms.is_none();
         let record = self.record.as_mut()?;
-        if let Some(mark) = self.done.take() {
+        let mark = self.done.take().filter(|mark| mark.next_line != record.line);
+        if mark.is_none() && !first {
+            return None;
+        }
+        if let Some(mark) = mark {
             record.line = mark.next_line;
             record.offset = mark.offset;
             record.after_cr = mark.after_cr;
             record.position = mark.position;
             record.modal = mark.modal;
         }
-        if self.stored_at_ms.is_some() && record.line == self.stored_line {
-            return None;
-        }
         self.stored_at_ms = Some(now_ms);
-        self.stored_line = record.line;
         self.stores += 1;
         Some(record)
     }
