@@ -47,9 +47,8 @@ use slot::FutureSlot;
 pub const HEALTH_PERIOD_MS: u64 = 1_000;
 
 /// The shared state, in statics: the planner (50 KB) built where it lies, a field at a time; the
-/// step queue and the panel in place; the machine (3 KB) and the flash store (1 KB) built in
-/// frames of their own and moved in. `.ci/run` holds every frame of the image to 4 KiB.
-static MACHINE: StaticCell<Machine> = StaticCell::new();
+/// step queue in place; the machine (4 KB), the panel (2.5 KB) and the flash store (1 KB) built
+/// in frames of their own and moved in. `.ci/run` holds every frame of the image to 4 KiB.
 static STEP_QUEUE: ConstStaticCell<StepQueue> = ConstStaticCell::new(StepQueue::new());
 static PLANNER: StaticCell<Planner<Curve, PLANNER_SEGMENTS>> = StaticCell::new();
 static STORE: StaticCell<Store<board::Flash>> = StaticCell::new();
@@ -61,8 +60,6 @@ type Links = ((board::HostRx, board::HostTx), (board::LinkRx, board::LinkTx));
 static LINKS: StaticCell<Links> = StaticCell::new();
 /// Room for it, bytes: a build fails should it outgrow this.
 const HOST_LINK_FUTURE_BYTES: usize = 18 * 1024;
-/// The keypad menu, shared by the keypad and LCD tasks (both in thread mode).
-static PANEL: StaticCell<Panel> = StaticCell::new();
 /// The board's card slot, shared by the keypad, host link and LCD tasks (all in thread mode).
 static CARD_SLOT: StaticCell<CardSlot<'static>> = StaticCell::new();
 /// The card file's check (4 KB) and the planner it times the plot with (50 KB), in the
@@ -76,6 +73,14 @@ static mut CHECK_PLANNER: MaybeUninit<CheckPlanner> = MaybeUninit::uninit();
 /// A card plot's resume bookkeeping (2 KB), beside them.
 #[unsafe(link_section = ".ccmram")]
 static mut RESUME_KEEPER: MaybeUninit<ResumeKeeper> = MaybeUninit::uninit();
+/// The machine (4 KB) and the keypad menu (2.5 KB, shared by the keypad and LCD tasks), in the
+/// core-coupled RAM as well: only the core reads them, never a DMA. The stack, below the statics
+/// in SRAM (flip-link), has their 6.5 KB more room for it. Built in place once ([`start`]'s
+/// [`core_coupled`]).
+#[unsafe(link_section = ".ccmram")]
+static mut MACHINE: MaybeUninit<Machine> = MaybeUninit::uninit();
+#[unsafe(link_section = ".ccmram")]
+static mut PANEL: MaybeUninit<Panel> = MaybeUninit::uninit();
 
 #[cortex_m_rt::entry]
 fn main() -> ! {
@@ -103,7 +108,8 @@ fn start(spawner: Spawner) {
         "settings loaded ({=str}): {} x {} steps/mm, pulses up to {} Hz",
         why, settings.steps_per_mm[0], settings.steps_per_mm[1], settings.max_pulse_rate_hz
     );
-    let machine: &'static Machine = build_machine(MACHINE.uninit(), settings);
+    let (machine_slot, panel_slot) = core_coupled();
+    let machine: &'static Machine = build_machine(machine_slot, settings);
     let Some(handles) = machine.handles() else { defmt::panic!("the machine's handles taken twice") };
     let planner = Planner::init(PLANNER.uninit(), Limits::from_settings(&settings));
 
@@ -112,7 +118,7 @@ fn start(spawner: Spawner) {
     let motion_spawner: SendSpawner = board::start_motion_executor();
     motion_spawner.spawn(timed(motion(handles.motion, planner, steps), "motion", Executor::Interrupt));
 
-    let panel: &'static Panel = PANEL.init_with(Panel::new);
+    let panel: &'static Panel = build_panel(panel_slot);
     let card: &'static CardSlot<'static> = CARD_SLOT.init(CardSlot::new(board.card));
     spawner.spawn(timed(keypad(machine, panel, card, board.columns, board.rows), "keypad", Executor::ThreadMode));
     spawner.spawn(timed(
@@ -129,10 +135,26 @@ fn start(spawner: Spawner) {
     spawner.spawn(timed(health(), "health", Executor::ThreadMode));
 }
 
-/// The machine, built and moved into `slot` in a frame of its own (3 KB), out of the caller's.
+/// The machine's and the panel's slots in the core-coupled RAM, once.
+fn core_coupled() -> (&'static mut MaybeUninit<Machine>, &'static mut MaybeUninit<Panel>) {
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    if TAKEN.swap(true, Ordering::Relaxed) {
+        defmt::panic!("the machine's and the panel's slots taken twice");
+    }
+    // SAFETY: `TAKEN` lets this run once, so these are the only references to the two statics.
+    unsafe { (&mut *addr_of_mut!(MACHINE), &mut *addr_of_mut!(PANEL)) }
+}
+
+/// The machine, built and moved into `slot` in a frame of its own (4 KB), out of the caller's.
 #[inline(never)]
 fn build_machine(slot: &'static mut MaybeUninit<Machine>, settings: Settings) -> &'static Machine {
     slot.write(Machine::new(settings))
+}
+
+/// The panel, built and moved into `slot` in a frame of its own (2.5 KB), out of the caller's.
+#[inline(never)]
+fn build_panel(slot: &'static mut MaybeUninit<Panel>) -> &'static Panel {
+    slot.write(Panel::new())
 }
 
 /// The card's slot, with the check of its files and that check's planner, built in place in the
